@@ -1,0 +1,3 @@
+//! Strapdown INS error analysis (work in progress; see module docs).
+
+pub mod earth;
