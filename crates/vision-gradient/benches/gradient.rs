@@ -1,0 +1,125 @@
+//! Criterion benches of the directional gradient: full frame (fixed and adaptive threshold,
+//! AVX2 and portable backends) at 320×240 and 640×480, and the tracking mode (two windows).
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::hint::black_box;
+use vision_gradient::{
+    Backend, ColSpan, EdgeBuffer, GradientDetector, GradientParams, GreyImage, Region, Threshold,
+};
+
+/// Road-like test frame: textured grey with two bright diagonal marks.
+fn frame(w: usize, h: usize) -> Vec<u8> {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut data = vec![0u8; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let mut v = 90 + rng.random_range(0..24);
+            let xl = w as f64 * 0.45 - (y as f64 - h as f64 * 0.5) * 0.9;
+            let xr = w as f64 * 0.55 + (y as f64 - h as f64 * 0.5) * 0.9;
+            if y > h / 2 && ((x as f64 - xl).abs() < 2.5 || (x as f64 - xr).abs() < 2.5) {
+                v = 220;
+            }
+            data[y * w + x] = v as u8;
+        }
+    }
+    data
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("gradient");
+    for &(w, h) in &[(320usize, 240usize), (640, 480)] {
+        let data = frame(w, h);
+        let img = GreyImage::new(&data, w, h, w).unwrap();
+        let mut edges = EdgeBuffer::with_capacity(w * h);
+        let mut class_img = vec![0u8; w * h];
+        let mut backends = vec![("portable", Backend::Portable)];
+        if GradientDetector::with_backend(GradientParams::default(), Backend::Avx2).is_ok() {
+            backends.push(("avx2", Backend::Avx2));
+        }
+        for (name, backend) in backends {
+            let fixed = GradientDetector::with_backend(GradientParams::default(), backend).unwrap();
+            group.bench_function(
+                BenchmarkId::new(format!("full_fixed_{name}"), format!("{w}x{h}")),
+                |b| {
+                    b.iter(|| {
+                        fixed
+                            .detect(black_box(&img), Region::Full, &mut edges, None)
+                            .unwrap()
+                    })
+                },
+            );
+            group.bench_function(
+                BenchmarkId::new(format!("full_fixed_classimg_{name}"), format!("{w}x{h}")),
+                |b| {
+                    b.iter(|| {
+                        fixed
+                            .detect(
+                                black_box(&img),
+                                Region::Full,
+                                &mut edges,
+                                Some(&mut class_img),
+                            )
+                            .unwrap()
+                    })
+                },
+            );
+            let params = GradientParams {
+                threshold: Threshold::Adaptive {
+                    keep_fraction: 0.05,
+                    min_magnitude: 40,
+                },
+                ..GradientParams::default()
+            };
+            let adaptive = GradientDetector::with_backend(params, backend).unwrap();
+            group.bench_function(
+                BenchmarkId::new(format!("full_adaptive_{name}"), format!("{w}x{h}")),
+                |b| {
+                    b.iter(|| {
+                        adaptive
+                            .detect(black_box(&img), Region::Full, &mut edges, None)
+                            .unwrap()
+                    })
+                },
+            );
+            // Tracking: one 40-px window per row in the lower half, per lane (two calls).
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            let spans: Vec<Vec<ColSpan>> = (0..2)
+                .map(|lane| {
+                    (0..h)
+                        .map(|y| {
+                            if y < h / 2 {
+                                return ColSpan::EMPTY;
+                            }
+                            let x0 = if lane == 0 {
+                                w as i64 / 4
+                            } else {
+                                w as i64 * 3 / 4
+                            };
+                            let x = x0 + rng.random_range(-3..=3);
+                            ColSpan::clamped(x - 20, x + 20, w)
+                        })
+                        .collect()
+                })
+                .collect();
+            group.bench_function(
+                BenchmarkId::new(format!("spans_two_lanes_40px_{name}"), format!("{w}x{h}")),
+                |b| {
+                    b.iter(|| {
+                        for s in &spans {
+                            fixed
+                                .detect(black_box(&img), Region::Spans(s), &mut edges, None)
+                                .unwrap();
+                        }
+                    })
+                },
+            );
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

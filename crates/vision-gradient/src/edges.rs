@@ -1,0 +1,115 @@
+//! Output types: edge pixels, the caller-owned edge buffer, per-call statistics.
+
+/// Orientation class of a kept edge pixel. The discriminant is the value written into the
+/// class image (`0` = not a candidate).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum EdgeClass {
+    /// Edge running from bottom-left up to top-right in the image (`gx·gy > 0`).
+    LeftLane = 1,
+    /// Edge running from bottom-right up to top-left in the image (`gx·gy < 0`).
+    RightLane = 2,
+}
+
+/// One lane-candidate pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EdgePixel {
+    /// Column (x, to the right), pixels.
+    pub col_px: u16,
+    /// Row (y, downward), pixels.
+    pub row_px: u16,
+    /// `|gx| + |gy|` of the Sobel responses, grey levels, `0..=2040`.
+    pub magnitude: u16,
+    /// Orientation class.
+    pub class: EdgeClass,
+}
+
+/// Caller-owned output list with a fixed capacity: allocated once, cleared and refilled by
+/// every call, never grown. Pixels past the capacity are counted in [`EdgeBuffer::dropped`].
+///
+/// Pixels are stored **bottom row first** (rows in decreasing `row_px`, columns increasing
+/// within a row), so a truncated buffer loses the far (top) rows, not the near road.
+#[derive(Debug, Clone)]
+pub struct EdgeBuffer {
+    pixels: Vec<EdgePixel>,
+    capacity: usize,
+    dropped: usize,
+}
+
+impl EdgeBuffer {
+    /// An empty buffer that holds at most `capacity` pixels (allocates here, never later).
+    pub fn with_capacity(capacity: usize) -> Self {
+        Self {
+            pixels: Vec::with_capacity(capacity),
+            capacity,
+            dropped: 0,
+        }
+    }
+
+    /// Maximum number of pixels stored.
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// The stored pixels.
+    pub fn pixels(&self) -> &[EdgePixel] {
+        &self.pixels
+    }
+
+    /// Number of stored pixels.
+    pub fn len(&self) -> usize {
+        self.pixels.len()
+    }
+
+    /// `true` if no pixel is stored.
+    pub fn is_empty(&self) -> bool {
+        self.pixels.is_empty()
+    }
+
+    /// Number of kept pixels that did not fit by the last call.
+    pub fn dropped(&self) -> usize {
+        self.dropped
+    }
+
+    /// `true` if the last call kept more pixels than the capacity.
+    pub fn is_truncated(&self) -> bool {
+        self.dropped > 0
+    }
+
+    /// Stored pixels of one class.
+    pub fn iter_class(&self, class: EdgeClass) -> impl Iterator<Item = &EdgePixel> + '_ {
+        self.pixels.iter().filter(move |p| p.class == class)
+    }
+
+    /// Empties the buffer (keeps the allocation).
+    pub fn clear(&mut self) {
+        self.pixels.clear();
+        self.dropped = 0;
+    }
+
+    #[inline]
+    pub(crate) fn push(&mut self, pixel: EdgePixel) {
+        if self.pixels.len() < self.capacity {
+            self.pixels.push(pixel);
+        } else {
+            self.dropped += 1;
+        }
+    }
+}
+
+/// What one call did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct EdgeStats {
+    /// Magnitude threshold applied (the fixed one, or the one chosen by the adaptive rule).
+    pub threshold_magnitude: u16,
+    /// Adaptive mode only: number of in-band pixels in the region (the histogram population).
+    pub in_band_count: Option<usize>,
+    /// Kept pixels of class [`EdgeClass::LeftLane`], stored or not.
+    pub left_count: usize,
+    /// Kept pixels of class [`EdgeClass::RightLane`], stored or not.
+    pub right_count: usize,
+    /// Pixels stored in the [`EdgeBuffer`].
+    pub stored: usize,
+    /// Kept pixels that did not fit in the [`EdgeBuffer`].
+    pub dropped: usize,
+}
