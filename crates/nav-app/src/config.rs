@@ -1,0 +1,409 @@
+//! Tracker configuration: TOML files and the `indoor` / `outdoor` presets.
+//!
+//! Every field carries its unit in its name or its doc. Unknown fields are refused
+//! (`deny_unknown_fields`) and [`TrackerConfig::validate`] names the first field out of range.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::NavError;
+
+/// The `outdoor` preset (highway, strong light/shadow contrast), as shipped in `configs/outdoor.toml`.
+pub const OUTDOOR_TOML: &str = include_str!("../../../configs/outdoor.toml");
+/// The `indoor` preset (corridor floor lines, low contrast), as shipped in `configs/indoor.toml`.
+pub const INDOOR_TOML: &str = include_str!("../../../configs/indoor.toml");
+
+/// Stage I: directional gradient (3×3 Sobel; see the `vision-gradient` crate).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GradientConfig {
+    /// Fixed magnitude threshold on the Sobel gradient, grey levels per pixel as `vision-gradient`
+    /// measures it. Used when `adaptive_k` is 0.
+    pub magnitude_threshold: f32,
+    /// Adaptive threshold: mean + `adaptive_k`·σ of the gradient magnitudes inside the region of
+    /// interest (dimensionless). 0 disables it (fixed threshold).
+    pub adaptive_k: f32,
+    /// Edge directions kept: the angle of the edge line from the image horizontal must lie in
+    /// [`min_edge_angle_deg`, `max_edge_angle_deg`], degrees (0 < min < max < 90).
+    pub min_edge_angle_deg: f32,
+    /// Upper limit of the edge-line angle band, degrees.
+    pub max_edge_angle_deg: f32,
+}
+
+/// Region of interest: the rows where lanes are looked for (the sky is not lane).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoiConfig {
+    /// First row of the ROI as a fraction of the image height (0 = top row), dimensionless in [0, 1).
+    pub top_row_fraction: f64,
+    /// One past the last ROI row as a fraction of the height (1 = down to the bottom row), in (top, 1].
+    pub bottom_row_fraction: f64,
+}
+
+/// Stage II: Hough + least-squares (re-)initialisation (see the `hough-init` crate).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitConfig {
+    /// Hough angle resolution, degrees (> 0, ≤ 5).
+    pub theta_step_deg: f64,
+    /// Hough distance resolution, px (> 0, ≤ 10).
+    pub rho_step_px: f64,
+    /// Half-width of the band around the Hough line whose pixels are fitted by LS, px (> 0).
+    pub band_half_width_px: f64,
+    /// Fewest pixels in the band for an initialisation to be accepted (≥ 3).
+    pub min_points: usize,
+}
+
+/// Stage III: windows of interest, point gathering, gates and re-initialisation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackConfig {
+    /// Half-width of the window of interest around the predicted parabola, px (> 0), at every row.
+    pub window_half_width_px: usize,
+    /// Most points per lane per frame fed to the filter, spread over the rows (paper: 150), 3..=1000.
+    pub max_points_per_lane: usize,
+    /// A tracked lane with fewer points than this in a frame misses that frame (≥ 3).
+    pub reinit_min_points: usize,
+    /// Consecutive missed frames after which a lane is declared lost and re-initialised (≥ 1).
+    pub lost_after_frames: u32,
+    /// Gate: an update moving the lane by more than this (px, at the top or bottom ROI row) from
+    /// its prediction is rejected (> 0; counts as a missed frame).
+    pub max_jump_px: f64,
+    /// Left and right lanes must stay at least this far apart at every ROI row, px (≥ 0).
+    pub min_lane_separation_px: f64,
+}
+
+/// Filter noise models (KIF and WRLS).
+///
+/// The filters' coefficients are expressed internally in a normalised row coordinate
+/// `u = (y − y_c)/s`, with `y_c` the middle ROI row and `s` half the ROI height, so that
+/// `x = b1·u² + b2·u + b3` with `b1`, `b2`, `b3` all in pixels over `u ∈ [−1, 1]`. Q and P0 are
+/// given as standard deviations of those coefficients and mapped to the paper's pixel
+/// coefficients `(a1, a2, a3)` by the linear map between the two parameterisations.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilterConfig {
+    /// Random-walk standard deviation per frame of `(b1, b2, b3)`, px/frame (each > 0). Q = diag(σ²).
+    pub q_sigma_px: [f64; 3],
+    /// Standard deviation of one pixel measurement (column of an edge pixel about the lane), px (> 0).
+    /// R = σ²·I.
+    pub r_sigma_px: f64,
+    /// Initial standard deviation of `(b1, b2, b3)` after an initialisation, px (each > 0).
+    pub p0_sigma_px: [f64; 3],
+    /// WRLS forgetting factor per frame, in (0, 1] (paper: 0.70).
+    pub wrls_lambda: f64,
+}
+
+/// The whole tracker configuration (one TOML file).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackerConfig {
+    /// Stage I.
+    pub gradient: GradientConfig,
+    /// Rows searched.
+    pub roi: RoiConfig,
+    /// Stage II.
+    pub init: InitConfig,
+    /// Stage III.
+    pub track: TrackConfig,
+    /// Noise models.
+    pub filter: FilterConfig,
+}
+
+fn field_err(field: &'static str, value: impl std::fmt::Display, reason: &str) -> NavError {
+    NavError::ConfigField {
+        field,
+        value: value.to_string(),
+        reason: reason.to_owned(),
+    }
+}
+
+fn check(
+    ok: bool,
+    field: &'static str,
+    value: impl std::fmt::Display,
+    reason: &str,
+) -> Result<(), NavError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(field_err(field, value, reason))
+    }
+}
+
+impl TrackerConfig {
+    /// The `outdoor` preset.
+    pub fn outdoor() -> Result<Self, NavError> {
+        Self::from_toml_str("preset outdoor", OUTDOOR_TOML)
+    }
+
+    /// The `indoor` preset.
+    pub fn indoor() -> Result<Self, NavError> {
+        Self::from_toml_str("preset indoor", INDOOR_TOML)
+    }
+
+    /// Parse and validate TOML text; `name` is used in errors.
+    pub fn from_toml_str(name: &str, text: &str) -> Result<Self, NavError> {
+        let cfg: TrackerConfig = toml::from_str(text).map_err(|e| NavError::ConfigParse {
+            path: name.to_owned(),
+            message: e.to_string(),
+        })?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// `indoor` / `outdoor` name a preset; anything else is a TOML file path.
+    pub fn load(name_or_path: &str) -> Result<Self, NavError> {
+        match name_or_path {
+            "outdoor" => Self::outdoor(),
+            "indoor" => Self::indoor(),
+            path => {
+                let text = std::fs::read_to_string(Path::new(path))
+                    .map_err(|e| NavError::io(path.to_owned(), e))?;
+                Self::from_toml_str(path, &text)
+            }
+        }
+    }
+
+    /// Check every field's range; the error names the first offending field.
+    pub fn validate(&self) -> Result<(), NavError> {
+        let g = &self.gradient;
+        check(
+            g.magnitude_threshold.is_finite() && g.magnitude_threshold >= 0.0,
+            "gradient.magnitude_threshold",
+            g.magnitude_threshold,
+            "must be finite and ≥ 0",
+        )?;
+        check(
+            g.adaptive_k.is_finite() && g.adaptive_k >= 0.0 && g.adaptive_k <= 10.0,
+            "gradient.adaptive_k",
+            g.adaptive_k,
+            "must be in [0, 10] (0 = fixed threshold)",
+        )?;
+        check(
+            g.min_edge_angle_deg > 0.0 && g.min_edge_angle_deg < 90.0,
+            "gradient.min_edge_angle_deg",
+            g.min_edge_angle_deg,
+            "must be in (0, 90) degrees",
+        )?;
+        check(
+            g.max_edge_angle_deg > g.min_edge_angle_deg && g.max_edge_angle_deg < 90.0,
+            "gradient.max_edge_angle_deg",
+            g.max_edge_angle_deg,
+            "must be in (min_edge_angle_deg, 90) degrees",
+        )?;
+        let r = &self.roi;
+        check(
+            (0.0..1.0).contains(&r.top_row_fraction),
+            "roi.top_row_fraction",
+            r.top_row_fraction,
+            "must be in [0, 1)",
+        )?;
+        check(
+            r.bottom_row_fraction > r.top_row_fraction && r.bottom_row_fraction <= 1.0,
+            "roi.bottom_row_fraction",
+            r.bottom_row_fraction,
+            "must be in (top_row_fraction, 1]",
+        )?;
+        let i = &self.init;
+        check(
+            i.theta_step_deg > 0.0 && i.theta_step_deg <= 5.0,
+            "init.theta_step_deg",
+            i.theta_step_deg,
+            "must be in (0, 5] degrees",
+        )?;
+        check(
+            i.rho_step_px > 0.0 && i.rho_step_px <= 10.0,
+            "init.rho_step_px",
+            i.rho_step_px,
+            "must be in (0, 10] px",
+        )?;
+        check(
+            i.band_half_width_px > 0.0 && i.band_half_width_px.is_finite(),
+            "init.band_half_width_px",
+            i.band_half_width_px,
+            "must be finite and > 0 px",
+        )?;
+        check(
+            i.min_points >= 3,
+            "init.min_points",
+            i.min_points,
+            "must be ≥ 3",
+        )?;
+        let t = &self.track;
+        check(
+            (1..=200).contains(&t.window_half_width_px),
+            "track.window_half_width_px",
+            t.window_half_width_px,
+            "must be in 1..=200 px",
+        )?;
+        check(
+            (3..=1000).contains(&t.max_points_per_lane),
+            "track.max_points_per_lane",
+            t.max_points_per_lane,
+            "must be in 3..=1000",
+        )?;
+        check(
+            t.reinit_min_points >= 3 && t.reinit_min_points <= t.max_points_per_lane,
+            "track.reinit_min_points",
+            t.reinit_min_points,
+            "must be in 3..=max_points_per_lane",
+        )?;
+        check(
+            t.lost_after_frames >= 1,
+            "track.lost_after_frames",
+            t.lost_after_frames,
+            "must be ≥ 1",
+        )?;
+        check(
+            t.max_jump_px > 0.0 && t.max_jump_px.is_finite(),
+            "track.max_jump_px",
+            t.max_jump_px,
+            "must be finite and > 0 px",
+        )?;
+        check(
+            t.min_lane_separation_px >= 0.0 && t.min_lane_separation_px.is_finite(),
+            "track.min_lane_separation_px",
+            t.min_lane_separation_px,
+            "must be finite and ≥ 0 px",
+        )?;
+        let f = &self.filter;
+        check(
+            f.q_sigma_px.iter().all(|s| s.is_finite() && *s > 0.0),
+            "filter.q_sigma_px",
+            format!("{:?}", f.q_sigma_px),
+            "each must be finite and > 0 px/frame",
+        )?;
+        check(
+            f.r_sigma_px.is_finite() && f.r_sigma_px > 0.0,
+            "filter.r_sigma_px",
+            f.r_sigma_px,
+            "must be finite and > 0 px",
+        )?;
+        check(
+            f.p0_sigma_px.iter().all(|s| s.is_finite() && *s > 0.0),
+            "filter.p0_sigma_px",
+            format!("{:?}", f.p0_sigma_px),
+            "each must be finite and > 0 px",
+        )?;
+        check(
+            f.wrls_lambda > 0.0 && f.wrls_lambda <= 1.0,
+            "filter.wrls_lambda",
+            f.wrls_lambda,
+            "must be in (0, 1]",
+        )?;
+        Ok(())
+    }
+
+    /// The ROI row range `[top, bottom)` for an image `height_px` rows high (at least 3 rows).
+    pub fn roi_rows(&self, height_px: usize) -> (usize, usize) {
+        let top = ((self.roi.top_row_fraction * height_px as f64).floor() as usize)
+            .min(height_px.saturating_sub(3));
+        let bottom = ((self.roi.bottom_row_fraction * height_px as f64).ceil() as usize)
+            .clamp(top + 3, height_px.max(top + 3));
+        (top, bottom.min(height_px))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_parse_and_validate() {
+        let out = TrackerConfig::outdoor().unwrap();
+        let ind = TrackerConfig::indoor().unwrap();
+        assert!(ind.gradient.magnitude_threshold < out.gradient.magnitude_threshold);
+        assert_eq!(TrackerConfig::load("outdoor").unwrap(), out);
+    }
+
+    #[test]
+    fn unknown_field_is_refused_naming_it() {
+        let text = OUTDOOR_TOML.replace("[track]", "[track]\nwindow_width = 3");
+        let err = TrackerConfig::from_toml_str("x.toml", &text).unwrap_err();
+        let msg = err.to_string();
+        assert!(matches!(err, NavError::ConfigParse { .. }));
+        assert!(
+            msg.contains("window_width") && msg.contains("x.toml"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn missing_field_is_refused_naming_it() {
+        let text: String = OUTDOOR_TOML
+            .lines()
+            .filter(|l| !l.starts_with("r_sigma_px"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let msg = TrackerConfig::from_toml_str("x.toml", &text)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("r_sigma_px"), "{msg}");
+    }
+
+    #[test]
+    fn each_out_of_range_field_is_named() {
+        type Edit = fn(&mut TrackerConfig);
+        let cases: &[(&str, Edit)] = &[
+            ("gradient.magnitude_threshold", |c| {
+                c.gradient.magnitude_threshold = f32::NAN
+            }),
+            ("gradient.adaptive_k", |c| c.gradient.adaptive_k = -1.0),
+            ("gradient.min_edge_angle_deg", |c| {
+                c.gradient.min_edge_angle_deg = 0.0
+            }),
+            ("gradient.max_edge_angle_deg", |c| {
+                c.gradient.max_edge_angle_deg = 5.0
+            }),
+            ("roi.top_row_fraction", |c| c.roi.top_row_fraction = 1.0),
+            ("roi.bottom_row_fraction", |c| {
+                c.roi.bottom_row_fraction = 0.1
+            }),
+            ("init.theta_step_deg", |c| c.init.theta_step_deg = 0.0),
+            ("init.rho_step_px", |c| c.init.rho_step_px = 11.0),
+            ("init.band_half_width_px", |c| {
+                c.init.band_half_width_px = f64::INFINITY
+            }),
+            ("init.min_points", |c| c.init.min_points = 2),
+            ("track.window_half_width_px", |c| {
+                c.track.window_half_width_px = 0
+            }),
+            ("track.max_points_per_lane", |c| {
+                c.track.max_points_per_lane = 2
+            }),
+            ("track.reinit_min_points", |c| {
+                c.track.reinit_min_points = 2000
+            }),
+            ("track.lost_after_frames", |c| c.track.lost_after_frames = 0),
+            ("track.max_jump_px", |c| c.track.max_jump_px = -1.0),
+            ("track.min_lane_separation_px", |c| {
+                c.track.min_lane_separation_px = f64::NAN
+            }),
+            ("filter.q_sigma_px", |c| c.filter.q_sigma_px[1] = 0.0),
+            ("filter.r_sigma_px", |c| c.filter.r_sigma_px = 0.0),
+            ("filter.p0_sigma_px", |c| c.filter.p0_sigma_px[2] = f64::NAN),
+            ("filter.wrls_lambda", |c| c.filter.wrls_lambda = 1.5),
+        ];
+        for (field, edit) in cases {
+            let mut cfg = TrackerConfig::outdoor().unwrap();
+            cfg.validate().unwrap();
+            edit(&mut cfg);
+            match cfg.validate() {
+                Err(NavError::ConfigField { field: f, .. }) => assert_eq!(f, *field),
+                other => panic!("{field}: expected a field error, got {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn roi_rows_follow_the_fractions_and_stay_inside_tiny_images() {
+        let mut cfg = TrackerConfig::outdoor().unwrap();
+        cfg.roi.top_row_fraction = 0.5;
+        cfg.roi.bottom_row_fraction = 1.0;
+        assert_eq!(cfg.roi_rows(240), (120, 240));
+        let (t, b) = cfg.roi_rows(4);
+        assert!(t < b && b <= 4 && b - t >= 3, "{t}..{b}");
+    }
+}

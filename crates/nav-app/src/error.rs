@@ -1,0 +1,197 @@
+//! The crate's one error type.
+
+use std::io;
+
+/// Everything that can go wrong in `nav-app`: opening and reading frames, loading a configuration,
+/// tracking, and writing reports or overlays.
+///
+/// Each variant names the file, the frame or the field concerned. [`NavError::is_fatal`] tells a
+/// frame loop whether to stop (fatal) or to report, count and skip one bad frame.
+#[derive(Debug, thiserror::Error)]
+pub enum NavError {
+    /// A file or stream could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// File, directory or stream (`stdin`) concerned.
+        path: String,
+        /// The operating-system error.
+        #[source]
+        source: io::Error,
+    },
+    /// A still image could not be decoded (truncated, corrupt or of an unknown format).
+    #[error("{path}: cannot decode image: {message}")]
+    ImageDecode {
+        /// The image file.
+        path: String,
+        /// What the decoder said.
+        message: String,
+    },
+    /// A directory given as a sequence holds a file that is not an image (by its extension).
+    #[error(
+        "{path}: not an image (expected .png, .jpg, .jpeg, .pgm, .pnm or .ppm) in an image directory"
+    )]
+    NotAnImage {
+        /// The offending file.
+        path: String,
+    },
+    /// A directory given as a sequence holds no image at all.
+    #[error("{path}: directory holds no images")]
+    EmptyDirectory {
+        /// The directory.
+        path: String,
+    },
+    /// An image or stream declares a zero width or height.
+    #[error("{name}: zero-size frame ({width}×{height})")]
+    ZeroSize {
+        /// File or stream concerned.
+        name: String,
+        /// Declared width, px.
+        width: usize,
+        /// Declared height, px.
+        height: usize,
+    },
+    /// A YUV4MPEG2 stream header is malformed.
+    #[error("{name}: bad YUV4MPEG2 header: {reason}")]
+    Y4mHeader {
+        /// File or `stdin`.
+        name: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A YUV4MPEG2 stream uses a chroma layout this reader does not take.
+    #[error(
+        "{name}: unsupported YUV4MPEG2 chroma `C{chroma}` (supported: mono, 420, 420jpeg, 420paldv, 420mpeg2)"
+    )]
+    UnsupportedChroma {
+        /// File or `stdin`.
+        name: String,
+        /// The `C` tag as found.
+        chroma: String,
+    },
+    /// A YUV4MPEG2 frame does not start with a `FRAME` header: the stream is corrupt from here on.
+    #[error("{name}: frame {frame}: expected a `FRAME` header, found {found:?}")]
+    Y4mFrameHeader {
+        /// File or `stdin`.
+        name: String,
+        /// Zero-based index of the frame.
+        frame: u64,
+        /// The bytes found instead (at most 16, lossily decoded).
+        found: String,
+    },
+    /// The stream changed frame size in the middle (a second YUV4MPEG2 header with another size).
+    #[error(
+        "{name}: frame {frame}: frame size changed mid-stream from {from_w}×{from_h} to {to_w}×{to_h}"
+    )]
+    SizeChanged {
+        /// File or `stdin`.
+        name: String,
+        /// Zero-based index of the first frame with the new size.
+        frame: u64,
+        /// Previous width, px.
+        from_w: usize,
+        /// Previous height, px.
+        from_h: usize,
+        /// New width, px.
+        to_w: usize,
+        /// New height, px.
+        to_h: usize,
+    },
+    /// The last frame of a stream is shorter than the header says (not fatal: reported, counted and
+    /// the stream ends there).
+    #[error("{name}: frame {frame}: short frame, {got} of {expected} bytes before end of stream")]
+    ShortFrame {
+        /// File or `stdin`.
+        name: String,
+        /// Zero-based index of the short frame.
+        frame: u64,
+        /// Bytes a whole frame takes.
+        expected: usize,
+        /// Bytes present.
+        got: usize,
+    },
+    /// One frame of a sequence is unusable (corrupt image, zero size, size differing from the
+    /// sequence). Not fatal: it is reported, counted and skipped.
+    #[error("{name}: frame {frame}: skipped: {reason}")]
+    BadFrame {
+        /// File of the frame.
+        name: String,
+        /// Zero-based index of the frame in the sequence.
+        frame: u64,
+        /// Why it is unusable.
+        reason: String,
+    },
+    /// Live capture was requested but this build has none.
+    #[error(
+        "{device}: live capture is not available in this build (the `capture` feature will wire the \
+         bt848-capture crate); use --input with an image, a directory of images or a .y4m file"
+    )]
+    CaptureUnavailable {
+        /// The device path asked for.
+        device: String,
+    },
+    /// A configuration file is not valid TOML or does not match the schema.
+    #[error("{path}: cannot parse configuration: {message}")]
+    ConfigParse {
+        /// Configuration file (or preset name).
+        path: String,
+        /// What the parser said (it names the line and the key).
+        message: String,
+    },
+    /// A configuration field holds a value outside its valid range.
+    #[error("configuration field `{field}` = {value}: {reason}")]
+    ConfigField {
+        /// Dotted field name, e.g. `track.window_half_width_px`.
+        field: &'static str,
+        /// The value found.
+        value: String,
+        /// The valid range.
+        reason: String,
+    },
+    /// The frame given to the tracker does not match the size it was built for.
+    #[error("tracker built for {expected_w}×{expected_h} frames, got {got_w}×{got_h}")]
+    FrameSize {
+        /// Expected width, px.
+        expected_w: usize,
+        /// Expected height, px.
+        expected_h: usize,
+        /// Width received, px.
+        got_w: usize,
+        /// Height received, px.
+        got_h: usize,
+    },
+    /// A component crate (gradient, Hough, filter) refused its input.
+    #[error("{stage}: {message}")]
+    Stage {
+        /// Which stage: `gradient`, `hough`, `kif`, `wrls`.
+        stage: &'static str,
+        /// The component's error, rendered.
+        message: String,
+    },
+    /// Writing an overlay, a fixture or a report failed.
+    #[error("{path}: cannot write: {message}")]
+    Write {
+        /// Output path.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl NavError {
+    /// `false` for errors that concern a single frame of a stream ([`NavError::BadFrame`],
+    /// [`NavError::ShortFrame`]): the caller reports and counts it and asks for the next frame.
+    /// `true` for everything else: the run cannot go on.
+    pub fn is_fatal(&self) -> bool {
+        !matches!(
+            self,
+            NavError::BadFrame { .. } | NavError::ShortFrame { .. }
+        )
+    }
+
+    pub(crate) fn io(path: impl Into<String>, source: io::Error) -> Self {
+        NavError::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}

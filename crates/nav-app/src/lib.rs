@@ -1,0 +1,16 @@
+//! # nav-app — the lane tracker of Pimentel & Hemerly
+//!
+//! (work in progress; see the full crate docs once the tracker lands)
+
+mod config;
+mod error;
+mod frame;
+pub mod sources;
+pub mod y4m;
+
+pub use config::{
+    FilterConfig, GradientConfig, INDOOR_TOML, InitConfig, OUTDOOR_TOML, RoiConfig, TrackConfig,
+    TrackerConfig,
+};
+pub use error::NavError;
+pub use frame::{FrameMeta, FrameSource, GreyFrame};
