@@ -153,6 +153,25 @@ pub fn normal_gravity_mps2(lat_rad: f64, alt_m: f64) -> f64 {
         + 3.0 * alt_m * alt_m / (a * a))
 }
 
+/// Partial derivatives of [`normal_gravity_mps2`]: (∂γ/∂L in m/s² per rad, ∂γ/∂h in s⁻²).
+/// ∂γ/∂h ≈ −2γ/R is the vertical-channel instability gradient.
+pub fn normal_gravity_partials(lat_rad: f64, alt_m: f64) -> (f64, f64) {
+    let s2 = lat_rad.sin().powi(2);
+    let a = WGS84_A_M;
+    let w2 = 1.0 - WGS84_E2 * s2;
+    let g0 = WGS84_GAMMA_E_MPS2 * (1.0 + WGS84_SOMIGLIANA_K * s2) / w2.sqrt();
+    let dg0_ds2 = WGS84_GAMMA_E_MPS2
+        * (WGS84_SOMIGLIANA_K / w2.sqrt()
+            + (1.0 + WGS84_SOMIGLIANA_K * s2) * 0.5 * WGS84_E2 / (w2 * w2.sqrt()));
+    let c1 = 2.0 / a * (1.0 + WGS84_F + WGS84_M - 2.0 * WGS84_F * s2);
+    let dc1_ds2 = 2.0 / a * (-2.0 * WGS84_F);
+    let fac = 1.0 - c1 * alt_m + 3.0 * alt_m * alt_m / (a * a);
+    let dgam_ds2 = dg0_ds2 * fac - g0 * dc1_ds2 * alt_m;
+    let dgam_dlat = dgam_ds2 * (2.0 * lat_rad).sin();
+    let dgam_dh = g0 * (-c1 + 6.0 * alt_m / (a * a));
+    (dgam_dlat, dgam_dh)
+}
+
 /// Normal gravity vector in NED, m/s²: (0, 0, γ(L, h)).
 #[inline]
 pub fn gravity_ned_mps2(lat_rad: f64, alt_m: f64) -> Vector3<f64> {
@@ -344,6 +363,19 @@ mod tests {
         assert!((grad + 3.07e-6).abs() < 0.01e-6, "grad {grad}");
         let tau = 1.0 / (-grad).sqrt();
         assert!((tau - 571.0).abs() < 2.0, "tau {tau}");
+    }
+
+    #[test]
+    fn gravity_partials_match_central_differences() {
+        for &(lat, h) in &[(-23.2_f64, 6000.0), (45.0, 0.0), (-70.0, 20_000.0)] {
+            let l = lat.to_radians();
+            let (dl, dh) = normal_gravity_partials(l, h);
+            let e = 1e-5;
+            let fl = (normal_gravity_mps2(l + e, h) - normal_gravity_mps2(l - e, h)) / (2.0 * e);
+            let fh = (normal_gravity_mps2(l, h + 1.0) - normal_gravity_mps2(l, h - 1.0)) / 2.0;
+            assert!((dl - fl).abs() < 1e-8, "{dl} {fl}");
+            assert!((dh - fh).abs() < 1e-12, "{dh} {fh}");
+        }
     }
 
     #[test]

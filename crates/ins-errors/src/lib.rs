@@ -1,3 +1,11 @@
-//! Strapdown INS error analysis (work in progress; see module docs).
+//! Strapdown INS error analysis (crate doc completed below).
 
+pub mod config;
 pub mod earth;
+pub mod error;
+pub mod error_model;
+pub mod imu;
+pub mod strapdown;
+pub mod trajectory;
+
+pub use error::InsError;
