@@ -7,6 +7,8 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
+mod vivid;
+
 #[derive(Parser)]
 #[command(name = "cargo xtask", about = "Project chores")]
 struct Cli {
@@ -18,11 +20,14 @@ struct Cli {
 enum Cmd {
     /// Every check CI runs: formatting, clippy with warnings denied, all tests and doc tests.
     Test,
+    /// Boot Debian's kernel under qemu with the vivid V4L2 driver and run the capture cases.
+    Vivid(vivid::VividArgs),
 }
 
 fn main() -> Result<()> {
     match Cli::parse().cmd {
         Cmd::Test => test(),
+        Cmd::Vivid(args) => vivid::run(args),
     }
 }
 
