@@ -50,8 +50,8 @@ pub(crate) enum CheckedRegion<'a> {
 
 /// What a pass does with its kept pixels.
 pub(crate) enum Sink<'s> {
-    /// Count the magnitudes of kept pixels.
-    Histogram(&'s mut [u32; HIST_BINS]),
+    /// Count the magnitudes of kept pixels (four interleaved histograms, summed by the caller).
+    Histogram(&'s mut [[u32; HIST_BINS]; 4]),
     /// Store kept pixels, optionally paint the class image, count classes.
     Emit {
         edges: &'s mut EdgeBuffer,
@@ -61,42 +61,160 @@ pub(crate) enum Sink<'s> {
     },
 }
 
-/// Sobel + band + threshold over one row segment. `up`, `mid`, `dn` hold columns
-/// `c-1 ..= c+n` of three consecutive rows, `mag` and `cls` receive columns `c .. c+n`.
-/// `cls` is 0 (dropped), 1 (left) or 2 (right); `mag` is `|gx| + |gy|`.
+/// Pixels per vector block of the kernel (16 × i16 = one AVX2 register).
+const BLOCK: usize = 16;
+
+/// Sobel responses `(gx, gy)` of one pixel from its 3×3 neighbourhood `a b c / d · f / g h k`.
+/// `|gx|, |gy| <= 1020`, so `|gx| + |gy| <= 2040` fits `i16`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn sobel(a: u8, b: u8, c: u8, d: u8, f: u8, g: u8, h: u8, k: u8) -> (i16, i16) {
+    let (a, b, c, d) = (i16::from(a), i16::from(b), i16::from(c), i16::from(d));
+    let (f, g, h, k) = (i16::from(f), i16::from(g), i16::from(h), i16::from(k));
+    let gx = (c - a) + 2 * (f - d) + (k - g);
+    let gy = (g + 2 * h + k) - (a + 2 * b + c);
+    (gx, gy)
+}
+
+/// Band + threshold decision for one pixel: class 0 (dropped), 1 (left) or 2 (right).
+#[inline(always)]
+fn classify(gx: i16, gy: i16, band: Band, thr: i16) -> u8 {
+    let ax = gx.abs();
+    let ay = gy.abs();
+    let ax32 = i32::from(ax);
+    let ay32 = i32::from(ay);
+    // Products <= 1020 · 16384 < 2^31.
+    let lo_ok = ax32 * band.cos_min >= ay32 * band.sin_min;
+    let hi_ok = ax32 * band.cos_max <= ay32 * band.sin_max;
+    let keep = lo_ok & hi_ok & (gx != 0) & (gy != 0) & (ax + ay >= thr);
+    let right = u8::from((gx ^ gy) < 0);
+    u8::from(keep) * (1 + right)
+}
+
+/// One fixed block of [`BLOCK`] pixels: fixed-size arrays, no remainder loop, so the block is
+/// straight-line vector code. Blocks where no pixel reaches the threshold skip the band test.
+#[inline(always)]
+fn block(
+    up: &[u8; BLOCK + 2],
+    mid: &[u8; BLOCK + 2],
+    dn: &[u8; BLOCK + 2],
+    band: Band,
+    thr: i16,
+    mag: &mut [u16; BLOCK],
+    cls: &mut [u8; BLOCK],
+) {
+    let mut gx = [0i16; BLOCK];
+    let mut gy = [0i16; BLOCK];
+    let mut any = false;
+    for i in 0..BLOCK {
+        let (x, y) = sobel(
+            up[i],
+            up[i + 1],
+            up[i + 2],
+            mid[i],
+            mid[i + 2],
+            dn[i],
+            dn[i + 1],
+            dn[i + 2],
+        );
+        let m = x.abs() + y.abs();
+        gx[i] = x;
+        gy[i] = y;
+        mag[i] = m as u16;
+        any |= m >= thr;
+    }
+    if any {
+        for i in 0..BLOCK {
+            cls[i] = classify(gx[i], gy[i], band, thr);
+        }
+    } else {
+        *cls = [0; BLOCK];
+    }
+}
+
+/// [`block`] at offset `i` of a row segment (no-op if the slices are too short, which the
+/// callers rule out). A plain `fn`, not a closure, so it inherits the caller's target features
+/// when inlined.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn block_at(
+    up: &[u8],
+    mid: &[u8],
+    dn: &[u8],
+    band: Band,
+    thr: i16,
+    mag: &mut [u16],
+    cls: &mut [u8],
+    i: usize,
+) -> Option<()> {
+    block(
+        up.get(i..i + BLOCK + 2)?.try_into().ok()?,
+        mid.get(i..i + BLOCK + 2)?.try_into().ok()?,
+        dn.get(i..i + BLOCK + 2)?.try_into().ok()?,
+        band,
+        thr,
+        mag.get_mut(i..i + BLOCK)?.try_into().ok()?,
+        cls.get_mut(i..i + BLOCK)?.try_into().ok()?,
+    );
+    Some(())
+}
+
+/// Per-pixel form of [`block`] for segments shorter than a block.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn pixel(
+    a: u8,
+    b: u8,
+    c: u8,
+    d: u8,
+    f: u8,
+    g: u8,
+    h: u8,
+    k: u8,
+    band: Band,
+    thr: i16,
+) -> (u16, u8) {
+    let (gx, gy) = sobel(a, b, c, d, f, g, h, k);
+    ((gx.abs() + gy.abs()) as u16, classify(gx, gy, band, thr))
+}
+
+/// Kernel over one row segment. `up`, `mid`, `dn` hold columns `c-1 ..= c+n` of three
+/// consecutive rows, `mag` and `cls` (length `n`) receive columns `c .. c+n`.
+/// Full blocks first; the remainder is one more block ending at `n` (overlapping the previous
+/// one, which recomputes identical values) or, for `n < BLOCK`, a per-pixel loop.
 #[inline(always)]
 fn kernel(up: &[u8], mid: &[u8], dn: &[u8], band: Band, thr: i16, mag: &mut [u16], cls: &mut [u8]) {
     let n = mag.len().min(cls.len());
+    if n >= BLOCK {
+        let mut i = 0;
+        while i + BLOCK <= n {
+            block_at(up, mid, dn, band, thr, mag, cls, i);
+            i += BLOCK;
+        }
+        if i < n {
+            block_at(up, mid, dn, band, thr, mag, cls, n - BLOCK);
+        }
+        return;
+    }
     let w = n + 2;
     if up.len() < w || mid.len() < w || dn.len() < w {
         return;
     }
-    let (up, mid, dn) = (&up[..w], &mid[..w], &dn[..w]);
-    let (mag, cls) = (&mut mag[..n], &mut cls[..n]);
     for i in 0..n {
-        let a = i16::from(up[i]);
-        let b = i16::from(up[i + 1]);
-        let c = i16::from(up[i + 2]);
-        let d = i16::from(mid[i]);
-        let f = i16::from(mid[i + 2]);
-        let g = i16::from(dn[i]);
-        let h = i16::from(dn[i + 1]);
-        let k = i16::from(dn[i + 2]);
-        // |gx|, |gy| <= 1020, |gx| + |gy| <= 2040: no i16 overflow.
-        let gx = (c - a) + 2 * (f - d) + (k - g);
-        let gy = (g + 2 * h + k) - (a + 2 * b + c);
-        let ax = gx.abs();
-        let ay = gy.abs();
-        let m = ax + ay;
-        let ax32 = i32::from(ax);
-        let ay32 = i32::from(ay);
-        // Products <= 1020 · 16384 < 2^31.
-        let lo_ok = ax32 * band.cos_min >= ay32 * band.sin_min;
-        let hi_ok = ax32 * band.cos_max <= ay32 * band.sin_max;
-        let keep = lo_ok & hi_ok & (gx != 0) & (gy != 0) & (m >= thr);
-        let right = u8::from((gx ^ gy) < 0);
-        cls[i] = u8::from(keep) * (1 + right);
-        mag[i] = m as u16;
+        let (m, k) = pixel(
+            up[i],
+            up[i + 1],
+            up[i + 2],
+            mid[i],
+            mid[i + 2],
+            dn[i],
+            dn[i + 1],
+            dn[i + 2],
+            band,
+            thr,
+        );
+        mag[i] = m;
+        cls[i] = k;
     }
 }
 
@@ -144,11 +262,11 @@ fn pass_impl(
             let n = CHUNK.min(c1 - c);
             let (m, k) = (&mut mag[..n], &mut cls[..n]);
             kernel(&up[c - 1..], &mid[c - 1..], &dn[c - 1..], band, thr, m, k);
-            if let CheckedRegion::Mask(mask) = region {
-                if let Some(mrow) = mask.get(r * w + c..r * w + c + n) {
-                    for (kk, &mm) in k.iter_mut().zip(mrow) {
-                        *kk &= 0u8.wrapping_sub(u8::from(mm != 0));
-                    }
+            if let CheckedRegion::Mask(mask) = region
+                && let Some(mrow) = mask.get(r * w + c..r * w + c + n)
+            {
+                for (kk, &mm) in k.iter_mut().zip(mrow) {
+                    *kk &= 0u8.wrapping_sub(u8::from(mm != 0));
                 }
             }
             consume(sink, r, c, m, k, w);
@@ -160,12 +278,26 @@ fn pass_impl(
 #[inline(always)]
 fn consume(sink: &mut Sink<'_>, r: usize, c: usize, mag: &[u16], cls: &[u8], w: usize) {
     match sink {
-        Sink::Histogram(hist) => {
-            for (&k, &m) in cls.iter().zip(mag) {
-                if k != 0 {
-                    if let Some(bin) = hist.get_mut(usize::from(m)) {
+        Sink::Histogram(hists) => {
+            // Branch-free: dropped pixels go to bin 0, which no in-band pixel can reach
+            // (gx, gy != 0 implies magnitude >= 2); the caller ignores bin 0. Four interleaved
+            // histograms break the store-to-load dependency on popular bins.
+            let [h0, h1, h2, h3] = &mut **hists;
+            let idx = |k: u8, m: u16| usize::from(m) & 0usize.wrapping_sub(usize::from(k != 0));
+            let mut kc = cls.chunks_exact(4);
+            let mut mc = mag.chunks_exact(4);
+            for (k, m) in kc.by_ref().zip(mc.by_ref()) {
+                for (h, j) in [(&mut *h0, 0), (&mut *h1, 1), (&mut *h2, 2), (&mut *h3, 3)] {
+                    if let (Some(&kk), Some(&mm)) = (k.get(j), m.get(j))
+                        && let Some(bin) = h.get_mut(idx(kk, mm))
+                    {
                         *bin += 1;
                     }
+                }
+            }
+            for (&k, &m) in kc.remainder().iter().zip(mc.remainder()) {
+                if let Some(bin) = h0.get_mut(idx(k, m)) {
+                    *bin += 1;
                 }
             }
         }
@@ -175,35 +307,43 @@ fn consume(sink: &mut Sink<'_>, r: usize, c: usize, mag: &[u16], cls: &[u8], w: 
             left,
             right,
         } => {
-            if let Some(ci) = class_image {
-                if let Some(dst) = ci.get_mut(r * w + c..r * w + c + cls.len()) {
-                    dst.copy_from_slice(cls);
-                }
+            if let Some(ci) = class_image
+                && let Some(dst) = ci.get_mut(r * w + c..r * w + c + cls.len())
+            {
+                dst.copy_from_slice(cls);
             }
+            let mut emit = |i: usize, k: u8| {
+                let class = if k == 1 {
+                    *left += 1;
+                    EdgeClass::LeftLane
+                } else {
+                    *right += 1;
+                    EdgeClass::RightLane
+                };
+                edges.push(EdgePixel {
+                    col_px: (c + i) as u16,
+                    row_px: r as u16,
+                    magnitude: mag.get(i).copied().unwrap_or(0),
+                    class,
+                });
+            };
+            let mut chunks = cls.chunks_exact(16);
             let mut base = 0;
-            for chunk in cls.chunks(8) {
-                let any = chunk.iter().fold(0u8, |acc, &v| acc | v);
-                if any != 0 {
+            for chunk in chunks.by_ref() {
+                let word: [u8; 16] = chunk.try_into().unwrap_or([1; 16]);
+                if u128::from_ne_bytes(word) != 0 {
                     for (j, &k) in chunk.iter().enumerate() {
                         if k != 0 {
-                            let i = base + j;
-                            let class = if k == 1 {
-                                *left += 1;
-                                EdgeClass::LeftLane
-                            } else {
-                                *right += 1;
-                                EdgeClass::RightLane
-                            };
-                            edges.push(EdgePixel {
-                                col_px: (c + i) as u16,
-                                row_px: r as u16,
-                                magnitude: mag.get(i).copied().unwrap_or(0),
-                                class,
-                            });
+                            emit(base + j, k);
                         }
                     }
                 }
-                base += chunk.len();
+                base += 16;
+            }
+            for (j, &k) in chunks.remainder().iter().enumerate() {
+                if k != 0 {
+                    emit(base + j, k);
+                }
             }
         }
     }

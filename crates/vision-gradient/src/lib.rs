@@ -253,13 +253,13 @@ impl GradientDetector {
     ) -> Result<EdgeStats, GradientError> {
         let checked = check_region(image, region)?;
         let expected = image.width() * image.height();
-        if let Some(ci) = class_image.as_deref() {
-            if ci.len() != expected {
-                return Err(GradientError::ClassImageSizeMismatch {
-                    len: ci.len(),
-                    expected,
-                });
-            }
+        if let Some(ci) = class_image.as_deref()
+            && ci.len() != expected
+        {
+            return Err(GradientError::ClassImageSizeMismatch {
+                len: ci.len(),
+                expected,
+            });
         }
         edges.clear();
         let (threshold, in_band_count) = match self.params.threshold {
@@ -268,8 +268,13 @@ impl GradientDetector {
                 keep_fraction,
                 min_magnitude,
             } => {
-                let mut hist = [0u32; HIST_BINS];
-                self.run(image, checked, 0, &mut Sink::Histogram(&mut hist));
+                let mut hists = [[0u32; HIST_BINS]; 4];
+                self.run(image, checked, 0, &mut Sink::Histogram(&mut hists));
+                let [mut hist, h1, h2, h3] = hists;
+                for (((a, b), c), d) in hist.iter_mut().zip(h1).zip(h2).zip(h3) {
+                    *a += b + c + d;
+                }
+                hist[0] = 0; // dropped pixels were parked there (see kernel::consume)
                 let (t, total) = upper_quantile(&hist, keep_fraction);
                 (t.max(min_magnitude), Some(total))
             }
