@@ -28,7 +28,7 @@ impl<const N: usize> Cholesky<N> {
                 d -= l[(j, k)] * l[(j, k)];
             }
             // `!(d > 0)` also rejects NaN.
-            if !(d > 0.0) || !d.is_finite() {
+            if !(d.is_finite() && d > 0.0) {
                 return Err(KifError::NotPositiveDefinite {
                     matrix,
                     pivot: j,

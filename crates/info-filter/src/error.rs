@@ -19,7 +19,9 @@ pub enum KifError {
         value: f64,
     },
     /// A matrix that must be symmetric is not (relative tolerance 1e-9 per entry pair).
-    #[error("{matrix} is not symmetric: entry ({row},{col}) = {upper:e} but ({col},{row}) = {lower:e}")]
+    #[error(
+        "{matrix} is not symmetric: entry ({row},{col}) = {upper:e} but ({col},{row}) = {lower:e}"
+    )]
     NotSymmetric {
         /// Which matrix.
         matrix: &'static str,

@@ -134,8 +134,8 @@ impl<const N: usize> InformationFilter<N> {
         let i_minus_b = SMatrix::<f64, N, N>::identity() - b;
         self.info = match self.form {
             TimeUpdateForm::PositiveDefinite => {
-                let mut y = i_minus_b * self.info * i_minus_b.transpose()
-                    + b * q_inv * b.transpose();
+                let mut y =
+                    i_minus_b * self.info * i_minus_b.transpose() + b * q_inv * b.transpose();
                 symmetrise(&mut y);
                 y
             }

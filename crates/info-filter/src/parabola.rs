@@ -3,9 +3,10 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::KifError;
+use crate::chol::check_finite_vec;
 use crate::generic::{InformationFilter, ProcessNoise, TimeUpdateForm};
 use crate::rownorm::{RowNorm, ThetaCov};
-use crate::KifError;
 
 /// A measured pixel: column `x` and row `y`, in pixels (the paper's `x = f(y)` convention).
 pub trait PixelPoint {
@@ -200,8 +201,13 @@ impl ParabolaKif {
     /// # Errors
     /// Invalid `row_norm`, non-finite `theta0_px`, or `p0` not symmetric positive definite
     /// (named `"P0"`, with the failing pivot, in the normalised parameterisation).
-    pub fn new(theta0_px: &Vector3<f64>, p0: &ThetaCov, row_norm: RowNorm) -> Result<Self, KifError> {
+    pub fn new(
+        theta0_px: &Vector3<f64>,
+        p0: &ThetaCov,
+        row_norm: RowNorm,
+    ) -> Result<Self, KifError> {
         row_norm.validate()?;
+        check_finite_vec(theta0_px, "theta0_px")?;
         let theta0_u = row_norm.theta_to_normalised(theta0_px);
         let filter = InformationFilter::new(&theta0_u, &p0.to_normalised(&row_norm))?;
         Ok(Self { filter, row_norm })
@@ -333,7 +339,9 @@ impl ParabolaKif {
     /// # Errors
     /// As [`Self::new`]; on error the state is unchanged.
     pub fn reset(&mut self, theta0_px: &Vector3<f64>, p0: &ThetaCov) -> Result<(), KifError> {
+        check_finite_vec(theta0_px, "theta0_px")?;
         let theta0_u = self.row_norm.theta_to_normalised(theta0_px);
-        self.filter.reset(&theta0_u, &p0.to_normalised(&self.row_norm))
+        self.filter
+            .reset(&theta0_u, &p0.to_normalised(&self.row_norm))
     }
 }

@@ -77,7 +77,7 @@ impl RowNorm {
                 reason: "must be finite",
             });
         }
-        if !(self.scale_px > 0.0) || !self.scale_px.is_finite() {
+        if !(self.scale_px.is_finite() && self.scale_px > 0.0) {
             return Err(KifError::InvalidRowNorm {
                 field: "scale_px",
                 value: self.scale_px,
