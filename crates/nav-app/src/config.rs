@@ -18,17 +18,20 @@ pub const INDOOR_TOML: &str = include_str!("../../../configs/indoor.toml");
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GradientConfig {
-    /// Fixed magnitude threshold on the Sobel gradient, grey levels per pixel as `vision-gradient`
-    /// measures it. Used when `adaptive_k` is 0.
-    pub magnitude_threshold: f32,
-    /// Adaptive threshold: mean + `adaptive_k`·σ of the gradient magnitudes inside the region of
-    /// interest (dimensionless). 0 disables it (fixed threshold).
-    pub adaptive_k: f32,
+    /// Threshold on the Sobel L1 magnitude `|gx| + |gy|`, grey levels (0..=2040; an ideal 45°
+    /// step of `h` grey levels gives `6h`). With the adaptive mode it is the floor.
+    pub magnitude_threshold: u16,
+    /// Adaptive threshold: keep this fraction of the in-band pixels of the searched region (the
+    /// `1 − f` quantile of their magnitudes, floored at `magnitude_threshold`), in (0, 1].
+    /// 0 disables it (fixed threshold).
+    pub adaptive_keep_fraction: f64,
     /// Edge directions kept: the angle of the edge line from the image horizontal must lie in
-    /// [`min_edge_angle_deg`, `max_edge_angle_deg`], degrees (0 < min < max < 90).
-    pub min_edge_angle_deg: f32,
+    /// [`min_edge_angle_deg`, `max_edge_angle_deg`], degrees (0 < min < max < 90). The Hough
+    /// search of each lane uses the matching band of line tilts from the vertical,
+    /// `±[90 − max, 90 − min]`.
+    pub min_edge_angle_deg: f64,
     /// Upper limit of the edge-line angle band, degrees.
-    pub max_edge_angle_deg: f32,
+    pub max_edge_angle_deg: f64,
 }
 
 /// Region of interest: the rows where lanes are looked for (the sky is not lane).
@@ -53,6 +56,9 @@ pub struct InitConfig {
     pub band_half_width_px: f64,
     /// Fewest pixels in the band for an initialisation to be accepted (≥ 3).
     pub min_points: usize,
+    /// Refits of the LS parabola to the pixels within `band_half_width_px` of the previous fit
+    /// (follows a curved mark beyond the straight Hough band), 0..=5; 0 disables.
+    pub refit_iterations: u32,
 }
 
 /// Stage III: windows of interest, point gathering, gates and re-initialisation.
@@ -63,6 +69,9 @@ pub struct TrackConfig {
     pub window_half_width_px: usize,
     /// Most points per lane per frame fed to the filter, spread over the rows (paper: 150), 3..=1000.
     pub max_points_per_lane: usize,
+    /// Inside the window, pixels farther than this from the midhinge residual (mean of the quartiles) of their third of
+    /// the ROI rows are dropped as clutter before the update, px (> 0).
+    pub inlier_half_width_px: f64,
     /// A tracked lane with fewer points than this in a frame misses that frame (≥ 3).
     pub reinit_min_points: usize,
     /// Consecutive missed frames after which a lane is declared lost and re-initialised (≥ 1).
@@ -70,7 +79,8 @@ pub struct TrackConfig {
     /// Gate: an update moving the lane by more than this (px, at the top or bottom ROI row) from
     /// its prediction is rejected (> 0; counts as a missed frame).
     pub max_jump_px: f64,
-    /// Left and right lanes must stay at least this far apart at every ROI row, px (≥ 0).
+    /// Left and right lanes must stay at least this far apart at the middle and bottom ROI rows
+    /// (and in order at the top row), px (≥ 0).
     pub min_lane_separation_px: f64,
 }
 
@@ -170,16 +180,16 @@ impl TrackerConfig {
     pub fn validate(&self) -> Result<(), NavError> {
         let g = &self.gradient;
         check(
-            g.magnitude_threshold.is_finite() && g.magnitude_threshold >= 0.0,
+            g.magnitude_threshold <= 2040,
             "gradient.magnitude_threshold",
             g.magnitude_threshold,
-            "must be finite and ≥ 0",
+            "must be in 0..=2040 (largest Sobel L1 magnitude)",
         )?;
         check(
-            g.adaptive_k.is_finite() && g.adaptive_k >= 0.0 && g.adaptive_k <= 10.0,
-            "gradient.adaptive_k",
-            g.adaptive_k,
-            "must be in [0, 10] (0 = fixed threshold)",
+            (0.0..=1.0).contains(&g.adaptive_keep_fraction),
+            "gradient.adaptive_keep_fraction",
+            g.adaptive_keep_fraction,
+            "must be in [0, 1] (0 = fixed threshold)",
         )?;
         check(
             g.min_edge_angle_deg > 0.0 && g.min_edge_angle_deg < 90.0,
@@ -237,6 +247,12 @@ impl TrackerConfig {
             "track.window_half_width_px",
             t.window_half_width_px,
             "must be in 1..=200 px",
+        )?;
+        check(
+            t.inlier_half_width_px > 0.0 && t.inlier_half_width_px.is_finite(),
+            "track.inlier_half_width_px",
+            t.inlier_half_width_px,
+            "must be finite and > 0 px",
         )?;
         check(
             (3..=1000).contains(&t.max_points_per_lane),
@@ -367,6 +383,10 @@ mod tests {
                 c.init.band_half_width_px = f64::INFINITY
             }),
             ("init.min_points", |c| c.init.min_points = 2),
+            ("init.refit_iterations", |c| c.init.refit_iterations = 6),
+            ("track.inlier_half_width_px", |c| {
+                c.track.inlier_half_width_px = 0.0
+            }),
             ("track.window_half_width_px", |c| {
                 c.track.window_half_width_px = 0
             }),

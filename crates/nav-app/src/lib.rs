@@ -14,3 +14,12 @@ pub use config::{
 };
 pub use error::NavError;
 pub use frame::{FrameMeta, FrameSource, GreyFrame};
+mod tracker;
+mod wrls_lane;
+
+pub use tracker::{
+    Estimator, LaneReport, LaneState, LaneTracker, LaneView, Side, TrackReport, TrackerCounters,
+};
+pub mod eval;
+pub mod overlay;
+pub mod synth;

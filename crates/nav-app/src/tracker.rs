@@ -1,0 +1,699 @@
+//! The tracking loop (paper Fig. 1): directional gradient → Hough + LS initialisation → KIF
+//! (or WRLS) recursion, per lane, with a state machine and sanity gates.
+
+use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, init_lane};
+use info_filter::{ParabolaKif, ProcessNoise, RowNorm, ThetaCov};
+use nalgebra::{Matrix3, Vector3};
+use serde::Serialize;
+use vision_gradient::{
+    ColSpan, EdgeBuffer, EdgeClass, GradientDetector, GradientParams, GreyImage, Region, Threshold,
+};
+
+use crate::{GreyFrame, NavError, TrackerConfig};
+
+/// Which lane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Side {
+    /// The left lane mark (edge class [`EdgeClass::LeftLane`], a `/` in the image).
+    Left,
+    /// The right lane mark (edge class [`EdgeClass::RightLane`], a `\` in the image).
+    Right,
+}
+
+/// Per-lane state, reported every frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LaneState {
+    /// No estimate yet: the first initialisation has not succeeded.
+    Initialising,
+    /// Updated from this frame's points (or initialised on this frame).
+    Tracking,
+    /// Too few points (or a gated update) this frame, for fewer than
+    /// `track.lost_after_frames` frames in a row: the reported coefficients are the prediction.
+    Coasting,
+    /// Too many missed frames in a row: no coefficients are reported and the lane is
+    /// re-initialised (Hough + LS over the whole region of interest) every frame until it is found.
+    Lost,
+}
+
+impl LaneState {
+    /// Lowercase name, as in the JSON output.
+    pub fn name(self) -> &'static str {
+        match self {
+            LaneState::Initialising => "initialising",
+            LaneState::Tracking => "tracking",
+            LaneState::Coasting => "coasting",
+            LaneState::Lost => "lost",
+        }
+    }
+}
+
+/// The recursive estimator of the lane coefficients.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Estimator {
+    /// Kalman information filter, positive-definite form (paper eqs. 6–12, 24). The default.
+    #[default]
+    Kif,
+    /// Exponentially weighted recursive least squares (paper eqs. 25–27), λ =
+    /// `filter.wrls_lambda`, applied once per frame.
+    Wrls,
+}
+
+/// One lane's result for one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LaneReport {
+    /// Which lane.
+    pub side: Side,
+    /// Its state after this frame.
+    pub state: LaneState,
+    /// `[a1, a2, a3]` of `x = a1·y² + a2·y + a3` (x column, y row, pixels of the input image);
+    /// `None` when the lane is [`LaneState::Initialising`] or [`LaneState::Lost`].
+    pub coeffs: Option<[f64; 3]>,
+    /// `[y_min, y_max]`, rows (px) of the points behind the estimate (last update or initialisation).
+    pub rows: [f64; 2],
+    /// Points used this frame (filter update, or LS fit of an initialisation); 0 when missed.
+    pub points: usize,
+    /// `true` if the lane was (re-)initialised by Hough + LS on this frame.
+    pub initialised: bool,
+}
+
+impl LaneReport {
+    /// Column of the reported parabola at `row_px`, if there is one.
+    pub fn col_at_row(&self, row_px: f64) -> Option<f64> {
+        self.coeffs
+            .map(|[a1, a2, a3]| (a1 * row_px + a2) * row_px + a3)
+    }
+}
+
+/// The tracker's result for one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrackReport {
+    /// Left then right.
+    pub lanes: [LaneReport; 2],
+    /// `true` if the full region of interest went through the gradient (an initialisation was
+    /// attempted); `false` on a pure tracking frame (gradient inside the windows only).
+    pub full_gradient: bool,
+}
+
+/// Counters over the tracker's life.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct TrackerCounters {
+    /// Frames processed.
+    pub frames: u64,
+    /// Successful initialisations per lane (left, right), the first one included.
+    pub initialisations: [u64; 2],
+    /// Updates rejected by the jump gate, per lane.
+    pub gated_jumps: [u64; 2],
+    /// Estimates rejected because the lanes crossed, per lane.
+    pub gated_crossings: [u64; 2],
+    /// Filter failures (numerical: a non-positive-definite matrix), per lane.
+    pub filter_failures: [u64; 2],
+}
+
+/// The per-lane recursive estimator state.
+#[derive(Debug, Clone)]
+enum LaneFilter {
+    Kif(ParabolaKif),
+    Wrls(crate::wrls_lane::WrlsLane),
+}
+
+impl LaneFilter {
+    fn col_at_row(&self, row_px: f64) -> f64 {
+        match self {
+            LaneFilter::Kif(k) => k.col_at_row_px(row_px),
+            LaneFilter::Wrls(w) => w.col_at_row_px(row_px),
+        }
+    }
+    fn coeffs(&self) -> [f64; 3] {
+        let v = match self {
+            LaneFilter::Kif(k) => k.estimate(),
+            LaneFilter::Wrls(w) => w.estimate(),
+        };
+        [v[0], v[1], v[2]]
+    }
+}
+
+#[derive(Debug)]
+struct Lane {
+    side: Side,
+    class: EdgeClass,
+    band: AngleBand,
+    state: LaneState,
+    filter: Option<LaneFilter>,
+    predicted: Option<LaneFilter>,
+    misses: u32,
+    points: Vec<(f32, f32)>,
+    spans: Vec<ColSpan>,
+    rows: [f64; 2],
+    points_now: usize,
+    initialised_now: bool,
+    updated_now: bool,
+    fresh: bool,
+}
+
+impl Lane {
+    fn report(&self) -> LaneReport {
+        let coeffs = match self.state {
+            LaneState::Tracking | LaneState::Coasting => {
+                self.filter.as_ref().map(LaneFilter::coeffs)
+            }
+            LaneState::Initialising | LaneState::Lost => None,
+        };
+        LaneReport {
+            side: self.side,
+            state: self.state,
+            coeffs,
+            rows: self.rows,
+            points: self.points_now,
+            initialised: self.initialised_now,
+        }
+    }
+
+    fn has_estimate(&self) -> bool {
+        matches!(self.state, LaneState::Tracking | LaneState::Coasting) && self.filter.is_some()
+    }
+}
+
+/// What an overlay needs of one lane: its windows, its points and its estimate.
+#[derive(Debug, Clone, Copy)]
+pub struct LaneView<'a> {
+    /// The lane's report for the last frame.
+    pub report: LaneReport,
+    /// Window of interest per image row (empty spans outside it) used on the last frame; all
+    /// empty if the lane was not tracked on it.
+    pub spans: &'a [ColSpan],
+    /// The points fed to the filter or the LS fit on the last frame, `(col_px, row_px)`.
+    pub points: &'a [(f32, f32)],
+}
+
+/// The lane tracker for frames of one size. Build once; [`LaneTracker::track`] per frame does
+/// not allocate.
+#[derive(Debug)]
+pub struct LaneTracker {
+    cfg: TrackerConfig,
+    estimator: Estimator,
+    width: usize,
+    height: usize,
+    roi: (usize, usize),
+    detector: GradientDetector,
+    edges: EdgeBuffer,
+    hough: HoughWorkspace,
+    init_params: LaneInitParams,
+    candidates: Vec<(f32, f32)>,
+    row_norm: RowNorm,
+    q: ProcessNoise<3>,
+    p0: ThetaCov,
+    lanes: [Lane; 2],
+    counters: TrackerCounters,
+}
+
+/// Largest window half-width accepted by the configuration, px.
+const MAX_WINDOW_HALF_WIDTH: usize = 200;
+
+fn stage(stage: &'static str, e: impl std::fmt::Display) -> NavError {
+    NavError::Stage {
+        stage,
+        message: e.to_string(),
+    }
+}
+
+impl LaneTracker {
+    /// A tracker for `width × height` frames. Validates `cfg`.
+    pub fn new(
+        cfg: &TrackerConfig,
+        estimator: Estimator,
+        width: usize,
+        height: usize,
+    ) -> Result<Self, NavError> {
+        cfg.validate()?;
+        if width < 3 || height < 3 {
+            return Err(NavError::ZeroSize {
+                name: "tracker".to_owned(),
+                width,
+                height,
+            });
+        }
+        let g = &cfg.gradient;
+        let threshold = if g.adaptive_keep_fraction > 0.0 {
+            Threshold::Adaptive {
+                keep_fraction: g.adaptive_keep_fraction,
+                min_magnitude: g.magnitude_threshold,
+            }
+        } else {
+            Threshold::Fixed {
+                min_magnitude: g.magnitude_threshold,
+            }
+        };
+        let detector = GradientDetector::new(GradientParams {
+            min_edge_angle_deg: g.min_edge_angle_deg,
+            max_edge_angle_deg: g.max_edge_angle_deg,
+            threshold,
+        })
+        .map_err(|e| stage("gradient", e))?;
+        let roi = cfg.roi_rows(height);
+        let capacity = width * (roi.1 - roi.0);
+        let hough = HoughWorkspace::new(
+            width,
+            height,
+            HoughParams {
+                theta_step_deg: cfg.init.theta_step_deg,
+                rho_step_px: cfg.init.rho_step_px,
+                ..HoughParams::default()
+            },
+        )
+        .map_err(|e| stage("hough", e))?;
+        let init_params = LaneInitParams {
+            band_px: cfg.init.band_half_width_px,
+            min_points: cfg.init.min_points,
+            refit_iterations: cfg.init.refit_iterations,
+        };
+        init_params.validate().map_err(|e| stage("hough", e))?;
+        let center = (roi.0 + roi.1 - 1) as f64 / 2.0;
+        let scale = ((roi.1 - 1 - roi.0) as f64 / 2.0).max(1.0);
+        let row_norm = RowNorm::new(center, scale).map_err(|e| stage("kif", e))?;
+        let f = &cfg.filter;
+        let q_u = Matrix3::from_diagonal(&Vector3::from(f.q_sigma_px.map(|s| s * s)));
+        let q = ProcessNoise::new(&q_u).map_err(|e| stage("kif", e))?;
+        let p0 = ThetaCov::Normalised(Matrix3::from_diagonal(&Vector3::from(
+            f.p0_sigma_px.map(|s| s * s),
+        )));
+        let lo = 90.0 - g.max_edge_angle_deg;
+        let hi = 90.0 - g.min_edge_angle_deg;
+        let make_lane = |side, class, band| Lane {
+            side,
+            class,
+            band,
+            state: LaneState::Initialising,
+            filter: None,
+            predicted: None,
+            misses: 0,
+            points: Vec::with_capacity(cfg.track.max_points_per_lane.max(capacity.min(1 << 16))),
+            spans: vec![ColSpan::EMPTY; height],
+            rows: [0.0, 0.0],
+            points_now: 0,
+            initialised_now: false,
+            updated_now: false,
+            fresh: false,
+        };
+        let lanes = [
+            make_lane(Side::Left, EdgeClass::LeftLane, AngleBand::new(lo, hi)),
+            make_lane(Side::Right, EdgeClass::RightLane, AngleBand::new(-hi, -lo)),
+        ];
+        for lane in &lanes {
+            lane.band.validate().map_err(|e| stage("hough", e))?;
+        }
+        Ok(LaneTracker {
+            cfg: *cfg,
+            estimator,
+            width,
+            height,
+            roi,
+            detector,
+            edges: EdgeBuffer::with_capacity(capacity),
+            hough,
+            init_params,
+            candidates: Vec::with_capacity(capacity),
+            row_norm,
+            q,
+            p0,
+            lanes,
+            counters: TrackerCounters::default(),
+        })
+    }
+
+    /// Frame size this tracker takes, px.
+    pub fn frame_size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// Rows searched, `[top, bottom)`, px.
+    pub fn roi_rows(&self) -> (usize, usize) {
+        self.roi
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &TrackerConfig {
+        &self.cfg
+    }
+
+    /// The estimator in use.
+    pub fn estimator(&self) -> Estimator {
+        self.estimator
+    }
+
+    /// Counters since construction (or the last [`LaneTracker::reset`]).
+    pub fn counters(&self) -> &TrackerCounters {
+        &self.counters
+    }
+
+    /// Forget both lanes (next frame initialises again) and zero the counters.
+    pub fn reset(&mut self) {
+        for lane in &mut self.lanes {
+            lane.state = LaneState::Initialising;
+            lane.filter = None;
+            lane.predicted = None;
+            lane.misses = 0;
+            lane.points.clear();
+            lane.spans.fill(ColSpan::EMPTY);
+            lane.points_now = 0;
+        }
+        self.counters = TrackerCounters::default();
+    }
+
+    /// Windows, points and report of one lane after the last frame (for overlays).
+    pub fn lane_view(&self, side: Side) -> LaneView<'_> {
+        let lane = &self.lanes[side as usize];
+        LaneView {
+            report: lane.report(),
+            spans: &lane.spans,
+            points: &lane.points,
+        }
+    }
+
+    /// Process one frame. Errors only for a frame of the wrong size or a component refusing
+    /// its (validated) input; a lane that cannot be tracked is reported as such, not as an error.
+    pub fn track(&mut self, frame: &GreyFrame) -> Result<TrackReport, NavError> {
+        if frame.width != self.width || frame.height != self.height {
+            return Err(NavError::FrameSize {
+                expected_w: self.width,
+                expected_h: self.height,
+                got_w: frame.width,
+                got_h: frame.height,
+            });
+        }
+        let image = GreyImage::new(&frame.data, self.width, self.height, self.width)
+            .map_err(|e| stage("gradient", e))?;
+        self.counters.frames += 1;
+        for i in 0..2 {
+            let lane = &mut self.lanes[i];
+            lane.initialised_now = false;
+            lane.updated_now = false;
+            lane.points_now = 0;
+            if lane.has_estimate() {
+                self.track_lane(i, &image)?;
+            } else {
+                lane.spans.fill(ColSpan::EMPTY);
+                lane.points.clear();
+            }
+        }
+        let need_init = self.lanes.iter().any(|l| !l.has_estimate());
+        if need_init {
+            self.initialise(&image)?;
+        }
+        self.crossing_gate();
+        Ok(TrackReport {
+            lanes: [self.lanes[0].report(), self.lanes[1].report()],
+            full_gradient: need_init,
+        })
+    }
+
+    fn track_lane(&mut self, i: usize, image: &GreyImage<'_>) -> Result<(), NavError> {
+        let (top, bottom) = self.roi;
+        let w = self.cfg.track.window_half_width_px as i64;
+        let max_points = self.cfg.track.max_points_per_lane;
+        let lane = &mut self.lanes[i];
+        let Some(filter) = lane.filter.as_mut() else {
+            return Ok(());
+        };
+        let predicted = match filter {
+            LaneFilter::Kif(k) => k.predict(&self.q).map_err(|e| e.to_string()),
+            LaneFilter::Wrls(_) => Ok(()),
+        };
+        if predicted.is_err() {
+            self.counters.filter_failures[i] += 1;
+            lane.state = LaneState::Lost;
+            return Ok(());
+        }
+        lane.predicted.clone_from(&lane.filter);
+        let Some(filter) = lane.filter.as_mut() else {
+            return Ok(());
+        };
+        for (row, span) in lane.spans.iter_mut().enumerate() {
+            *span = if row >= top && row < bottom {
+                let x = filter.col_at_row(row as f64);
+                if x.is_finite() && x.abs() < 1e6 {
+                    let c = x.round() as i64;
+                    ColSpan::clamped(c - w, c + w + 1, self.width)
+                } else {
+                    ColSpan::EMPTY
+                }
+            } else {
+                ColSpan::EMPTY
+            };
+        }
+        self.detector
+            .detect(image, Region::Spans(&lane.spans), &mut self.edges, None)
+            .map_err(|e| stage("gradient", e))?;
+        // Outlier rejection: the residuals r = x − x̂(y) of the window pixels are histogrammed
+        // in three row bands; pixels farther than `inlier_half_width_px` from their band's
+        // midhinge residual (mean of the quartiles) are dropped (clutter, noise, the edges of a shadow).
+        const BANDS: usize = 3;
+        let mut hist = [[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS];
+        let band_of = |row: u16| {
+            ((usize::from(row).saturating_sub(top)) * BANDS / (bottom - top)).min(BANDS - 1)
+        };
+        let w_us = w as usize;
+        let residual = |p: &vision_gradient::EdgePixel| -> i64 {
+            (f64::from(p.col_px) - filter.col_at_row(f64::from(p.row_px))).round() as i64
+        };
+        for p in self.edges.iter_class(lane.class) {
+            let r = (residual(p) + w).clamp(0, 2 * w) as usize;
+            hist[band_of(p.row_px)][r] += 1;
+        }
+        // Band centre = midhinge (mean of the quartiles): with the two edges of a mark it
+        // lands between them, where a median would pick one edge.
+        let mut median = [0i64; BANDS];
+        for (b, h) in hist.iter().enumerate() {
+            let n: u32 = h[..=2 * w_us].iter().sum();
+            if n == 0 {
+                continue;
+            }
+            let (q1, q3) = (n.div_ceil(4), (3 * n).div_ceil(4));
+            let (mut acc, mut r1, mut r3) = (0u32, None, None);
+            for (r, &c) in h[..=2 * w_us].iter().enumerate() {
+                acc += c;
+                if r1.is_none() && acc >= q1 {
+                    r1 = Some(r as i64);
+                }
+                if acc >= q3 {
+                    r3 = Some(r as i64);
+                    break;
+                }
+            }
+            if let (Some(a), Some(c)) = (r1, r3) {
+                median[b] = (a + c).div_euclid(2) - w;
+            }
+        }
+        let inlier = self.cfg.track.inlier_half_width_px;
+        let is_inlier = |p: &vision_gradient::EdgePixel| {
+            (residual(p) - median[band_of(p.row_px)]).abs() as f64 <= inlier
+        };
+        // Uniform decimation of the row-ordered inliers down to max_points: spreads the points
+        // over the rows in proportion to the edge density, and over both edges of a mark.
+        let total = self
+            .edges
+            .iter_class(lane.class)
+            .filter(|p| is_inlier(p))
+            .count();
+        lane.points.clear();
+        for (j, p) in self
+            .edges
+            .iter_class(lane.class)
+            .filter(|p| is_inlier(p))
+            .enumerate()
+        {
+            if total <= max_points || (j + 1) * max_points / total > j * max_points / total {
+                lane.points.push((f32::from(p.col_px), f32::from(p.row_px)));
+            }
+        }
+        if lane.points.len() < self.cfg.track.reinit_min_points {
+            Self::miss(lane, &self.cfg);
+            return Ok(());
+        }
+        let r2 = self.cfg.filter.r_sigma_px * self.cfg.filter.r_sigma_px;
+        let updated = match filter {
+            LaneFilter::Kif(k) => k.update(&lane.points, r2).map_err(|e| e.to_string()),
+            LaneFilter::Wrls(wl) => wl.update(&lane.points).map_err(|e| e.to_string()),
+        };
+        if updated.is_err() {
+            self.counters.filter_failures[i] += 1;
+            lane.filter.clone_from(&lane.predicted);
+            Self::miss(lane, &self.cfg);
+            return Ok(());
+        }
+        // Jump gate at the top and bottom ROI rows.
+        let (Some(new), Some(pred)) = (lane.filter.as_ref(), lane.predicted.as_ref()) else {
+            return Ok(());
+        };
+        let jump = [top as f64, (bottom - 1) as f64]
+            .iter()
+            .map(|&y| (new.col_at_row(y) - pred.col_at_row(y)).abs())
+            .fold(0.0f64, f64::max);
+        // The first update after an initialisation corrects the LS fit (P0) and is not gated.
+        if !lane.fresh && !(jump <= self.cfg.track.max_jump_px) {
+            self.counters.gated_jumps[i] += 1;
+            lane.filter.clone_from(&lane.predicted);
+            Self::miss(lane, &self.cfg);
+            return Ok(());
+        }
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &(_, y) in &lane.points {
+            lo = lo.min(f64::from(y));
+            hi = hi.max(f64::from(y));
+        }
+        lane.rows = [lo, hi];
+        lane.points_now = lane.points.len();
+        lane.state = LaneState::Tracking;
+        lane.misses = 0;
+        lane.updated_now = true;
+        lane.fresh = false;
+        Ok(())
+    }
+
+    fn miss(lane: &mut Lane, cfg: &TrackerConfig) {
+        lane.misses += 1;
+        lane.points_now = 0;
+        lane.state = if lane.misses >= cfg.track.lost_after_frames {
+            LaneState::Lost
+        } else {
+            LaneState::Coasting
+        };
+    }
+
+    fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), NavError> {
+        let (top, bottom) = self.roi;
+        self.detector
+            .detect(
+                image,
+                Region::Rows {
+                    row_start_px: top,
+                    row_end_px: bottom,
+                },
+                &mut self.edges,
+                None,
+            )
+            .map_err(|e| stage("gradient", e))?;
+        for i in 0..2 {
+            if self.lanes[i].has_estimate() {
+                continue;
+            }
+            let class = self.lanes[i].class;
+            self.candidates.clear();
+            self.candidates.extend(
+                self.edges
+                    .iter_class(class)
+                    .map(|p| (f32::from(p.col_px), f32::from(p.row_px))),
+            );
+            let Ok(init) = init_lane(
+                &self.candidates,
+                &self.lanes[i].band,
+                &mut self.hough,
+                &self.init_params,
+            ) else {
+                continue;
+            };
+            // Sanity: the fit must cover a fair part of the ROI and stay near the image.
+            let span_rows = init.rows_px.1 - init.rows_px.0;
+            let min_span = 0.25 * (bottom - top) as f64;
+            let x_bottom = init.parabola.col_at_row((bottom - 1) as f64);
+            let w = self.width as f64;
+            if span_rows < min_span || !x_bottom.is_finite() || x_bottom < -w || x_bottom > 2.0 * w
+            {
+                continue;
+            }
+            let theta = Vector3::new(init.parabola.a1, init.parabola.a2, init.parabola.a3);
+            let filter = match self.estimator {
+                Estimator::Kif => ParabolaKif::new(&theta, &self.p0, self.row_norm)
+                    .map(LaneFilter::Kif)
+                    .map_err(|e| e.to_string()),
+                Estimator::Wrls => crate::wrls_lane::WrlsLane::new(
+                    &theta,
+                    &self.p0,
+                    self.row_norm,
+                    self.cfg.filter.wrls_lambda,
+                )
+                .map(LaneFilter::Wrls)
+                .map_err(|e| e.to_string()),
+            };
+            let Ok(filter) = filter else {
+                self.counters.filter_failures[i] += 1;
+                continue;
+            };
+            let lane = &mut self.lanes[i];
+            // Keep the points the LS fit used, for overlays.
+            lane.points.clear();
+            let (s, c) = init.line.theta_rad.sin_cos();
+            let band = self.init_params.band_px;
+            for &(x, y) in &self.candidates {
+                let (xf, yf) = (f64::from(x), f64::from(y));
+                if (xf * c + yf * s - init.line.rho_px).abs() <= band
+                    && lane.points.len() < lane.points.capacity()
+                {
+                    lane.points.push((x, y));
+                }
+            }
+            lane.filter = Some(filter);
+            lane.predicted = None;
+            lane.fresh = true;
+            lane.state = LaneState::Tracking;
+            lane.misses = 0;
+            lane.rows = [init.rows_px.0, init.rows_px.1];
+            lane.points_now = init.points_used;
+            lane.initialised_now = true;
+            self.counters.initialisations[i] += 1;
+        }
+        Ok(())
+    }
+
+    /// Left and right lanes may not cross at the top ROI row, nor come closer than
+    /// `min_lane_separation_px` at the middle and bottom ROI rows. The offending estimate is the one that changed on this
+    /// frame by initialisation, else the one backed by fewer points; it is undone.
+    fn crossing_gate(&mut self) {
+        let [l, r] = &self.lanes;
+        let (Some(lf), Some(rf)) = (l.filter.as_ref(), r.filter.as_ref()) else {
+            return;
+        };
+        if !(l.has_estimate() && r.has_estimate()) {
+            return;
+        }
+        let (top, bottom) = self.roi;
+        let sep = self.cfg.track.min_lane_separation_px;
+        // Lanes converge towards the horizon: at the top ROI row they need only be in order,
+        // at the middle and bottom rows `sep` apart.
+        let rows = [
+            (top as f64, 0.0),
+            (0.5 * (top + bottom - 1) as f64, sep),
+            ((bottom - 1) as f64, sep),
+        ];
+        let crossed = rows
+            .iter()
+            .any(|&(y, s)| !(rf.col_at_row(y) - lf.col_at_row(y) >= s));
+        if !crossed {
+            return;
+        }
+        let victim = match (l.initialised_now, r.initialised_now) {
+            (true, false) => 0,
+            (false, true) => 1,
+            _ => usize::from(r.points_now < l.points_now),
+        };
+        self.counters.gated_crossings[victim] += 1;
+        let lane = &mut self.lanes[victim];
+        if lane.initialised_now {
+            lane.initialised_now = false;
+            lane.filter = None;
+            lane.points_now = 0;
+            lane.state = if self.counters.initialisations[victim] > 1 {
+                LaneState::Lost
+            } else {
+                LaneState::Initialising
+            };
+            self.counters.initialisations[victim] -= 1;
+        } else {
+            if lane.predicted.is_some() {
+                lane.filter.clone_from(&lane.predicted);
+            }
+            Self::miss(lane, &self.cfg);
+        }
+    }
+}
