@@ -161,8 +161,12 @@ pub(crate) fn check_finite_vec<const R: usize>(
 
 /// Validates a user-supplied symmetric positive definite matrix: finite entries, symmetric to a
 /// relative 1e-9 per entry pair, and a successful Cholesky factorisation. Returns the exactly
-/// symmetrised matrix and its factor.
-pub(crate) fn validate_spd<const N: usize>(
+/// symmetrised matrix and its factor. `matrix` names it in the error.
+///
+/// # Errors
+/// [`KifError::NonFiniteMatrix`], [`KifError::NotSymmetric`] or
+/// [`KifError::NotPositiveDefinite`] (with the failing pivot).
+pub fn validate_spd<const N: usize>(
     a: &SMatrix<f64, N, N>,
     matrix: &'static str,
 ) -> Result<(SMatrix<f64, N, N>, Cholesky<N>), KifError> {

@@ -99,7 +99,7 @@ mod generic;
 mod parabola;
 mod rownorm;
 
-pub use chol::{Cholesky, symmetrise};
+pub use chol::{Cholesky, symmetrise, validate_spd};
 pub use error::KifError;
 pub use generic::{InformationFilter, ProcessNoise, TimeUpdateForm};
 pub use parabola::{ParabolaKif, PixelPoint, PowerSums};
