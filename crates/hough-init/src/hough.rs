@@ -1,0 +1,389 @@
+//! Restricted-angle Hough transform with a caller-owned, reusable accumulator.
+
+use serde::{Deserialize, Serialize};
+
+use crate::{AngleBand, EdgePoint, HoughError, HoughParams, PointSet};
+
+/// Largest accepted image side, pixels.
+pub const MAX_IMAGE_SIDE_PX: usize = 1 << 14;
+/// Largest accepted accumulator, cells (`u32` each).
+pub const MAX_ACCUMULATOR_CELLS: usize = 1 << 25;
+
+/// A straight line in normal form `ρ = x·cos θ + y·sin θ` (x = column, y = row, pixels; origin
+/// at the centre of the top-left pixel).
+///
+/// `θ ∈ [−π/2, π/2)` is the angle of the line's normal from the column axis towards the
+/// (downward) row axis, equivalently the line's tilt from the image vertical (positive when its
+/// top leans right, `/`). `ρ` is the signed distance of the origin's foot point, pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HoughLine {
+    /// Signed distance from the origin (top-left pixel centre), pixels.
+    pub rho_px: f64,
+    /// Normal angle θ, radians.
+    pub theta_rad: f64,
+    /// Raw votes in the peak accumulator cell (before smoothing / refinement).
+    pub votes: u32,
+}
+
+impl HoughLine {
+    /// θ in degrees.
+    #[must_use]
+    pub fn theta_deg(&self) -> f64 {
+        self.theta_rad.to_degrees()
+    }
+
+    /// Signed perpendicular distance of `(col_px, row_px)` from the line, pixels:
+    /// `x cos θ + y sin θ − ρ`.
+    #[inline]
+    #[must_use]
+    pub fn signed_distance_px(&self, col_px: f64, row_px: f64) -> f64 {
+        let (s, c) = self.theta_rad.sin_cos();
+        col_px * c + row_px * s - self.rho_px
+    }
+
+    /// Column where the line crosses row `row_px`, pixels; `None` for a (numerically)
+    /// horizontal line (`|cos θ| < 1e-12`).
+    #[must_use]
+    pub fn col_at_row(&self, row_px: f64) -> Option<f64> {
+        let (s, c) = self.theta_rad.sin_cos();
+        (c.abs() >= 1e-12).then(|| (self.rho_px - row_px * s) / c)
+    }
+}
+
+/// Reusable Hough state for one image size: accumulator, cos/sin tables and a smoothing
+/// scratch buffer. Built once; [`HoughWorkspace::find_line`] does not allocate.
+///
+/// θ bins: `θ_k = −90° + k·Δθ`, `k = 0 … n_θ − 1`, `n_θ = ⌈180°/Δθ⌉`. Votes are cast relative to
+/// the image centre `((W−1)/2, (H−1)/2)` so the ρ range is the half-diagonal `±hypot(W/2, H/2)`;
+/// the reported [`HoughLine`] is converted to the top-left origin.
+#[derive(Debug, Clone)]
+pub struct HoughWorkspace {
+    width_px: usize,
+    height_px: usize,
+    params: HoughParams,
+    center_col_px: f64,
+    center_row_px: f64,
+    theta_bins: usize,
+    rho_bins: usize,
+    /// Index of the ρ bin centred on ρ_c = 0.
+    rho_zero_bin: usize,
+    /// cos θ_k / Δρ.
+    cos_over_step: Vec<f32>,
+    /// sin θ_k / Δρ.
+    sin_over_step: Vec<f32>,
+    /// Votes, θ-major: `acc[k * rho_bins + r]`.
+    acc: Vec<u32>,
+    /// Three rows of ρ-direction 3-sums (ring buffer) for the 3×3 smoothing.
+    ring: Vec<u32>,
+}
+
+impl HoughWorkspace {
+    /// Build the workspace for `width_px × height_px` images.
+    ///
+    /// # Errors
+    /// [`HoughError::InvalidParam`] from [`HoughParams::validate`];
+    /// [`HoughError::InvalidImageSize`] for a zero side or one above [`MAX_IMAGE_SIDE_PX`];
+    /// [`HoughError::AccumulatorTooLarge`] above [`MAX_ACCUMULATOR_CELLS`].
+    pub fn new(width_px: usize, height_px: usize, params: HoughParams) -> Result<Self, HoughError> {
+        params.validate()?;
+        if width_px == 0 || height_px == 0 {
+            return Err(HoughError::InvalidImageSize {
+                width_px,
+                height_px,
+                reason: "both sides must be at least 1 px",
+            });
+        }
+        if width_px > MAX_IMAGE_SIDE_PX || height_px > MAX_IMAGE_SIDE_PX {
+            return Err(HoughError::InvalidImageSize {
+                width_px,
+                height_px,
+                reason: "a side exceeds MAX_IMAGE_SIDE_PX (16384 px)",
+            });
+        }
+        let theta_bins = (180.0 / params.theta_step_deg - 1e-9).ceil() as usize;
+        let half_diag_px = (0.5 * width_px as f64).hypot(0.5 * height_px as f64);
+        // One spare bin each side absorbs rounding at the image corners.
+        let rho_zero_bin = (half_diag_px / params.rho_step_px).ceil() as usize + 1;
+        let rho_bins = 2 * rho_zero_bin + 1;
+        let cells = theta_bins.saturating_mul(rho_bins);
+        if cells > MAX_ACCUMULATOR_CELLS {
+            return Err(HoughError::AccumulatorTooLarge {
+                theta_bins,
+                rho_bins,
+                limit: MAX_ACCUMULATOR_CELLS,
+            });
+        }
+        let inv_step = 1.0 / params.rho_step_px;
+        let (cos_over_step, sin_over_step) = (0..theta_bins)
+            .map(|k| {
+                let theta = (-90.0 + k as f64 * params.theta_step_deg).to_radians();
+                let (s, c) = theta.sin_cos();
+                ((c * inv_step) as f32, (s * inv_step) as f32)
+            })
+            .unzip();
+        Ok(Self {
+            width_px,
+            height_px,
+            params,
+            center_col_px: 0.5 * (width_px as f64 - 1.0),
+            center_row_px: 0.5 * (height_px as f64 - 1.0),
+            theta_bins,
+            rho_bins,
+            rho_zero_bin,
+            cos_over_step,
+            sin_over_step,
+            acc: vec![0; cells],
+            ring: vec![0; 3 * rho_bins],
+        })
+    }
+
+    /// Image width, pixels.
+    #[must_use]
+    pub fn width_px(&self) -> usize {
+        self.width_px
+    }
+
+    /// Image height, pixels.
+    #[must_use]
+    pub fn height_px(&self) -> usize {
+        self.height_px
+    }
+
+    /// The parameters the workspace was built with.
+    #[must_use]
+    pub fn params(&self) -> &HoughParams {
+        &self.params
+    }
+
+    /// Accumulator shape `(θ bins over [−90°, 90°), ρ bins)`.
+    #[must_use]
+    pub fn accumulator_shape(&self) -> (usize, usize) {
+        (self.theta_bins, self.rho_bins)
+    }
+
+    /// θ of bin `k`, degrees.
+    fn theta_deg_of_bin(&self, k: f64) -> f64 {
+        -90.0 + k * self.params.theta_step_deg
+    }
+
+    /// Inclusive θ-bin range `[k0, k1]` covered by `band`.
+    ///
+    /// # Errors
+    /// [`HoughError::InvalidBand`] if the band is invalid or contains no bin centre.
+    pub fn band_bins(&self, band: &AngleBand) -> Result<(usize, usize), HoughError> {
+        band.validate()?;
+        let step = self.params.theta_step_deg;
+        let k0 = ((band.min_deg + 90.0) / step - 1e-9).ceil().max(0.0) as usize;
+        let k1 = (((band.max_deg + 90.0) / step + 1e-9).floor() as usize).min(self.theta_bins - 1);
+        if k0 > k1 {
+            return Err(HoughError::InvalidBand {
+                min_deg: band.min_deg,
+                max_deg: band.max_deg,
+                reason: "the band contains no θ bin centre (narrower than theta_step_deg)",
+            });
+        }
+        Ok((k0, k1))
+    }
+
+    /// Vote every point into the θ bins of `band` and return the peak line.
+    ///
+    /// Each point votes once per θ bin, for the ρ bin nearest to `x_c cos θ + y_c sin θ`
+    /// (centred coordinates). The peak is the maximum of the raw votes, or of their 3×3 box sum
+    /// when `peak_smoothing` is on (cells outside the band do not contribute); ties go to the
+    /// smallest θ, then the smallest ρ. With `subbin_refinement` the peak is refined along θ
+    /// and ρ separately by a three-point parabola.
+    ///
+    /// # Errors
+    /// [`HoughError::InvalidBand`]; [`HoughError::NonFinitePoint`];
+    /// [`HoughError::PointOutsideImage`] for a point outside
+    /// `[−0.5, W − 0.5] × [−0.5, H − 0.5]`; [`HoughError::TooFewPoints`] for fewer than 2 points.
+    pub fn find_line<P: EdgePoint>(
+        &mut self,
+        points: &[P],
+        band: &AngleBand,
+    ) -> Result<HoughLine, HoughError> {
+        let (k0, k1) = self.band_bins(band)?;
+        self.check_points(points)?;
+        if points.len() < 2 {
+            return Err(HoughError::TooFewPoints {
+                set: PointSet::Candidates,
+                found: points.len(),
+                required: 2,
+            });
+        }
+        self.vote(points, k0, k1);
+        let (k, r) = if self.params.peak_smoothing {
+            self.peak_smoothed(k0, k1)
+        } else {
+            self.peak_raw(k0, k1)
+        };
+        let (dk, dr) = if self.params.subbin_refinement {
+            self.refine(k, r, k0, k1)
+        } else {
+            (0.0, 0.0)
+        };
+        let theta_rad = self.theta_deg_of_bin(k as f64 + dk).to_radians();
+        let rho_c_px = (r as f64 + dr - self.rho_zero_bin as f64) * self.params.rho_step_px;
+        let (s, c) = theta_rad.sin_cos();
+        let rho_px = rho_c_px + self.center_col_px * c + self.center_row_px * s;
+        Ok(HoughLine {
+            rho_px,
+            theta_rad,
+            votes: self.acc[k * self.rho_bins + r],
+        })
+    }
+
+    fn check_points<P: EdgePoint>(&self, points: &[P]) -> Result<(), HoughError> {
+        let col_max = self.width_px as f64 - 0.5;
+        let row_max = self.height_px as f64 - 0.5;
+        for (index, p) in points.iter().enumerate() {
+            let (x, y) = (p.col_px(), p.row_px());
+            if !(x.is_finite() && y.is_finite()) {
+                return Err(HoughError::NonFinitePoint {
+                    index,
+                    col_px: x,
+                    row_px: y,
+                });
+            }
+            if !((-0.5..=col_max).contains(&x) && (-0.5..=row_max).contains(&y)) {
+                return Err(HoughError::PointOutsideImage {
+                    index,
+                    col_px: x,
+                    row_px: y,
+                    width_px: self.width_px,
+                    height_px: self.height_px,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn vote<P: EdgePoint>(&mut self, points: &[P], k0: usize, k1: usize) {
+        let nr = self.rho_bins;
+        let cx = self.center_col_px;
+        let cy = self.center_row_px;
+        // +0.5 turns the truncating cast into round-to-nearest; all values are positive
+        // because |ρ_c/Δρ| ≤ rho_zero_bin − 1 for in-image points.
+        let offset = self.rho_zero_bin as f32 + 0.5;
+        for k in k0..=k1 {
+            let row = &mut self.acc[k * nr..(k + 1) * nr];
+            row.fill(0);
+            let c = self.cos_over_step[k];
+            let s = self.sin_over_step[k];
+            for p in points {
+                let xc = (p.col_px() - cx) as f32;
+                let yc = (p.row_px() - cy) as f32;
+                let idx = (xc * c + yc * s + offset) as usize;
+                if let Some(cell) = row.get_mut(idx) {
+                    *cell = cell.saturating_add(1);
+                }
+            }
+        }
+    }
+
+    fn peak_raw(&self, k0: usize, k1: usize) -> (usize, usize) {
+        let nr = self.rho_bins;
+        let mut best = (0u32, k0, 0usize);
+        for k in k0..=k1 {
+            for (r, &v) in self.acc[k * nr..(k + 1) * nr].iter().enumerate() {
+                if v > best.0 {
+                    best = (v, k, r);
+                }
+            }
+        }
+        (best.1, best.2)
+    }
+
+    /// ρ-direction 3-sum of accumulator row `k` into ring slot `slot`.
+    fn hsum_into_ring(&mut self, k: usize, slot: usize) {
+        let nr = self.rho_bins;
+        let src = &self.acc[k * nr..(k + 1) * nr];
+        let dst = &mut self.ring[slot * nr..(slot + 1) * nr];
+        for r in 0..nr {
+            let left = if r > 0 { src[r - 1] } else { 0 };
+            let right = if r + 1 < nr { src[r + 1] } else { 0 };
+            dst[r] = left + src[r] + right;
+        }
+    }
+
+    fn peak_smoothed(&mut self, k0: usize, k1: usize) -> (usize, usize) {
+        let nr = self.rho_bins;
+        self.hsum_into_ring(k0, 0);
+        if k0 < k1 {
+            self.hsum_into_ring(k0 + 1, 1);
+        }
+        let mut best = (0u32, k0, 0usize);
+        for k in k0..=k1 {
+            if k < k1 && k > k0 {
+                self.hsum_into_ring(k + 1, (k + 1 - k0) % 3);
+            }
+            let cur = (k - k0) % 3;
+            let prev = (k > k0).then(|| (k - 1 - k0) % 3);
+            let next = (k < k1).then(|| (k + 1 - k0) % 3);
+            for r in 0..nr {
+                let mut v = self.ring[cur * nr + r];
+                if let Some(p) = prev {
+                    v += self.ring[p * nr + r];
+                }
+                if let Some(n) = next {
+                    v += self.ring[n * nr + r];
+                }
+                if v > best.0 {
+                    best = (v, k, r);
+                }
+            }
+        }
+        (best.1, best.2)
+    }
+
+    /// Peak score of cell `(k, r)`: raw votes or 3×3 box sum inside `[k0, k1]`.
+    fn score(&self, k: usize, r: usize, k0: usize, k1: usize) -> f64 {
+        let nr = self.rho_bins;
+        if !self.params.peak_smoothing {
+            return f64::from(self.acc[k * nr + r]);
+        }
+        let mut v = 0u64;
+        for kk in k.saturating_sub(1).max(k0)..=(k + 1).min(k1) {
+            for rr in r.saturating_sub(1)..=(r + 1).min(nr - 1) {
+                v += u64::from(self.acc[kk * nr + rr]);
+            }
+        }
+        v as f64
+    }
+
+    /// Sub-bin offsets `(dθ, dρ)` in bins, each in `[−½, ½]`.
+    fn refine(&self, k: usize, r: usize, k0: usize, k1: usize) -> (f64, f64) {
+        let s0 = self.score(k, r, k0, k1);
+        let dk = if k > k0 && k < k1 {
+            parabolic_offset(
+                self.score(k - 1, r, k0, k1),
+                s0,
+                self.score(k + 1, r, k0, k1),
+            )
+        } else {
+            0.0
+        };
+        let dr = if r > 0 && r + 1 < self.rho_bins {
+            parabolic_offset(
+                self.score(k, r - 1, k0, k1),
+                s0,
+                self.score(k, r + 1, k0, k1),
+            )
+        } else {
+            0.0
+        };
+        (dk, dr)
+    }
+}
+
+/// Vertex offset of the parabola through `(−1, a)`, `(0, b)`, `(1, c)`, clamped to `[−½, ½]`;
+/// `0` when the three values are not a strict local maximum shape.
+fn parabolic_offset(a: f64, b: f64, c: f64) -> f64 {
+    let denom = a - 2.0 * b + c;
+    if denom < 0.0 {
+        (0.5 * (a - c) / denom).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    }
+}

@@ -1,0 +1,114 @@
+//! Lane initialisation — stage II of Pimentel & Hemerly (ITA), "lane-mark detection and
+//! tracking": a Hough transform finds each lane's best straight line among its candidate edge
+//! pixels, and the pixels in a band around that line are fitted by least squares with the
+//! parabola of **eq. 1**
+//!
+//! ```text
+//!     x = a1·y² + a2·y + a3            (x = column, y = row, pixels)
+//! ```
+//!
+//! The paper runs this stage on the first frame and whenever the tracker (stage III, the
+//! Kalman information filter) has too few lane pixels; it reports 122.2 ms for it on a
+//! Pentium II 450 MHz. The paper leaves the Hough parameterisation, resolutions and band width
+//! open; the choices below are this crate's.
+//!
+//! # Coordinates
+//!
+//! Image coordinates in pixels: `x = col_px` to the right, `y = row_px` downwards, origin at
+//! the **centre of the top-left pixel**. Inputs are anything implementing [`EdgePoint`]
+//! ([`Point`], `(col, row)` tuples or `[col, row]` arrays of `f32`/`f64`/`u16`/`u32`/`i32`).
+//!
+//! # Hough transform
+//!
+//! Lines are in normal form
+//!
+//! ```text
+//!     ρ = x·cos θ + y·sin θ,     θ ∈ [−90°, 90°),   ρ signed, pixels
+//! ```
+//!
+//! with the same origin (top-left pixel centre) for the reported [`HoughLine`]. θ is the angle
+//! of the line's normal from the column axis towards the (downward) row axis, which equals the
+//! line's tilt from the image vertical; along the line `dx/dy = −tan θ`. So a left-lane mark
+//! (`/`, top leaning right) has θ > 0 and a right-lane mark (`\`) has θ < 0:
+//! [`AngleBand::LEFT_LANE`] = [15°, 75°], [`AngleBand::RIGHT_LANE`] = [−75°, −15°]. Only the θ
+//! bins of the lane's band are voted and searched.
+//!
+//! The accumulator ([`HoughWorkspace`]) is built once per image size and reused: θ bins
+//! `θ_k = −90° + k·Δθ` (`theta_step_deg`, default 0.5°) with precomputed cos/sin tables, ρ
+//! bins of `rho_step_px` (default 1 px) over `±hypot(W/2, H/2)` measured from the image
+//! centre (internally; converted to the top-left origin on output). Each point votes once per
+//! θ bin in the band for its nearest ρ bin. The peak is the maximum of the 3×3 box-summed votes
+//! (`peak_smoothing`), refined to sub-bin precision by three-point parabolas along θ and ρ
+//! (`subbin_refinement`).
+//!
+//! # Least squares
+//!
+//! The pixels with perpendicular distance `|x cos θ + y sin θ − ρ| ≤ band_px` (default 4 px)
+//! are fitted by ordinary least squares, minimising `Σ (x_i − a1·y_i² − a2·y_i − a3)²` (the
+//! horizontal residual, as in eq. 1 and the paper's measurement model `x = φᵀθ + v`,
+//! `φ = (y², y, 1)`). Raw rows up to 480 make the normal matrix's entries span `1 … 480⁴ ≈ 5·10¹⁰`,
+//! so the rows are normalised, `y' = (y − y0)/s` with `y0, s` the mid-row and half-span of the
+//! fitted rows (`y' ∈ [−1, 1]`); the 3×3 normal equations in the basis `(1, y', y'²)`,
+//!
+//! ```text
+//!     ⎡ Σ1    Σy'   Σy'² ⎤ ⎡b0⎤   ⎡ Σx    ⎤
+//!     ⎢ Σy'   Σy'²  Σy'³ ⎥ ⎢b1⎥ = ⎢ Σx·y' ⎥ ,
+//!     ⎣ Σy'²  Σy'³  Σy'⁴ ⎦ ⎣b2⎦   ⎣ Σx·y'²⎦
+//! ```
+//!
+//! are solved by Cholesky with a relative pivot test ([`MIN_RELATIVE_PIVOT`]; the error names
+//! the failed pivot), and mapped back to pixels:
+//!
+//! ```text
+//!     a1 = b2/s²,   a2 = b1/s − 2·b2·y0/s²,   a3 = b0 − b1·y0/s + b2·y0²/s².
+//! ```
+//!
+//! Fewer than 3 points, a single row, fewer than three distinct rows, or a non-finite
+//! coordinate give a [`HoughError`], never NaN coefficients.
+//!
+//! # Parameters and units
+//!
+//! | struct | field | unit | default | disables |
+//! |---|---|---|---|---|
+//! | [`HoughParams`] | `theta_step_deg` | degrees | 0.5 | — |
+//! | [`HoughParams`] | `rho_step_px` | pixels | 1.0 | — |
+//! | [`HoughParams`] | `peak_smoothing` | — | `true` | `false` |
+//! | [`HoughParams`] | `subbin_refinement` | — | `true` | `false` |
+//! | [`LaneInitParams`] | `band_px` | pixels | 4.0 | — |
+//! | [`LaneInitParams`] | `min_points` | points | 10 | — (≥ 3) |
+//! | [`LaneInitParams`] | `refit_iterations` | iterations | 0 | `0` |
+//! | [`AngleBand`] | `min_deg`, `max_deg` | degrees of θ | see above | — |
+//!
+//! # Example
+//!
+//! ```
+//! use hough_init::{init_lane, AngleBand, HoughParams, HoughWorkspace, LaneInitParams, Point};
+//!
+//! // A right-lane mark x = 0.001·y² + 0.4·y + 130 on rows 100..240 of a 320×240 frame,
+//! // plus a few stray pixels.
+//! let truth = |y: f64| 0.001 * y * y + 0.4 * y + 130.0;
+//! let mut points: Vec<Point> = (100..240).map(|r| Point::new(truth(f64::from(r)), f64::from(r))).collect();
+//! points.extend([Point::new(10.0, 20.0), Point::new(300.0, 50.0), Point::new(40.0, 230.0)]);
+//!
+//! let mut ws = HoughWorkspace::new(320, 240, HoughParams::default())?;
+//! let params = LaneInitParams { band_px: 6.0, ..LaneInitParams::default() };
+//! let lane = init_lane(&points, &AngleBand::RIGHT_LANE, &mut ws, &params)?;
+//!
+//! assert!(lane.line.theta_deg() < 0.0); // a `\` line
+//! assert!((lane.parabola.col_at_row(200.0) - truth(200.0)).abs() < 0.5);
+//! # Ok::<(), hough_init::HoughError>(())
+//! ```
+
+mod error;
+mod hough;
+mod init;
+mod parabola;
+mod params;
+mod point;
+
+pub use error::{HoughError, PointSet};
+pub use hough::{HoughLine, HoughWorkspace, MAX_ACCUMULATOR_CELLS, MAX_IMAGE_SIDE_PX};
+pub use init::{LaneInit, init_lane};
+pub use parabola::{MIN_RELATIVE_PIVOT, Parabola, ParabolaFit, fit_parabola, fit_parabola_where};
+pub use params::{AngleBand, HoughParams, LaneInitParams};
+pub use point::{EdgePoint, Point};
