@@ -155,14 +155,12 @@ impl Capture {
                 }
                 *index
             }
-            InputSelect::Name(name) => inputs
-                .iter()
-                .find(|i| i.name.eq_ignore_ascii_case(name.trim()))
-                .map(|i| i.index)
-                .ok_or_else(|| CaptureError::InputNotFound {
+            InputSelect::Name(name) => {
+                find_input_by_name(&inputs, name).ok_or_else(|| CaptureError::InputNotFound {
                     name: name.clone(),
                     available: inputs.iter().map(|i| i.name.clone()).collect(),
-                })?,
+                })?
+            }
         };
         if !matches!(config.input, InputSelect::Current) {
             raw::set_input(fd, input_index).map_err(|e| gone(e, "VIDIOC_S_INPUT"))?;
@@ -580,6 +578,26 @@ fn timeval_us(tv_sec: libc::time_t, tv_usec: libc::suseconds_t) -> i64 {
     i64::from(tv_sec) * 1_000_000 + i64::from(tv_usec)
 }
 
+/// The index of the input called `name`: an exact (ASCII case-insensitive) match, else the only
+/// input whose name is `name` followed by a space and a suffix (vivid calls its inputs
+/// `"S-Video 0"`, `"TV 0"`; bttv's `"Composite0"` needs the exact name).
+fn find_input_by_name(inputs: &[InputInfo], name: &str) -> Option<u32> {
+    let name = name.trim();
+    if let Some(exact) = inputs.iter().find(|i| i.name.eq_ignore_ascii_case(name)) {
+        return Some(exact.index);
+    }
+    let mut prefixed = inputs.iter().filter(|i| {
+        i.name.len() > name.len()
+            && i.name.is_char_boundary(name.len())
+            && i.name[..name.len()].eq_ignore_ascii_case(name)
+            && i.name[name.len()..].starts_with(' ')
+    });
+    match (prefixed.next(), prefixed.next()) {
+        (Some(only), None) => Some(only.index),
+        _ => None,
+    }
+}
+
 /// `ENODEV` → [`CaptureError::DeviceGone`], anything else → [`CaptureError::Ioctl`].
 fn gone_or(e: io::Error, op: &'static str, path: &str) -> CaptureError {
     if e.raw_os_error() == Some(libc::ENODEV) {
@@ -621,4 +639,40 @@ pub fn list_inputs(path: &str) -> Result<Vec<InputInfo>, CaptureError> {
         source,
     })?;
     raw::enum_inputs(device.handle().fd()).map_err(|e| gone_or(e, "VIDIOC_ENUMINPUT", path))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn input(index: u32, name: &str) -> InputInfo {
+        InputInfo {
+            index,
+            name: name.into(),
+            is_tuner: false,
+            std_mask: 0xb0ff,
+            status: 0,
+        }
+    }
+
+    #[test]
+    fn input_name_matching_exact_then_unique_space_suffix() {
+        let bttv = [
+            input(0, "Television"),
+            input(1, "Composite1"),
+            input(2, "S-Video"),
+            input(3, "Composite3"),
+        ];
+        assert_eq!(find_input_by_name(&bttv, "s-video"), Some(2));
+        assert_eq!(find_input_by_name(&bttv, "Composite3"), Some(3));
+        // "Composite" is a prefix of two names without a space separator: no match.
+        assert_eq!(find_input_by_name(&bttv, "Composite"), None);
+        let vivid = [input(0, "TV 0"), input(1, "S-Video 0")];
+        assert_eq!(find_input_by_name(&vivid, "S-Video"), Some(1));
+        assert_eq!(find_input_by_name(&vivid, "TV"), Some(0));
+        assert_eq!(find_input_by_name(&vivid, "S-Vid"), None);
+        let ambiguous = [input(0, "S-Video 0"), input(1, "S-Video 1")];
+        assert_eq!(find_input_by_name(&ambiguous, "S-Video"), None);
+        assert_eq!(find_input_by_name(&ambiguous, "S-Video 1"), Some(1));
+    }
 }

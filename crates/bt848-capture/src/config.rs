@@ -12,7 +12,8 @@ pub enum InputSelect {
     #[default]
     Current,
     /// The input whose `VIDIOC_ENUMINPUT` name equals this (ASCII case-insensitive), e.g. bttv's
-    /// `"Composite0"`, `"S-Video"`, `"Television"`; vivid's `"S-Video"`, `"TV"`.
+    /// `"Composite0"`, `"S-Video"`, `"Television"`; failing that, the only input named this plus
+    /// a space and a suffix (vivid's `"S-Video 0"` answers to `"S-Video"`).
     Name(String),
     /// The input with this `VIDIOC_ENUMINPUT` index.
     Index(u32),

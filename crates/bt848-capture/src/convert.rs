@@ -294,10 +294,10 @@ mod tests {
 
     #[test]
     fn uyvy_takes_odd_bytes() {
+        // 4×2 with stride 10 (2 padding bytes 0xEE); each row U Y0 V Y1 U Y2 V Y3.
         let src = [
-            128, 10, 129, 20, 130, 30, 131, 40, 0xEE, 0xEE, 50, 0, 60, 0, 70, 0, 80,
+            128, 10, 129, 20, 130, 30, 131, 40, 0xEE, 0xEE, 0, 50, 0, 60, 0, 70, 0, 80,
         ];
-        // 4×2 with stride 10 (2 padding bytes); second row U Y V Y…
         let mut dst = [0u8; 8];
         to_grey(PixelFormat::Uyvy, &src, 4, 2, 10, &mut dst).unwrap();
         assert_eq!(dst, [10, 20, 30, 40, 50, 60, 70, 80]);
