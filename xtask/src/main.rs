@@ -7,6 +7,8 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
+mod fixtures;
+mod regress;
 mod vivid;
 
 #[derive(Parser)]
@@ -22,12 +24,18 @@ enum Cmd {
     Test,
     /// Boot Debian's kernel under qemu with the vivid V4L2 driver and run the capture cases.
     Vivid(vivid::VividArgs),
+    /// Render the synthetic lane sequences with ground truth into fixtures/synthetic/.
+    Fixtures(fixtures::FixturesArgs),
+    /// Run the lane tracker over every fixture and compare with the recorded expectations.
+    Regress(regress::RegressArgs),
 }
 
 fn main() -> Result<()> {
     match Cli::parse().cmd {
         Cmd::Test => test(),
         Cmd::Vivid(args) => vivid::run(args),
+        Cmd::Fixtures(args) => fixtures::run(args),
+        Cmd::Regress(args) => regress::run(args),
     }
 }
 
@@ -38,13 +46,29 @@ struct Step {
 }
 
 const STEPS: &[Step] = &[
-    Step { name: "fmt", args: &["fmt", "--all", "--", "--check"] },
+    Step {
+        name: "fmt",
+        args: &["fmt", "--all", "--", "--check"],
+    },
     Step {
         name: "clippy",
-        args: &["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"],
+        args: &[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ],
     },
-    Step { name: "test", args: &["test", "--workspace", "--all-targets"] },
-    Step { name: "doctest", args: &["test", "--workspace", "--doc"] },
+    Step {
+        name: "test",
+        args: &["test", "--workspace", "--all-targets"],
+    },
+    Step {
+        name: "doctest",
+        args: &["test", "--workspace", "--doc"],
+    },
 ];
 
 fn test() -> Result<()> {

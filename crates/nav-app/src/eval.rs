@@ -114,3 +114,211 @@ pub fn score_sequence(truth: &SequenceTruth, reports: &[Option<TrackReport>]) ->
         initialisations: inits,
     }
 }
+
+/// A whole run of the tracker over a source.
+#[derive(Debug, Clone)]
+pub struct RunOutcome {
+    /// Report per frame index (`None` for a frame that was skipped as bad).
+    pub reports: Vec<Option<crate::TrackReport>>,
+    /// Non-fatal frame errors (reported, counted, skipped), as text.
+    pub bad_frames: Vec<String>,
+    /// The tracker's counters at the end.
+    pub counters: crate::TrackerCounters,
+}
+
+/// Run a fresh tracker (built on the first frame's size) over `source`, at most `max_frames`.
+/// Fatal source errors and tracker errors end the run with that error.
+pub fn run_tracker(
+    source: &mut dyn crate::FrameSource,
+    cfg: &crate::TrackerConfig,
+    estimator: crate::Estimator,
+    max_frames: Option<u64>,
+) -> Result<RunOutcome, crate::NavError> {
+    let mut frame = crate::GreyFrame::default();
+    let mut tracker: Option<crate::LaneTracker> = None;
+    let mut reports = Vec::new();
+    let mut bad_frames = Vec::new();
+    let mut n = 0u64;
+    while max_frames.is_none_or(|m| n < m) {
+        let meta = match source.next_frame(&mut frame) {
+            Ok(Some(m)) => m,
+            Ok(None) => break,
+            Err(e) if !e.is_fatal() => {
+                bad_frames.push(e.to_string());
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        let t = match &mut tracker {
+            Some(t) => t,
+            slot => slot.insert(crate::LaneTracker::new(
+                cfg,
+                estimator,
+                frame.width,
+                frame.height,
+            )?),
+        };
+        let report = t.track(&frame)?;
+        let i = usize::try_from(meta.index).unwrap_or(usize::MAX);
+        if reports.len() <= i {
+            reports.resize(i + 1, None);
+        }
+        if let Some(slot) = reports.get_mut(i) {
+            *slot = Some(report);
+        }
+        n += 1;
+    }
+    let counters = tracker.as_ref().map(|t| *t.counters()).unwrap_or_default();
+    Ok(RunOutcome {
+        reports,
+        bad_frames,
+        counters,
+    })
+}
+
+/// Continuity on an unlabelled real sequence.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ContinuityScore {
+    /// Frames read.
+    pub frames: u64,
+    /// Frames where both lanes were reported tracking (updated or initialised on that frame).
+    pub frames_both_tracking: u64,
+    /// Frames where both lanes had coefficients (tracking or coasting).
+    pub frames_both_reported: u64,
+    /// Median over frames and lanes of |x(t) − x(t−1)| at the scoring row, px.
+    pub median_bottom_change_px: f64,
+    /// Largest such change, px.
+    pub max_bottom_change_px: f64,
+    /// Successful (re-)initialisations, both lanes, the first ones included.
+    pub initialisations: u64,
+}
+
+/// Continuity of the reported lanes at `row_px` (e.g. the bottom row).
+pub fn continuity(reports: &[Option<crate::TrackReport>], row_px: f64) -> ContinuityScore {
+    let mut changes: Vec<f64> = Vec::with_capacity(2 * reports.len());
+    let mut s = ContinuityScore::default();
+    let mut prev: [Option<f64>; 2] = [None, None];
+    for r in reports.iter().flatten() {
+        s.frames += 1;
+        if r.lanes.iter().all(|l| l.state == LaneState::Tracking) {
+            s.frames_both_tracking += 1;
+        }
+        if r.lanes.iter().all(|l| l.coeffs.is_some()) {
+            s.frames_both_reported += 1;
+        }
+        for (k, lane) in r.lanes.iter().enumerate() {
+            if lane.initialised {
+                s.initialisations += 1;
+            }
+            let x = lane.col_at_row(row_px);
+            if let (Some(a), Some(b)) = (prev[k], x) {
+                changes.push((b - a).abs());
+            }
+            prev[k] = x;
+        }
+    }
+    changes.sort_by(f64::total_cmp);
+    s.median_bottom_change_px = changes.get(changes.len() / 2).copied().unwrap_or(0.0);
+    s.max_bottom_change_px = changes.last().copied().unwrap_or(0.0);
+    s
+}
+
+/// TuSimple-style score of one labelled still frame (lanenet): the tracker's initialisation
+/// (gradient → Hough → LS on a fresh tracker) against the two ego lanes of an instance label
+/// image (one grey level per lane, 0 = background).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct LabelScore {
+    /// Ground-truth points scored (rows of the two ego lanes where they are labelled).
+    pub points: u64,
+    /// Points within [`tusimple_tolerance_px`].
+    pub correct: u64,
+    /// `correct / points`.
+    pub accuracy: f64,
+    /// Mean |x_reported − x_label| over the points of reported lanes, px.
+    pub mean_error_px: f64,
+}
+
+/// Score `report` against `label` (`width × height` instance image). Rows are scored every
+/// `row_step_px` from `first_row_px` down (TuSimple: 160, 170, … on 720-row frames); the label x
+/// of a lane at a row is the mean column of its pixels there. The ego lanes are the labelled
+/// lanes nearest the image centre at their lowest row, one on each side.
+pub fn score_against_instance_label(
+    report: &crate::TrackReport,
+    label: &crate::GreyFrame,
+    first_row_px: usize,
+    row_step_px: usize,
+) -> LabelScore {
+    let (w, h) = (label.width, label.height);
+    let tol = tusimple_tolerance_px(w);
+    // Per instance grey level: lowest labelled row and its mean x.
+    let mut lowest: [(usize, f64); 256] = [(0, f64::NAN); 256];
+    for y in 0..h {
+        let row = &label.data[y * w..(y + 1) * w];
+        let mut sums = [(0.0f64, 0u32); 256];
+        for (x, &v) in row.iter().enumerate() {
+            if v != 0 {
+                sums[usize::from(v)].0 += x as f64;
+                sums[usize::from(v)].1 += 1;
+            }
+        }
+        for (v, &(sx, n)) in sums.iter().enumerate() {
+            if n > 0 {
+                lowest[v] = (y, sx / f64::from(n));
+            }
+        }
+    }
+    let centre = w as f64 / 2.0;
+    let (mut left, mut right): (Option<(u8, f64)>, Option<(u8, f64)>) = (None, None);
+    for (v, &(_, x)) in lowest.iter().enumerate().skip(1) {
+        if x.is_nan() {
+            continue;
+        }
+        let d = (x - centre).abs();
+        let slot = if x < centre { &mut left } else { &mut right };
+        if slot.is_none_or(|(_, best)| d < best) {
+            *slot = Some((v as u8, d));
+        }
+    }
+    let mut s = LabelScore::default();
+    let (mut err_sum, mut err_n) = (0.0, 0u64);
+    for (k, ego) in [left, right].iter().enumerate() {
+        let Some((level, _)) = ego else { continue };
+        let mut y = first_row_px;
+        while y < h {
+            let row = &label.data[y * w..(y + 1) * w];
+            let (mut sx, mut n) = (0.0, 0u32);
+            for (x, &v) in row.iter().enumerate() {
+                if v == *level {
+                    sx += x as f64;
+                    n += 1;
+                }
+            }
+            if n > 0 {
+                let x_label = sx / f64::from(n);
+                s.points += 1;
+                if let Some(x) = report.lanes[k].col_at_row(y as f64) {
+                    let e = (x - x_label).abs();
+                    err_sum += e;
+                    err_n += 1;
+                    if e <= tol {
+                        s.correct += 1;
+                    }
+                }
+            }
+            y += row_step_px.max(1);
+        }
+    }
+    s.accuracy = if s.points > 0 {
+        s.correct as f64 / s.points as f64
+    } else {
+        0.0
+    };
+    s.mean_error_px = if err_n > 0 {
+        err_sum / err_n as f64
+    } else {
+        f64::NAN
+    };
+    s
+}

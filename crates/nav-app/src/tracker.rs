@@ -391,7 +391,7 @@ impl LaneTracker {
             lane.updated_now = false;
             lane.points_now = 0;
             if lane.has_estimate() {
-                self.track_lane(i, &image)?;
+                self.track_lane(i, &image, true)?;
             } else {
                 lane.spans.fill(ColSpan::EMPTY);
                 lane.points.clear();
@@ -400,6 +400,20 @@ impl LaneTracker {
         let need_init = self.lanes.iter().any(|l| !l.has_estimate());
         if need_init {
             self.initialise(&image)?;
+            // Refine a fresh initialisation on the same frame: one windowed update around the
+            // LS parabola, with the window's outlier rejection (the Hough band keeps clutter).
+            for i in 0..2 {
+                if self.lanes[i].initialised_now {
+                    self.track_lane(i, &image, false)?;
+                    let lane = &mut self.lanes[i];
+                    if lane.state != LaneState::Tracking {
+                        // The refinement missed: keep the LS initialisation as it was.
+                        lane.state = LaneState::Tracking;
+                        lane.misses = 0;
+                    }
+                    lane.initialised_now = true;
+                }
+            }
         }
         self.crossing_gate();
         Ok(TrackReport {
@@ -408,7 +422,12 @@ impl LaneTracker {
         })
     }
 
-    fn track_lane(&mut self, i: usize, image: &GreyImage<'_>) -> Result<(), NavError> {
+    fn track_lane(
+        &mut self,
+        i: usize,
+        image: &GreyImage<'_>,
+        predict: bool,
+    ) -> Result<(), NavError> {
         let (top, bottom) = self.roi;
         let w = self.cfg.track.window_half_width_px as i64;
         let max_points = self.cfg.track.max_points_per_lane;
@@ -417,8 +436,8 @@ impl LaneTracker {
             return Ok(());
         };
         let predicted = match filter {
-            LaneFilter::Kif(k) => k.predict(&self.q).map_err(|e| e.to_string()),
-            LaneFilter::Wrls(_) => Ok(()),
+            LaneFilter::Kif(k) if predict => k.predict(&self.q).map_err(|e| e.to_string()),
+            LaneFilter::Kif(_) | LaneFilter::Wrls(_) => Ok(()),
         };
         if predicted.is_err() {
             self.counters.filter_failures[i] += 1;

@@ -1,30 +1,43 @@
-//! Adapter: one lane's WRLS estimator (the `wrls` crate) behind the tracker's interface.
+//! Adapter: one lane's WRLS estimator (the `wrls` crate's fast, information form) behind the
+//! tracker's interface.
+//!
+//! The tracker uses [`wrls::WrlsFast`]: the same estimator as the paper's eqs. 25–27 (the `wrls`
+//! crate tests the equality), with λ applied once per frame and no `N×N` inversion, so the
+//! per-frame path stays allocation-free. The paper's `N×N` form ([`wrls::WrlsPaper`]) is what
+//! the Table 1 bench times.
 
 use info_filter::{RowNorm, ThetaCov};
 use nalgebra::Vector3;
+use wrls::{WrlsError, WrlsFast};
 
-/// One lane's WRLS state (placeholder until the `wrls` crate lands).
+/// One lane's WRLS state.
 #[derive(Debug, Clone)]
 pub(crate) struct WrlsLane {
-    theta_px: Vector3<f64>,
+    inner: WrlsFast,
 }
 
 impl WrlsLane {
     pub(crate) fn new(
-        _theta0_px: &Vector3<f64>,
-        _p0: &ThetaCov,
-        _row_norm: RowNorm,
-        _lambda: f64,
-    ) -> Result<Self, String> {
-        Err("the wrls estimator is not available yet in this build".to_owned())
+        theta0_px: &Vector3<f64>,
+        p0: &ThetaCov,
+        row_norm: RowNorm,
+        lambda: f64,
+    ) -> Result<Self, WrlsError> {
+        Ok(WrlsLane {
+            inner: WrlsFast::new(theta0_px, p0, lambda, row_norm)?,
+        })
     }
-    pub(crate) fn update(&mut self, _points: &[(f32, f32)]) -> Result<(), String> {
-        Err("unavailable".to_owned())
+
+    pub(crate) fn update(&mut self, points: &[(f32, f32)]) -> Result<(), WrlsError> {
+        self.inner.update(points)
     }
+
     pub(crate) fn estimate(&self) -> Vector3<f64> {
-        self.theta_px
+        self.inner.estimate()
     }
+
     pub(crate) fn col_at_row_px(&self, row_px: f64) -> f64 {
-        (self.theta_px[0] * row_px + self.theta_px[1]) * row_px + self.theta_px[2]
+        let t = self.inner.estimate();
+        (t[0] * row_px + t[1]) * row_px + t[2]
     }
 }

@@ -1,0 +1,314 @@
+//! `cargo xtask regress`: run the lane tracker over every fixture and compare with the recorded
+//! expectations (`fixtures/expectations-synthetic.json`, `fixtures/expectations-real.json`).
+//!
+//! Synthetic sequences (ground truth): mean and worst per-frame lateral error at fixed rows, a
+//! TuSimple-style accuracy (correct within 20 px at 1280 px width, scaled to the frame width),
+//! frames to regain a lane after it reappears, initialisation count. Real sequences (no labels):
+//! frames with both lanes reported, median and worst bottom-row change frame to frame,
+//! initialisation count. A regression beyond the tolerances below fails the command.
+//! `--record` writes the current figures as the new expectations.
+
+use std::collections::BTreeMap;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use nav_app::eval::{ContinuityScore, SequenceScore, continuity, run_tracker, score_sequence};
+use nav_app::synth::SequenceTruth;
+use nav_app::y4m::Y4mSource;
+use nav_app::{Estimator, TrackerConfig};
+
+use crate::fixtures::workspace_root;
+
+/// Arguments of `cargo xtask regress`.
+#[derive(clap::Args, Debug)]
+pub struct RegressArgs {
+    /// Write the figures of this run as the expectations instead of comparing.
+    #[arg(long)]
+    record: bool,
+    /// Estimator to run (the expectations are recorded for kif).
+    #[arg(long, default_value = "kif")]
+    estimator: String,
+}
+
+/// Tolerances of the comparison with the recorded figures.
+const LATERAL_ERROR_SLACK_PX: f64 = 0.25;
+const MAX_FRAME_ERROR_SLACK_PX: f64 = 1.5;
+const ACCURACY_SLACK: f64 = 0.01;
+const BOTTOM_CHANGE_SLACK_PX: f64 = 0.5;
+
+/// Acceptance bounds of issue 4 §4 (reported; the regression gate is the comparison).
+const ACCEPT_MEAN_ERROR_PX: f64 = 1.5;
+const ACCEPT_ACCURACY: f64 = 0.98;
+const ACCEPT_RECOVERY_FRAMES: u64 = 3;
+const ACCEPT_MEDIAN_CHANGE_PX: f64 = 3.0;
+
+fn open_y4m(path: &Path) -> Result<Y4mSource<BufReader<std::fs::File>>> {
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    Ok(Y4mSource::new(
+        BufReader::new(file),
+        path.display().to_string(),
+    )?)
+}
+
+fn read_text(path: &Path) -> Result<Option<String>> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    Ok(Some(std::fs::read_to_string(path).with_context(|| {
+        format!("cannot read {}", path.display())
+    })?))
+}
+
+/// Real (unlabelled) sequences: the committed 30-frame copy, and the whole 221-frame clip when
+/// `../shared/data` is beside the checkout.
+fn real_sequences(root: &Path) -> Vec<(String, PathBuf)> {
+    let mut v = vec![(
+        "udacity_first30".to_owned(),
+        root.join("fixtures/udacity/solidWhiteRight-first30.y4m"),
+    )];
+    let full = root.join("../shared/data/udacity/solidWhiteRight-320x240-gray.y4m");
+    if full.exists() {
+        v.push(("udacity_full221".to_owned(), full));
+    } else {
+        println!(
+            "regress: note: {} absent, skipping the full udacity clip",
+            full.display()
+        );
+    }
+    v
+}
+
+pub fn run(args: RegressArgs) -> Result<()> {
+    let root = workspace_root();
+    let estimator = match args.estimator.as_str() {
+        "kif" => Estimator::Kif,
+        "wrls" => Estimator::Wrls,
+        other => bail!("--estimator must be kif or wrls, got {other}"),
+    };
+    let synth_dir = root.join("fixtures/synthetic");
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&synth_dir)
+        .with_context(|| {
+            format!(
+                "cannot list {} (run `cargo xtask fixtures`)",
+                synth_dir.display()
+            )
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "y4m"))
+        .collect();
+    names.sort();
+    if names.is_empty() {
+        bail!(
+            "no .y4m fixtures in {} (run `cargo xtask fixtures`)",
+            synth_dir.display()
+        );
+    }
+    let mut failures: Vec<String> = Vec::new();
+    let mut synth_scores: BTreeMap<String, SequenceScore> = BTreeMap::new();
+    println!(
+        "{:22} {:>8} {:>8} {:>8} {:>6} {:>6} {:>5} {:>5}  acceptance",
+        "sequence", "err px", "max px", "acc", "miss", "false", "rec", "inits"
+    );
+    for y4m in &names {
+        let stem = y4m
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("?")
+            .to_owned();
+        let truth_path = y4m.with_extension("json");
+        let truth: SequenceTruth = serde_json::from_str(
+            &std::fs::read_to_string(&truth_path)
+                .with_context(|| format!("cannot read {}", truth_path.display()))?,
+        )
+        .with_context(|| format!("cannot parse {}", truth_path.display()))?;
+        let cfg = TrackerConfig::load(&truth.config)?;
+        let mut source = open_y4m(y4m)?;
+        let outcome = run_tracker(&mut source, &cfg, estimator, None)?;
+        for bad in &outcome.bad_frames {
+            failures.push(format!("{stem}: unexpected bad frame: {bad}"));
+        }
+        let s = score_sequence(&truth, &outcome.reports);
+        let accept = s.mean_lateral_error_px <= ACCEPT_MEAN_ERROR_PX
+            && s.accuracy >= ACCEPT_ACCURACY
+            && s.max_recovery_frames <= ACCEPT_RECOVERY_FRAMES;
+        println!(
+            "{stem:22} {:8.3} {:8.3} {:8.4} {:6} {:6} {:5} {:5}  {}",
+            s.mean_lateral_error_px,
+            s.max_frame_lateral_error_px,
+            s.accuracy,
+            s.missed_lane_frames,
+            s.false_lane_frames,
+            s.max_recovery_frames,
+            s.initialisations,
+            if accept { "met" } else { "NOT met" }
+        );
+        synth_scores.insert(stem, s);
+    }
+    let mut real_scores: BTreeMap<String, ContinuityScore> = BTreeMap::new();
+    println!(
+        "{:22} {:>8} {:>8} {:>8} {:>10} {:>8} {:>5}  acceptance",
+        "real sequence", "frames", "both tr", "both rep", "median Δx", "max Δx", "inits"
+    );
+    for (name, path) in real_sequences(&root) {
+        let cfg = TrackerConfig::outdoor()?;
+        let mut source = open_y4m(&path)?;
+        let outcome = run_tracker(&mut source, &cfg, estimator, None)?;
+        let c = continuity(&outcome.reports, 239.0);
+        let accept = c.frames_both_reported == c.frames
+            && c.median_bottom_change_px <= ACCEPT_MEDIAN_CHANGE_PX;
+        println!(
+            "{name:22} {:8} {:8} {:8} {:10.3} {:8.3} {:5}  {}",
+            c.frames,
+            c.frames_both_tracking,
+            c.frames_both_reported,
+            c.median_bottom_change_px,
+            c.max_bottom_change_px,
+            c.initialisations,
+            if accept { "met" } else { "NOT met" }
+        );
+        real_scores.insert(name, c);
+    }
+
+    let synth_exp_path = root.join("fixtures/expectations-synthetic.json");
+    let real_exp_path = root.join("fixtures/expectations-real.json");
+    if args.record {
+        std::fs::write(
+            &synth_exp_path,
+            serde_json::to_string_pretty(&synth_scores)? + "\n",
+        )?;
+        // The full clip is optional (absent in some checkouts): record only the committed one
+        // plus the full clip when present.
+        std::fs::write(
+            &real_exp_path,
+            serde_json::to_string_pretty(&real_scores)? + "\n",
+        )?;
+        println!(
+            "regress: recorded {} and {}",
+            synth_exp_path.display(),
+            real_exp_path.display()
+        );
+        return Ok(());
+    }
+    let Some(text) = read_text(&synth_exp_path)? else {
+        bail!(
+            "{} missing: run `cargo xtask regress --record` once",
+            synth_exp_path.display()
+        );
+    };
+    let synth_exp: BTreeMap<String, SequenceScore> = serde_json::from_str(&text)?;
+    for (name, exp) in &synth_exp {
+        let Some(got) = synth_scores.get(name) else {
+            failures.push(format!("{name}: fixture missing"));
+            continue;
+        };
+        let mut check = |ok: bool, what: String| {
+            if !ok {
+                failures.push(format!("{name}: {what}"));
+            }
+        };
+        check(
+            got.mean_lateral_error_px <= exp.mean_lateral_error_px + LATERAL_ERROR_SLACK_PX,
+            format!(
+                "mean lateral error {:.3} px > recorded {:.3} + {LATERAL_ERROR_SLACK_PX}",
+                got.mean_lateral_error_px, exp.mean_lateral_error_px
+            ),
+        );
+        check(
+            got.max_frame_lateral_error_px
+                <= exp.max_frame_lateral_error_px + MAX_FRAME_ERROR_SLACK_PX,
+            format!(
+                "worst frame error {:.3} px > recorded {:.3} + {MAX_FRAME_ERROR_SLACK_PX}",
+                got.max_frame_lateral_error_px, exp.max_frame_lateral_error_px
+            ),
+        );
+        check(
+            got.accuracy >= exp.accuracy - ACCURACY_SLACK,
+            format!(
+                "accuracy {:.4} < recorded {:.4} − {ACCURACY_SLACK}",
+                got.accuracy, exp.accuracy
+            ),
+        );
+        check(
+            got.max_recovery_frames <= exp.max_recovery_frames,
+            format!(
+                "recovery {} frames > recorded {}",
+                got.max_recovery_frames, exp.max_recovery_frames
+            ),
+        );
+        check(
+            got.initialisations <= exp.initialisations,
+            format!(
+                "{} initialisations > recorded {}",
+                got.initialisations, exp.initialisations
+            ),
+        );
+        check(
+            got.missed_lane_frames <= exp.missed_lane_frames
+                && got.false_lane_frames <= exp.false_lane_frames,
+            format!(
+                "missed/false lane frames {}/{} > recorded {}/{}",
+                got.missed_lane_frames,
+                got.false_lane_frames,
+                exp.missed_lane_frames,
+                exp.false_lane_frames
+            ),
+        );
+    }
+    for name in synth_scores.keys() {
+        if !synth_exp.contains_key(name) {
+            failures.push(format!("{name}: no recorded expectation (run --record)"));
+        }
+    }
+    if let Some(text) = read_text(&real_exp_path)? {
+        let real_exp: BTreeMap<String, ContinuityScore> = serde_json::from_str(&text)?;
+        for (name, got) in &real_scores {
+            let Some(exp) = real_exp.get(name) else {
+                println!("regress: note: no recorded expectation for {name}");
+                continue;
+            };
+            if got.frames_both_reported < exp.frames_both_reported
+                || got.frames_both_tracking < exp.frames_both_tracking
+            {
+                failures.push(format!(
+                    "{name}: both lanes reported/tracking on {}/{} frames < recorded {}/{}",
+                    got.frames_both_reported,
+                    got.frames_both_tracking,
+                    exp.frames_both_reported,
+                    exp.frames_both_tracking
+                ));
+            }
+            if got.median_bottom_change_px > exp.median_bottom_change_px + BOTTOM_CHANGE_SLACK_PX {
+                failures.push(format!(
+                    "{name}: median bottom-row change {:.3} px > recorded {:.3} + {BOTTOM_CHANGE_SLACK_PX}",
+                    got.median_bottom_change_px, exp.median_bottom_change_px
+                ));
+            }
+            if got.initialisations > exp.initialisations {
+                failures.push(format!(
+                    "{name}: {} initialisations > recorded {}",
+                    got.initialisations, exp.initialisations
+                ));
+            }
+        }
+    } else {
+        failures.push(format!(
+            "{} missing: run `cargo xtask regress --record`",
+            real_exp_path.display()
+        ));
+    }
+    if failures.is_empty() {
+        println!(
+            "regress: no regression ({} synthetic, {} real sequences)",
+            synth_scores.len(),
+            real_scores.len()
+        );
+        Ok(())
+    } else {
+        for f in &failures {
+            println!("regress: REGRESSION {f}");
+        }
+        bail!("{} regression(s)", failures.len())
+    }
+}
