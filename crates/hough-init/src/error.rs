@@ -109,6 +109,14 @@ pub enum HoughError {
         /// How many are required.
         required: usize,
     },
+    /// More points than the `u32` vote counters can hold.
+    #[error("{found} points exceed the limit of {limit} per Hough call")]
+    TooManyPoints {
+        /// How many there were.
+        found: usize,
+        /// The limit.
+        limit: usize,
+    },
     /// All fitted points lie on one image row: `x(y)` is undetermined.
     #[error("all {count} fitted points lie on row {row_px} px; x(y) is undetermined")]
     SingleRow {

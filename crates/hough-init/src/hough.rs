@@ -6,6 +6,9 @@ use crate::{AngleBand, EdgePoint, HoughError, HoughParams, PointSet};
 
 /// Largest accepted image side, pixels.
 pub const MAX_IMAGE_SIDE_PX: usize = 1 << 14;
+/// Points converted to centred `f32` coordinates at a time while voting.
+const VOTE_CHUNK: usize = 256;
+
 /// Largest accepted accumulator, cells (`u32` each).
 pub const MAX_ACCUMULATOR_CELLS: usize = 1 << 25;
 
@@ -74,7 +77,7 @@ pub struct HoughWorkspace {
     sin_over_step: Vec<f32>,
     /// Votes, θ-major: `acc[k * rho_bins + r]`.
     acc: Vec<u32>,
-    /// Three rows of ρ-direction 3-sums (ring buffer) for the 3×3 smoothing.
+    /// Three rows of ρ-direction 3-sums (ring buffer) and one zero row, for the 3×3 smoothing.
     ring: Vec<u32>,
 }
 
@@ -134,7 +137,7 @@ impl HoughWorkspace {
             cos_over_step,
             sin_over_step,
             acc: vec![0; cells],
-            ring: vec![0; 3 * rho_bins],
+            ring: vec![0; 4 * rho_bins],
         })
     }
 
@@ -205,6 +208,12 @@ impl HoughWorkspace {
     ) -> Result<HoughLine, HoughError> {
         let (k0, k1) = self.band_bins(band)?;
         self.check_points(points)?;
+        if points.len() > u32::MAX as usize {
+            return Err(HoughError::TooManyPoints {
+                found: points.len(),
+                limit: u32::MAX as usize,
+            });
+        }
         if points.len() < 2 {
             return Err(HoughError::TooFewPoints {
                 set: PointSet::Candidates,
@@ -266,17 +275,32 @@ impl HoughWorkspace {
         // +0.5 turns the truncating cast into round-to-nearest; all values are positive
         // because |ρ_c/Δρ| ≤ rho_zero_bin − 1 for in-image points.
         let offset = self.rho_zero_bin as f32 + 0.5;
-        for k in k0..=k1 {
-            let row = &mut self.acc[k * nr..(k + 1) * nr];
-            row.fill(0);
-            let c = self.cos_over_step[k];
-            let s = self.sin_over_step[k];
-            for p in points {
-                let xc = (p.col_px() - cx) as f32;
-                let yc = (p.row_px() - cy) as f32;
-                let idx = (xc * c + yc * s + offset) as usize;
-                if let Some(cell) = row.get_mut(idx) {
-                    *cell = cell.saturating_add(1);
+        self.acc[k0 * nr..(k1 + 1) * nr].fill(0);
+        // Points are processed in stack-sized chunks of centred f32 coordinates, so the
+        // per-vote work is a multiply-add, a conversion and an increment (no heap buffer).
+        let mut xs = [0f32; VOTE_CHUNK];
+        let mut ys = [0f32; VOTE_CHUNK];
+        let mut idx = [0u32; VOTE_CHUNK];
+        for chunk in points.chunks(VOTE_CHUNK) {
+            let m = chunk.len();
+            for ((p, x), y) in chunk.iter().zip(&mut xs).zip(&mut ys) {
+                *x = (p.col_px() - cx) as f32;
+                *y = (p.row_px() - cy) as f32;
+            }
+            for k in k0..=k1 {
+                let c = self.cos_over_step[k];
+                let s = self.sin_over_step[k];
+                for ((j, &x), &y) in idx[..m].iter_mut().zip(&xs[..m]).zip(&ys[..m]) {
+                    *j = (x * c + y * s + offset) as i32 as u32;
+                }
+                let row = &mut self.acc[k * nr..(k + 1) * nr];
+                for &j in &idx[..m] {
+                    // In range by construction; `get_mut` keeps a bad index from panicking.
+                    // No overflow: a cell gets at most one vote per point per call and
+                    // `find_line` rejects more than u32::MAX points.
+                    if let Some(cell) = row.get_mut(j as usize) {
+                        *cell += 1;
+                    }
                 }
             }
         }
@@ -295,43 +319,42 @@ impl HoughWorkspace {
         (best.1, best.2)
     }
 
-    /// ρ-direction 3-sum of accumulator row `k` into ring slot `slot`.
-    fn hsum_into_ring(&mut self, k: usize, slot: usize) {
-        let nr = self.rho_bins;
-        let src = &self.acc[k * nr..(k + 1) * nr];
-        let dst = &mut self.ring[slot * nr..(slot + 1) * nr];
-        for r in 0..nr {
-            let left = if r > 0 { src[r - 1] } else { 0 };
-            let right = if r + 1 < nr { src[r + 1] } else { 0 };
-            dst[r] = left + src[r] + right;
-        }
-    }
-
     fn peak_smoothed(&mut self, k0: usize, k1: usize) -> (usize, usize) {
         let nr = self.rho_bins;
-        self.hsum_into_ring(k0, 0);
+        let acc = &self.acc;
+        // Slots 0..3: ρ-direction 3-sums of rows k0 + j (j mod 3); slot 3 stays zero and
+        // stands in for the rows outside the band.
+        let slot = |k: usize| (k - k0) % 3;
+        let row = |k: usize| &acc[k * nr..(k + 1) * nr];
+        let ring = &mut self.ring;
+        ring[3 * nr..].fill(0);
+        hsum3(row(k0), &mut ring[0..nr]);
         if k0 < k1 {
-            self.hsum_into_ring(k0 + 1, 1);
+            hsum3(row(k0 + 1), &mut ring[nr..2 * nr]);
         }
         let mut best = (0u32, k0, 0usize);
         for k in k0..=k1 {
-            if k < k1 && k > k0 {
-                self.hsum_into_ring(k + 1, (k + 1 - k0) % 3);
+            if k > k0 && k < k1 {
+                let j = slot(k + 1);
+                hsum3(row(k + 1), &mut ring[j * nr..(j + 1) * nr]);
             }
-            let cur = (k - k0) % 3;
-            let prev = (k > k0).then(|| (k - 1 - k0) % 3);
-            let next = (k < k1).then(|| (k + 1 - k0) % 3);
-            for r in 0..nr {
-                let mut v = self.ring[cur * nr + r];
-                if let Some(p) = prev {
-                    v += self.ring[p * nr + r];
+            let prev = if k > k0 { slot(k - 1) } else { 3 };
+            let next = if k < k1 { slot(k + 1) } else { 3 };
+            let cur = slot(k);
+            let (a, b, c) = (
+                &ring[prev * nr..(prev + 1) * nr],
+                &ring[cur * nr..(cur + 1) * nr],
+                &ring[next * nr..(next + 1) * nr],
+            );
+            let mut row_best = (0u32, 0usize);
+            for (r, ((&x, &y), &z)) in a.iter().zip(b).zip(c).enumerate() {
+                let v = x + y + z;
+                if v > row_best.0 {
+                    row_best = (v, r);
                 }
-                if let Some(n) = next {
-                    v += self.ring[n * nr + r];
-                }
-                if v > best.0 {
-                    best = (v, k, r);
-                }
+            }
+            if row_best.0 > best.0 {
+                best = (row_best.0, k, row_best.1);
             }
         }
         (best.1, best.2)
@@ -375,6 +398,20 @@ impl HoughWorkspace {
         };
         (dk, dr)
     }
+}
+
+/// `dst[r] = src[r − 1] + src[r] + src[r + 1]` (missing neighbours count as zero); both
+/// slices have the same length ≥ 2.
+fn hsum3(src: &[u32], dst: &mut [u32]) {
+    let n = src.len();
+    if n < 2 || dst.len() != n {
+        return;
+    }
+    dst[0] = src[0] + src[1];
+    for (d, w) in dst[1..n - 1].iter_mut().zip(src.windows(3)) {
+        *d = w[0] + w[1] + w[2];
+    }
+    dst[n - 1] = src[n - 2] + src[n - 1];
 }
 
 /// Vertex offset of the parabola through `(−1, a)`, `(0, b)`, `(1, c)`, clamped to `[−½, ½]`;
