@@ -85,8 +85,9 @@
 //! position-induced tilt δθ term: the gimbal command and the landmark direction are both formed
 //! in the computed frame c, so δθ cancels exactly between the pointing error and the line of
 //! sight. A test shows that adding the tilt term (the paper's H₃, below) makes the δp columns
-//! fail the finite-difference check by ≈ ρ/R ≈ 10⁻³ relative, while the H above matches to
-//! ~10⁻⁸.
+//! fail the finite-difference check by ≈ ρ/R ≈ 10⁻³ relative, while the H above passes it with
+//! a per-entry tolerance of 10⁻⁶ relative (plus round-off floors of 10⁻⁷ m/m and 10⁻³ m/rad for
+//! entries that are ~0, e.g. H[w, δp_D] = e_w,D = 0 exactly because e_w is horizontal).
 //!
 //! # Comparison with the printed eqs. 15–18, term by term
 //!
@@ -112,16 +113,31 @@
 //!   although the limit is finite; e_w has no such singularity.)
 //! * **H₄ = ψ part of H:** row 1 = (d₁₁, d₁₂, d₁₃) = ρ (cos β sin ε, sin β sin ε, −cos ε)
 //!   = −ρ e_hᵀ; row 2 = (d₂₁, d₂₂, 0) = ρ (−sin β, cos β, 0) = ρ e_wᵀ. Identical.
-//! * **H₃** = −H₄ ∂δθ/∂δp (δθ = the contract's frame tilt). It converts a misalignment measured
-//!   against the *true* frame, φ = ψ + δθ, into ψ: H₂ δp + H₄ ψ = (H₂ + H₃) δp + H₄ φ. So the
-//!   printed eq. 15 is the correct Jacobian for a φ-angle attitude state (verified by finite
-//!   differences holding φ fixed), but the paper's state and eq. 8 are psi-angle; with ψ,
-//!   H₃ must be dropped. Its entries are ≈ ρ/(R + h) ≈ 2·10⁻³ of the δp entries, far below
-//!   σ_SD in practice, but the check sees it.
+//! * **H₃** is (−H₄ ∂δθ/∂δp, δθ = the contract's frame tilt) *up to one sign*: its (w, δp_E)
+//!   entry is printed −(d₁₁ + d₁₃ tan λ)/(R_E + H), the tilt gives −(d₁₁ − d₁₃ tan λ)/(R_E + H)
+//!   (δθ_D = −δp_E tan λ/(R_E + h) for geographic latitude λ, verified in `ins-errors` against
+//!   the exact ECEF rotation). With that sign fixed, H₃ converts a misalignment measured
+//!   against the *true* frame, φ = ψ + δθ, into ψ: H₂ δp + H₄ ψ = (H₂ + H₃) δp + H₄ φ. So
+//!   eq. 15 is the correct Jacobian for a φ-angle attitude state (verified by finite
+//!   differences holding φ fixed; the printed tan λ sign fails that check at −23°), but the
+//!   paper's state and its eq. 8 are psi-angle; with ψ, H₃ must be dropped. Its entries are
+//!   ≈ ρ/(R + h) ≈ 2·10⁻³ of the δp entries — far below σ_SD in practice, but the finite
+//!   difference check rejects it.
 //!
 //! (The reading note's form δu^c = −C_n^c (δp + u × φ) matches this crate's
 //! S C_cam^cᵀ (δp + r̃ × ψ) up to its sign convention only with ψ in place of φ, for the same
 //! reason.)
+//!
+//! # Use in the Kalman filter
+//!
+//! Per update, stack the three landmarks: z = (w₀, h₀, w₁, h₁, w₂, h₂) measured
+//! ([`sighting_offsets3_m`] on the simulated truth plus [`add_sighting_noise`]), H from
+//! [`sighting_jacobian3`] at the INS's computed position, R = σ²_SD I₆. The camera is pointed
+//! at where the INS believes the landmark is, so the predicted offset of the computed state is
+//! zero and z itself is the measurement of the error state: z = H x + v, innovation
+//! ν = z − H x̂⁻ (x̂⁻ = 0 after a feedback reset). Call [`SightingConfig::check_vehicle`] once
+//! at the start of a run to reject landmarks at (or too close to, or straight below) the
+//! vehicle.
 //!
 //! # Units
 //!
@@ -129,7 +145,8 @@
 //! |---|---|
 //! | positions ([`Geodetic`]) | rad, rad, m above the WGS-84 ellipsoid |
 //! | (w, h), noise σ | m at the landmark; variance m² |
-//! | H δp columns | m/m; H ψ columns | m/rad |
+//! | H, δp columns | m/m |
+//! | H, ψ columns | m/rad |
 //! | config `lat_deg`, `lon_deg` / `alt_m`, `min_range_m` / `update_period_s` | ° / m / s |
 //!
 //! # Example
