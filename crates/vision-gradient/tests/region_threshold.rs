@@ -11,6 +11,9 @@ use vision_gradient::{
     Threshold,
 };
 
+/// Membership test `(col, row) -> inside`.
+type Inside<'a> = Box<dyn Fn(usize, usize) -> bool + 'a>;
+
 fn random_image(rng: &mut ChaCha8Rng, w: usize, h: usize) -> Vec<u8> {
     (0..w * h).map(|_| rng.random()).collect()
 }
@@ -72,7 +75,7 @@ fn regions_select_exactly_their_pixels() {
         })
         .collect();
     let in_rows = |r: usize| (17..45).contains(&r);
-    let cases: [(Region<'_>, Box<dyn Fn(usize, usize) -> bool>); 3] = [
+    let cases: [(Region<'_>, Inside<'_>); 3] = [
         (
             Region::Rows {
                 row_start_px: 17,
