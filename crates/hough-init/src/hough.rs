@@ -424,3 +424,99 @@ fn parabolic_offset(a: f64, b: f64, c: f64) -> f64 {
         0.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Point;
+
+    /// Deterministic pseudo-random votes (xorshift), no external RNG needed here.
+    fn fill_votes(ws: &mut HoughWorkspace, k0: usize, k1: usize, seed: u64) {
+        let mut state = seed | 1;
+        let nr = ws.rho_bins;
+        for v in &mut ws.acc[k0 * nr..(k1 + 1) * nr] {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            *v = (state % 50) as u32;
+        }
+    }
+
+    /// Brute-force argmax of `score` in scan order (first maximum wins).
+    fn naive_peak(ws: &HoughWorkspace, k0: usize, k1: usize) -> (usize, usize) {
+        let mut best = (-1.0, k0, 0);
+        for k in k0..=k1 {
+            for r in 0..ws.rho_bins {
+                let v = ws.score(k, r, k0, k1);
+                if v > best.0 {
+                    best = (v, k, r);
+                }
+            }
+        }
+        (best.1, best.2)
+    }
+
+    /// The ring-buffer 3×3 peak and the raw peak equal a brute-force argmax of the
+    /// independently written `score` (direct 3×3 sums clipped to the band), for bands of
+    /// 1, 2, 3 and many θ bins.
+    #[test]
+    fn fast_peak_search_matches_brute_force() {
+        for smoothing in [true, false] {
+            let params = HoughParams {
+                peak_smoothing: smoothing,
+                ..HoughParams::default()
+            };
+            let mut ws = HoughWorkspace::new(64, 48, params).unwrap();
+            for (i, (k0, k1)) in [(10, 10), (10, 11), (10, 12), (0, 359), (200, 317)]
+                .into_iter()
+                .enumerate()
+            {
+                fill_votes(&mut ws, k0, k1, 17 + i as u64);
+                let fast = if smoothing {
+                    ws.peak_smoothed(k0, k1)
+                } else {
+                    ws.peak_raw(k0, k1)
+                };
+                assert_eq!(
+                    fast,
+                    naive_peak(&ws, k0, k1),
+                    "band {k0}..={k1}, smoothing {smoothing}"
+                );
+            }
+        }
+    }
+
+    /// The three-point vertex formula is exact on a sampled parabola and clamps outside ±½.
+    #[test]
+    fn parabolic_offset_recovers_the_vertex() {
+        for d in [-0.45, -0.2, 0.0, 0.13, 0.5] {
+            let f = |x: f64| 10.0 - 3.0 * (x - d) * (x - d);
+            assert!((parabolic_offset(f(-1.0), f(0.0), f(1.0)) - d).abs() < 1e-12);
+        }
+        assert_eq!(parabolic_offset(0.0, 1.0, 5.0), 0.0); // not a maximum: convex → no shift
+        assert_eq!(parabolic_offset(1.0, 1.0, 1.0), 0.0);
+        assert_eq!(parabolic_offset(0.0, 1.0, 1.9), 0.5); // vertex beyond the bin → clamped
+    }
+
+    /// Every in-image point votes exactly once per θ bin of the band.
+    #[test]
+    fn each_point_votes_once_per_theta_bin() {
+        let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
+        let corners = [
+            Point::new(-0.5, -0.5),
+            Point::new(319.5, -0.5),
+            Point::new(-0.5, 239.5),
+            Point::new(319.5, 239.5),
+            Point::new(160.0, 120.0),
+        ];
+        let band = AngleBand::new(-90.0, 90.0);
+        let (k0, k1) = ws.band_bins(&band).unwrap();
+        assert_eq!((k0, k1), (0, 359));
+        ws.vote(&corners, k0, k1);
+        let nr = ws.rho_bins;
+        for k in k0..=k1 {
+            let total: u32 = ws.acc[k * nr..(k + 1) * nr].iter().sum();
+            assert_eq!(total, corners.len() as u32, "θ bin {k}");
+        }
+    }
+}

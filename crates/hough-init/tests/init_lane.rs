@@ -171,6 +171,33 @@ fn curved_lanes_are_followed_and_refit_resists_clutter() {
     }
 }
 
+/// The least-squares input is exactly the candidates within `band_px` (perpendicular) of the
+/// returned Hough line: `points_used` equals an independent count, for several band widths,
+/// and the result equals `fit_parabola` on that subset.
+#[test]
+fn fitted_pixels_are_those_within_the_band_of_the_hough_line() {
+    let s = scene(320, 240, 4.0, 2.0, 0.5, 0.3, 5);
+    let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
+    for band_px in [1.0, 2.5, 4.0, 8.0] {
+        let params = LaneInitParams {
+            band_px,
+            ..LaneInitParams::default()
+        };
+        let init = init_lane(&s.right, &AngleBand::RIGHT_LANE, &mut ws, &params).unwrap();
+        let subset: Vec<Point> = s
+            .right
+            .iter()
+            .copied()
+            .filter(|p| init.line.signed_distance_px(p.col_px, p.row_px).abs() <= band_px)
+            .collect();
+        assert_eq!(init.points_used, subset.len(), "band {band_px} px");
+        let reference = hough_init::fit_parabola(&subset).unwrap();
+        let scale = 1.0 + init.parabola.a3.abs();
+        assert!((init.parabola.a3 - reference.parabola.a3).abs() < 1e-9 * scale);
+        assert!((init.rms_residual_px - reference.rms_residual_px).abs() < 1e-9);
+    }
+}
+
 #[test]
 fn too_few_candidates_or_band_pixels_are_reported_per_stage() {
     let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
