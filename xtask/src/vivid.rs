@@ -853,20 +853,37 @@ fn check_frames(o: &CaseOutput, fourcc: Option<&str>) -> Result<(), String> {
     Ok(())
 }
 
+/// Mean of the per-frame mean grey levels of a case.
+fn mean_level(o: &CaseOutput) -> Option<f64> {
+    let levels: Vec<f64> = o
+        .frames
+        .iter()
+        .filter_map(|f| f.get("mean").and_then(Value::as_f64))
+        .collect();
+    (!levels.is_empty()).then(|| levels.iter().sum::<f64>() / levels.len() as f64)
+}
+
+/// Largest difference, grey levels, allowed between a format's mean frame level and GREY's.
+/// vivid draws the same test pattern in every format; Y'CbCr formats carry studio-range luma
+/// (16–235, ≈ +8 here) and RGB ones the pattern's R'G'B' through our BT.601 weights (≈ +2), while
+/// reading a wrong byte (a chroma sample, a padding byte) moves the mean by tens of levels.
+const MEAN_TOLERANCE: f64 = 12.0;
+
 fn judge(cases: &[Case], log: &SerialLog) -> Vec<Verdict> {
     let outputs = split_cases(log);
+    let grey_mean = outputs.get("stream-grey").and_then(mean_level);
     cases
         .iter()
         .map(|c| match outputs.get(c.name) {
             None => Verdict::Fail("case never started (VM died or timed out?)".into()),
             Some(o) if o.rc.is_none() => Verdict::Fail("case never finished".into()),
             Some(o) if o.panicked => Verdict::Fail("guest panicked".into()),
-            Some(o) => judge_one(c.expect, o),
+            Some(o) => judge_one(c.expect, o, grey_mean),
         })
         .collect()
 }
 
-fn judge_one(expect: Expect, o: &CaseOutput) -> Verdict {
+fn judge_one(expect: Expect, o: &CaseOutput, grey_mean: Option<f64>) -> Verdict {
     let rc = o.rc.unwrap_or(-1);
     let s = o.summary.as_ref();
     let frames = num(s, "frames");
@@ -932,8 +949,18 @@ fn judge_one(expect: Expect, o: &CaseOutput) -> Verdict {
                     if num(o.open.as_ref(), "input_index") != 1 {
                         return Err("S-Video is input 1".into());
                     }
+                    let mean = mean_level(o).unwrap_or(-1.0);
+                    let level = match grey_mean {
+                        Some(g) if (mean - g).abs() > MEAN_TOLERANCE => {
+                            return Err(format!(
+                                "mean grey {mean:.1} vs GREY's {g:.1}: wrong bytes read?"
+                            ));
+                        }
+                        Some(g) => format!(", mean grey {mean:.1} (GREY {g:.1})"),
+                        None => format!(", mean grey {mean:.1}"),
+                    };
                     Ok(format!(
-                        "{want} frames {fourcc} 320x240, seq increasing, NTSC-M"
+                        "{want} frames {fourcc} 320x240, seq increasing, NTSC-M{level}"
                     ))
                 })
         }
