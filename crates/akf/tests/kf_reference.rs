@@ -337,3 +337,36 @@ fn invalid_process_noise_and_initial_covariance_are_rejected() {
         .unwrap();
     assert!(inn.nis > 0.0);
 }
+
+#[test]
+fn joseph_form_keeps_psd_to_round_off_where_the_textbook_form_does_not() {
+    // Very precise measurements of poorly known states (P ~ 1e8, R ~ 1e-8). The textbook
+    // (I − K H) P loses positive semi-definiteness at the 1e-13 relative level; the Joseph form
+    // stays at the eigen-solver's own round-off (≈ 1e-16). The bound 2e-15 separates the two.
+    let mut rng = rng(61);
+    let mut textbook_violations = 0;
+    for case in 0..300 {
+        let p = random_spd::<6>(&mut rng, 1e-3) * 1e8;
+        let h: SMatrix<f64, 3, 6> = uniform_mat(&mut rng);
+        let r = random_spd::<3>(&mut rng, 0.1) * 1e-8;
+        let mut kf = KalmanFilter::new(SVector::zeros(), p).unwrap();
+        kf.update(&SVector::<f64, 3>::zeros(), &h, &r).unwrap();
+        let joseph_min = kf.covariance().symmetric_eigenvalues().min() / kf.covariance().amax();
+        assert!(
+            joseph_min >= -2e-15,
+            "case {case}: Joseph min eigenvalue {joseph_min:e}"
+        );
+
+        let s = h * p * h.transpose() + r;
+        let k = p * h.transpose() * s.try_inverse().unwrap();
+        let textbook = (SMatrix::<f64, 6, 6>::identity() - k * h) * p;
+        let textbook = (textbook + textbook.transpose()) * 0.5;
+        if textbook.symmetric_eigenvalues().min() / textbook.amax() < -2e-15 {
+            textbook_violations += 1;
+        }
+    }
+    assert!(
+        textbook_violations > 30,
+        "only {textbook_violations} textbook violations"
+    );
+}
