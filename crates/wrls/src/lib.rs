@@ -72,7 +72,7 @@
 //!         [truth[0] * y * y + truth[1] * y + truth[2], y]
 //!     })
 //!     .collect();
-//! let p0 = ThetaCov::Normalised(Matrix3::identity() * 1e3);
+//! let p0 = ThetaCov::Normalised(Matrix3::identity() * 1e6); // a weak prior, px²
 //! let theta0 = Vector3::new(0.0, 0.0, 160.0);
 //! let mut paper = WrlsPaper::new(&theta0, &p0, PAPER_LAMBDA, RowNorm::default(), 150)?;
 //! let mut fast = WrlsFast::new(&theta0, &p0, PAPER_LAMBDA, RowNorm::default())?;

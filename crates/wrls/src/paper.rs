@@ -156,13 +156,13 @@ impl WrlsPaper {
         let mut k_k_t = Matrix3::zeros();
         let mut theta = self.theta;
         if n > 0 {
-            let mut stack = MemStack::new(&mut ws.mem);
+            let stack = MemStack::new(&mut ws.mem);
             let mut s = ws.s.as_mut().submatrix_mut(0, 0, n, n);
             llt::factor::cholesky_in_place(
                 s.as_mut(),
                 Default::default(),
                 Par::Seq,
-                &mut stack,
+                stack,
                 Default::default(),
             )
             .map_err(|e| match e {
@@ -175,7 +175,7 @@ impl WrlsPaper {
                 s.as_ref(),
                 ws.a.as_mut().submatrix_mut(0, 0, n, 3),
                 Par::Seq,
-                &mut stack,
+                stack,
             );
             // Innovations use the prior θ̂ (eq. 25), so accumulate the correction separately.
             let mut correction = Vector3::zeros();
