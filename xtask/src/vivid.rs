@@ -55,6 +55,18 @@ pub struct VividArgs {
     verbose: bool,
 }
 
+impl Default for VividArgs {
+    /// What `cargo xtask vivid` without flags does (for calling [`run`] from the test gate).
+    fn default() -> Self {
+        Self {
+            guest_bin: None,
+            timeout_secs: 240,
+            cases: Vec::new(),
+            verbose: false,
+        }
+    }
+}
+
 /// Modules to insert, in dependency order (vivid last, with its parameters).
 const MODULES: &[&str] = &[
     "rc-core",
@@ -1040,5 +1052,143 @@ fn judge_one(expect: Expect, o: &CaseOutput, grey_mean: Option<f64>) -> Verdict 
     match result {
         Ok(msg) => Verdict::Pass(format!("{msg}; {counters}")),
         Err(why) => fail(why),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn log_of(lines: &[&str]) -> SerialLog {
+        SerialLog {
+            lines: lines.iter().map(|l| (*l).to_owned()).collect(),
+            killed: false,
+        }
+    }
+
+    fn frame(n: u64, seq: u64, ts: u64) -> String {
+        format!(
+            r#"{{"type":"frame","n":{n},"seq":{seq},"ts_us":{ts},"w":320,"h":240,"fourcc":"GREY","missed":0,"signal_lost":false,"mean":65.0}}"#
+        )
+    }
+
+    fn stream_log(seqs: &[u64], rc: i32) -> SerialLog {
+        let mut lines = vec![
+            "VIVID-CASE-BEGIN s".to_owned(),
+            r#"{"type":"open","input_index":1,"std_id":4096,"width":320,"height":240,"fourcc":"GREY"}"#
+                .to_owned(),
+        ];
+        for (i, s) in seqs.iter().enumerate() {
+            // Kernel noise on the console must not confuse the parser.
+            lines.push(format!(
+                "[    1.0] some kernel line {}",
+                frame(i as u64 + 1, *s, 1000 + *s)
+            ));
+        }
+        lines.push(format!(
+            r#"{{"type":"summary","frames":{},"errored_dropped":0,"sequence_gaps":0,"exit":"max-frames","error":null}}"#,
+            seqs.len()
+        ));
+        lines.push(format!("VIVID-CASE-END s rc={rc}"));
+        SerialLog {
+            lines,
+            killed: false,
+        }
+    }
+
+    fn verdict(log: &SerialLog, expect: Expect) -> Verdict {
+        let cases = [Case {
+            name: "s",
+            args: String::new(),
+            expect,
+        }];
+        judge(&cases, log).remove(0)
+    }
+
+    const GREY3: Expect = Expect::Stream {
+        fourcc: "GREY",
+        frames: 3,
+        optional: false,
+    };
+
+    #[test]
+    fn stream_case_passes_only_with_increasing_sequence_and_exit_zero() {
+        assert!(matches!(
+            verdict(&stream_log(&[0, 1, 2], 0), GREY3),
+            Verdict::Pass(_)
+        ));
+        assert!(matches!(
+            verdict(&stream_log(&[0, 2, 1], 0), GREY3),
+            Verdict::Fail(_)
+        ));
+        assert!(matches!(
+            verdict(&stream_log(&[0, 1, 2], 1), GREY3),
+            Verdict::Fail(_)
+        ));
+        // Too few frames.
+        assert!(matches!(
+            verdict(&stream_log(&[0, 1], 0), GREY3),
+            Verdict::Fail(_)
+        ));
+    }
+
+    #[test]
+    fn unfinished_or_missing_case_fails() {
+        let mut log = stream_log(&[0, 1, 2], 0);
+        log.lines.pop(); // no END marker: the guest hung or the VM died
+        assert!(matches!(verdict(&log, GREY3), Verdict::Fail(_)));
+        assert!(matches!(
+            verdict(&log_of(&["VIVID-READY"]), GREY3),
+            Verdict::Fail(_)
+        ));
+    }
+
+    #[test]
+    fn disconnect_requires_device_gone_exit() {
+        let expect = Expect::Disconnect {
+            at_least: 1,
+            max_frames: 60,
+        };
+        let gone = log_of(&[
+            "VIVID-CASE-BEGIN s",
+            r#"{"type":"summary","frames":10,"exit":"device-gone","error":"gone"}"#,
+            "VIVID-CASE-END s rc=3",
+        ]);
+        assert!(matches!(verdict(&gone, expect), Verdict::Pass(_)));
+        let panicked = log_of(&[
+            "VIVID-CASE-BEGIN s",
+            "thread 'main' panicked at src/x.rs:1:1",
+            r#"{"type":"summary","frames":10,"exit":"device-gone","error":"gone"}"#,
+            "VIVID-CASE-END s rc=3",
+        ]);
+        assert!(matches!(verdict(&panicked, expect), Verdict::Fail(_)));
+    }
+
+    #[test]
+    fn cpio_newc_entries_are_aligned_and_terminated() {
+        let mut c = Cpio::new();
+        c.file("init", b"abc", true);
+        let buf = c.finish();
+        assert_eq!(&buf[..6], b"070701");
+        // Header 110 bytes + "init\0" (5) = 115 → padded to 116, then 3 data bytes → 120.
+        let mode = u32::from_str_radix(std::str::from_utf8(&buf[14..22]).unwrap(), 16).unwrap();
+        assert_eq!(mode, 0o100_755);
+        assert_eq!(&buf[110..115], b"init\0");
+        assert_eq!(&buf[116..119], b"abc");
+        assert_eq!(&buf[120..126], b"070701");
+        assert!(buf.windows(11).any(|w| w == b"TRAILER!!!\0"));
+        assert_eq!(buf.len() % 4, 0);
+    }
+
+    #[test]
+    fn init_script_runs_every_case_between_markers() {
+        let script = init_script(&cases());
+        for c in cases() {
+            assert!(script.contains(&format!("echo 'VIVID-CASE-BEGIN {}'", c.name)));
+            assert!(script.contains(&format!("VIVID-CASE-END {} rc=$?", c.name)));
+        }
+        assert!(script.contains(VIVID_PARAMS));
+        // Disconnect must be the last case: vivid stays gone while any handle is open.
+        assert_eq!(cases().last().map(|c| c.name), Some("fault-disconnect"));
     }
 }
