@@ -23,3 +23,4 @@ pub use tracker::{
 pub mod eval;
 pub mod overlay;
 pub mod synth;
+pub mod ins_sd;

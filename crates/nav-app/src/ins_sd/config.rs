@@ -1,0 +1,292 @@
+//! The scenario file: `[trajectory]`, `[imu]` (crate `ins-errors`), `[sighting]` (crate
+//! `sighting-model`), `[filter]` and `[monte_carlo]` (this module).
+
+use akf::QProjection;
+use ins_errors::config::{ImuConfig, TrajectoryConfig};
+use ins_errors::imu::{DEGPH_TO_RADPS, MG_TO_MPS2};
+use serde::{Deserialize, Serialize};
+use sighting_model::SightingConfig;
+
+/// Errors of [`super::Scenario::from_toml_str`]: every variant names the section or the dotted
+/// field (`"filter.r_var_m2"`, `"imu.accel_bias_sigma_mg"`, `"sighting.landmarks[1].lat_deg"`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScenarioError {
+    /// The text is not TOML, a section is missing or unknown, or a key is unknown or mistyped.
+    #[error("scenario TOML, section [{section}]: {message}")]
+    Parse {
+        /// Section concerned (`"(document)"` for top-level problems).
+        section: String,
+        /// Parser message (names the offending key).
+        message: String,
+    },
+    /// A field holds an invalid value.
+    #[error("{field}: {requirement} (got {value})")]
+    Invalid {
+        /// Dotted path, e.g. `filter.open_loop_until_s`.
+        field: String,
+        /// What the field must satisfy.
+        requirement: String,
+        /// The value found (formatted).
+        value: String,
+    },
+}
+
+impl ScenarioError {
+    pub(crate) fn invalid(field: &str, requirement: &str, value: impl std::fmt::Debug) -> Self {
+        Self::Invalid {
+            field: field.to_string(),
+            requirement: requirement.to_string(),
+            value: format!("{value:?}"),
+        }
+    }
+}
+
+/// `[filter]`: initial covariance, process-noise tuning, measurement noise, feedback switch
+/// and the discretisation / adaptive-Q parameters of the INS/SD error-state filter.
+///
+/// The process noise is given as continuous white-noise densities on the sensor inputs
+/// (body axes, equal on the three axes): accelerometer and gyro white noise, and the
+/// random-walk densities of the bias/drift states. The white-noise figures use the same units
+/// as `[imu]` (variance of one IMU sample at `trajectory.step_s`; PSD = variance · step_s), so
+/// "true statistics" means copying the `[imu]` values and zero random walks.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilterConfig {
+    /// Initial σ of each position-error component, m (> 0).
+    pub p0_pos_sigma_m: f64,
+    /// Initial σ of each velocity-error component, m/s (> 0).
+    pub p0_vel_sigma_mps: f64,
+    /// Initial σ of each misalignment (ψ) component, mrad (> 0).
+    pub p0_psi_sigma_mrad: f64,
+    /// Initial σ of each accelerometer-bias component, mg (> 0).
+    pub p0_accel_bias_sigma_mg: f64,
+    /// Initial σ of each gyro-drift component, °/h (> 0).
+    pub p0_gyro_drift_sigma_degph: f64,
+    /// Filter's accelerometer white-noise variance per IMU sample, mg² (≥ 0).
+    pub q_accel_noise_var_per_sample_mg2: f64,
+    /// Filter's gyro white-noise variance per IMU sample, (°/h)² (≥ 0).
+    pub q_gyro_noise_var_per_sample_degph2: f64,
+    /// Random-walk PSD of the accelerometer-bias states, mg²/s (≥ 0; 0 = random constant).
+    pub q_accel_bias_rw_psd_mg2_per_s: f64,
+    /// Random-walk PSD of the gyro-drift states, (°/h)²/s (≥ 0; 0 = random constant).
+    pub q_gyro_drift_rw_psd_degph2_per_s: f64,
+    /// Filter's SD measurement-noise variance R (each of w, h), m² (> 0).
+    pub r_var_m2: f64,
+    /// Time until which the filter runs open loop, s (paper: 195); at the first SD update at or
+    /// after this time and at every update afterwards the estimates are fed back. A value
+    /// beyond the run's end keeps the filter open loop throughout.
+    pub open_loop_until_s: f64,
+    /// Number of equal sub-intervals per SD interval on which the error model A is averaged to
+    /// build Φ and Q_d of the interval (1 ..= steps per interval; see the module doc).
+    pub phi_subintervals: usize,
+    /// AKF window N (Mohamed & Schwarz; paper: 10), 1 ..= 64.
+    pub akf_window: usize,
+    /// How the AKF's indefinite Q̂ is made PSD: `"eigen_clip"` or `"diagonal"`.
+    pub akf_projection: QProjection,
+    /// Floor of the projected Q̂ (eigenvalues or diagonal), state units² per SD interval (≥ 0).
+    pub akf_min_variance: f64,
+}
+
+impl Default for FilterConfig {
+    fn default() -> Self {
+        Self::paper()
+    }
+}
+
+impl FilterConfig {
+    /// The values of `configs/paper.toml` (the tuned KF, see the module doc).
+    pub fn paper() -> Self {
+        Self {
+            p0_pos_sigma_m: 1.0,
+            p0_vel_sigma_mps: 0.1,
+            p0_psi_sigma_mrad: 1.0,
+            p0_accel_bias_sigma_mg: 3.0,
+            p0_gyro_drift_sigma_degph: 2.0,
+            q_accel_noise_var_per_sample_mg2: 1.0,
+            q_gyro_noise_var_per_sample_degph2: 1.0,
+            q_accel_bias_rw_psd_mg2_per_s: 0.0,
+            q_gyro_drift_rw_psd_degph2_per_s: 0.0,
+            r_var_m2: 40.0,
+            open_loop_until_s: 195.0,
+            phi_subintervals: 10,
+            akf_window: 10,
+            akf_projection: QProjection::EigenClip,
+            akf_min_variance: 0.0,
+        }
+    }
+
+    /// Checks every field; the error names it as `filter.<field>`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        let pos = [
+            ("filter.p0_pos_sigma_m", self.p0_pos_sigma_m),
+            ("filter.p0_vel_sigma_mps", self.p0_vel_sigma_mps),
+            ("filter.p0_psi_sigma_mrad", self.p0_psi_sigma_mrad),
+            ("filter.p0_accel_bias_sigma_mg", self.p0_accel_bias_sigma_mg),
+            (
+                "filter.p0_gyro_drift_sigma_degph",
+                self.p0_gyro_drift_sigma_degph,
+            ),
+            ("filter.r_var_m2", self.r_var_m2),
+        ];
+        for (f, v) in pos {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(ScenarioError::invalid(f, "must be finite and > 0", v));
+            }
+        }
+        let nonneg = [
+            (
+                "filter.q_accel_noise_var_per_sample_mg2",
+                self.q_accel_noise_var_per_sample_mg2,
+            ),
+            (
+                "filter.q_gyro_noise_var_per_sample_degph2",
+                self.q_gyro_noise_var_per_sample_degph2,
+            ),
+            (
+                "filter.q_accel_bias_rw_psd_mg2_per_s",
+                self.q_accel_bias_rw_psd_mg2_per_s,
+            ),
+            (
+                "filter.q_gyro_drift_rw_psd_degph2_per_s",
+                self.q_gyro_drift_rw_psd_degph2_per_s,
+            ),
+            ("filter.akf_min_variance", self.akf_min_variance),
+            ("filter.open_loop_until_s", self.open_loop_until_s),
+        ];
+        for (f, v) in nonneg {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(ScenarioError::invalid(f, "must be finite and >= 0", v));
+            }
+        }
+        if self.phi_subintervals == 0 {
+            return Err(ScenarioError::invalid(
+                "filter.phi_subintervals",
+                "must be >= 1",
+                self.phi_subintervals,
+            ));
+        }
+        if self.akf_window == 0 || self.akf_window > akf::DEFAULT_WINDOW_CAPACITY {
+            return Err(ScenarioError::invalid(
+                "filter.akf_window",
+                "must be within 1..=64",
+                self.akf_window,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Initial covariance diagonal in state units (m², (m/s)², rad², (m/s²)², (rad/s)²).
+    pub(crate) fn p0_diagonal(&self) -> [f64; 5] {
+        [
+            self.p0_pos_sigma_m.powi(2),
+            self.p0_vel_sigma_mps.powi(2),
+            (self.p0_psi_sigma_mrad * 1e-3).powi(2),
+            (self.p0_accel_bias_sigma_mg * MG_TO_MPS2).powi(2),
+            (self.p0_gyro_drift_sigma_degph * DEGPH_TO_RADPS).powi(2),
+        ]
+    }
+
+    /// Continuous PSDs (accelerometer (m/s²)²/Hz, gyro rad²/s, bias RW (m/s²)²/s, drift RW
+    /// (rad/s)²/s) for an IMU sample step `step_s`.
+    pub(crate) fn psd(&self, step_s: f64) -> [f64; 4] {
+        [
+            self.q_accel_noise_var_per_sample_mg2 * MG_TO_MPS2.powi(2) * step_s,
+            self.q_gyro_noise_var_per_sample_degph2 * DEGPH_TO_RADPS.powi(2) * step_s,
+            self.q_accel_bias_rw_psd_mg2_per_s * MG_TO_MPS2.powi(2),
+            self.q_gyro_drift_rw_psd_degph2_per_s * DEGPH_TO_RADPS.powi(2),
+        ]
+    }
+}
+
+/// `[monte_carlo]`: how many runs and the master seed.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonteCarloConfig {
+    /// Runs per mode (paper: not stated; we use 100), ≥ 1.
+    pub runs: usize,
+    /// Master seed; run i uses [`super::run_seed`]`(seed, mode, i)`.
+    pub seed: u64,
+}
+
+impl Default for MonteCarloConfig {
+    fn default() -> Self {
+        Self::paper()
+    }
+}
+
+impl MonteCarloConfig {
+    /// 100 runs, seed 2009 (the values of `configs/paper.toml`).
+    pub fn paper() -> Self {
+        Self {
+            runs: 100,
+            seed: 2009,
+        }
+    }
+
+    /// Checks every field; the error names it as `monte_carlo.<field>`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        if self.runs == 0 {
+            return Err(ScenarioError::invalid(
+                "monte_carlo.runs",
+                "must be >= 1",
+                self.runs,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The whole scenario document, as deserialised (unknown sections are rejected).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ScenarioFile {
+    pub trajectory: TrajectoryConfig,
+    pub imu: ImuConfig,
+    pub sighting: SightingConfig,
+    pub filter: FilterConfig,
+    pub monte_carlo: MonteCarloConfig,
+}
+
+const SECTIONS: [&str; 5] = ["trajectory", "imu", "sighting", "filter", "monte_carlo"];
+
+/// Parses the document section by section so that an error names its section.
+pub(crate) fn parse(text: &str) -> Result<ScenarioFile, ScenarioError> {
+    let table: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| ScenarioError::Parse {
+            section: "(document)".to_string(),
+            message: e.to_string(),
+        })?;
+    for key in table.keys() {
+        if !SECTIONS.contains(&key.as_str()) {
+            return Err(ScenarioError::Parse {
+                section: key.clone(),
+                message: format!("unknown section `{key}`, expected one of {SECTIONS:?}"),
+            });
+        }
+    }
+    fn section<T: serde::de::DeserializeOwned>(
+        table: &toml::Table,
+        name: &str,
+    ) -> Result<T, ScenarioError> {
+        let v = table
+            .get(name)
+            .cloned()
+            .ok_or_else(|| ScenarioError::Parse {
+                section: name.to_string(),
+                message: "section missing".to_string(),
+            })?;
+        v.try_into()
+            .map_err(|e: toml::de::Error| ScenarioError::Parse {
+                section: name.to_string(),
+                message: e.to_string().trim().to_string(),
+            })
+    }
+    Ok(ScenarioFile {
+        trajectory: section(&table, "trajectory")?,
+        imu: section(&table, "imu")?,
+        sighting: section(&table, "sighting")?,
+        filter: section(&table, "filter")?,
+        monte_carlo: section(&table, "monte_carlo")?,
+    })
+}

@@ -1,0 +1,512 @@
+//! # INS/SD closed loop — Lustosa, Chagas & Waldmann, §§5–6
+//!
+//! Monte Carlo simulation of a strapdown INS aided by a sighting device (SD), in three modes
+//! ([`Mode`]): stand-alone INS, INS/SD with a manually tuned Kalman filter, and INS/SD with
+//! the adaptive KF of Mohamed & Schwarz (paper eq. 19). Built on the sibling crates:
+//! `ins-errors` (truth trajectory, IMU errors, NED strapdown, 15-state ψ-angle error model),
+//! `sighting-model` (nonlinear (w, h) offsets and their Jacobian H) and `akf` (Joseph-form KF,
+//! adaptive Q̂).
+//!
+//! ## One run
+//!
+//! ```text
+//! truth (100 Hz) ──► IMU: f̃ = f + ∇ + w_a, ω̃ = ω + ε + w_g ──► strapdown INS ──┐
+//!        │                                                                      │ A(t) averaged
+//!        │                            every T_SD = 1 s:                         ▼ on sub-intervals
+//!        └──► z = h(truth, INS, landmarks) + v ──► KF/AKF: predict (Φ_T, Q_T), update (H at INS)
+//!                                                       │ t ≥ 195 s: feedback
+//!                                                       ▼
+//!              INS ← INS − (δp̂, δv̂, ψ̂);  sensor corrections += (∇̂, ε̂);  x̂ ← 0, P kept
+//! ```
+//!
+//! * Error state (15, `ins-errors` contract): x = (δp m NED, δv m/s NED, ψ rad, ∇ m/s² body,
+//!   ε rad/s body), δ = computed − true.
+//! * Continuous model (paper eqs. 10–14, as implemented and verified in `ins-errors`):
+//!   δṗ = −ρ×δp + δv, δv̇ = G_p δp − (2Ω+ρ)×δv + f_n×ψ + C̃∇, ψ̇ = −(Ω+ρ)×ψ − C̃ε, ∇̇ = ε̇ = 0
+//!   (+ white noise).
+//! * Measurement (paper eqs. 15–18, verified in `sighting-model`): for each of the three
+//!   landmarks the camera is pointed with the INS's position and attitude; z = (w, h) ∈ ℝ⁶ is
+//!   simulated with the **nonlinear** model from the true and the computed states plus
+//!   N(0, σ²_SD) noise ([sighting] `noise_var_m2`), and the filter uses z = H x + v with H
+//!   (6×15, δp and ψ columns) evaluated at the computed position; R = `filter.r_var_m2` · I₆.
+//!   Innovation ν = z − H x̂⁻ (the predicted offset of the computed state is zero).
+//! * Filter (paper §5): discrete KF, Joseph update (`akf`). **Open loop** until
+//!   `filter.open_loop_until_s` (paper: 195 s): x̂ is propagated and updated, the INS runs
+//!   free. At every update at or after that time, **feedback**: δp̂, δv̂, ψ̂ are removed from the
+//!   INS (`Strapdown::apply_correction`, exact in the contract's conventions), ∇̂, ε̂ are added
+//!   to the INS's sensor corrections, x̂ ← 0 and P is kept (the reset is an identity on the
+//!   error: INS error − x̂ is the same before and after, to first order; tested).
+//!
+//! ## Discretisation over the update interval (speed)
+//!
+//! The covariance is **not** propagated at 100 Hz. The filter predicts once per SD interval
+//! T = 1 s with (Φ_T, Q_T) built by [`interval`]: the interval is cut into
+//! `filter.phi_subintervals` = 10 pieces of 0.1 s; on each, the INS's linearisation
+//! quantities (position, velocity, f_n = C̃ f_b, C̃) are averaged over its 10 steps, A is
+//! built from the averages, discretised by `ins_errors::error_model::discretize_fast` (third
+//! order series Φ, Simpson Q_d) and the pieces are chained (Φ_T ← Φ_τ Φ_T,
+//! Q_T ← Φ_τ Q_T Φ_τᵀ + Q_τ). Measured against the paper's way (product of the 100 Φ(0.01 s),
+//! Q_d per step accumulated; `tests/ins_sd_interval.rs`): on the manoeuvring flight the
+//! propagated variances agree to ~1e-4 relative or better (the test asserts 1e-3 for
+//! m = 10, and prints m = 1, 2, 5, 10).
+//!
+//! ## Process noise Q
+//!
+//! * **KF (manually tuned).** Continuous PSDs on the sensor inputs (`[filter]` `q_*`; white
+//!   noise in per-sample variance like `[imu]`, PSD = variance · T_s; random walks in
+//!   units²/s). Starting point = the true sensor statistics (1 mg², 1 (°/h)² per sample, zero
+//!   bias random walk). The values in `configs/paper.toml` and the reasons are in
+//!   [`Scenario::assumptions`] and the crate report; W = G Q_c Gᵀ is constant because the PSDs
+//!   are equal on the three body axes (C̃ q I C̃ᵀ = q I).
+//! * **AKF.** Until N = `filter.akf_window` updates have been seen, the a-priori Q_T of the KF
+//!   tuning is used. Afterwards the Mohamed–Schwarz estimate (paper eq. 19, `akf`)
+//!   Q̂_k = (1/N) Σ Δx_j Δx_jᵀ + P_k⁺ − Φ_T P_{k−1}⁺ Φ_Tᵀ, with Φ_T the transition over the 1 s
+//!   interval, is an estimate of the noise accumulated **over one interval** — exactly the
+//!   Q_T the filter predicts with, since it predicts once per interval. So Q̂_k, made PSD
+//!   (`filter.akf_projection`, default eigenvalue clipping at `akf_min_variance` = 0), is used
+//!   unchanged as Q_T of the next prediction; no conversion to a per-0.01 s Q_d is needed.
+//!   (The paper's Φ of eq. 19 is discretised at T_s = 0.01 s, which would not span the
+//!   interval between the Δx_j; with a 1 s interval Φ_T is the consistent reading.)
+//!
+//! ## Randomness
+//!
+//! [`run_seed`] derives run i's seed from the master seed (SplitMix64, independent of threads
+//! and order; it ignores the mode, so the three modes of one run index see the **same truth,
+//! the same IMU error draw and the same IMU noise** — common random numbers, paired
+//! comparisons). The IMU uses `ChaCha8Rng::seed_from_u64(seed)` exactly as a stand-alone
+//! `ins-errors` run (draw ∇, ε, then per-step noise); the SD noise uses ChaCha stream 1 of the
+//! same seed.
+//!
+//! ## Records
+//!
+//! [`Sample`]s at 1 Hz (t = 0 … duration): error of the system's navigation output (the INS
+//! corrected by the current estimate: INS error − x̂; equal to the INS error in feedback and
+//! stand-alone), ψ per the contract (from true and computed attitudes and the frame tilt δθ:
+//! `ins_errors::error_model::error_state`), distance flown (truth, trapezoidal), and at SD
+//! epochs NEES (all 15 states: true ∇, ε minus the sensor corrections applied so far, minus
+//! x̂; against P⁺) and NIS (from the update).
+//!
+//! ## Example
+//!
+//! ```
+//! use nav_app::ins_sd::{Mode, Sample, Scenario, run, run_seed};
+//!
+//! let scenario = Scenario::paper_default().truncated(20.0)?; // the first 20 s of the flight
+//! let mut out = vec![Sample::default(); scenario.samples_per_run()];
+//! let seed = run_seed(scenario.monte_carlo.seed, Mode::Kf, 0);
+//! let outcome = run(&scenario, Mode::Kf, seed, &mut out)?;
+//! assert_eq!(outcome.samples_written, 21);
+//! assert!(out[20].nis.is_some()); // an SD update at t = 20 s
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod config;
+mod engine;
+pub mod interval;
+
+pub use config::{FilterConfig, MonteCarloConfig, ScenarioError};
+
+use ins_errors::InsError;
+use ins_errors::config::{ImuConfig, TrajectoryConfig};
+use ins_errors::trajectory::Trajectory;
+use sighting_model::{SightingConfig, SightingError};
+
+/// A complete scenario: the sections of `configs/paper.toml`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// `[trajectory]` (crate `ins-errors`): flight and 100 Hz step.
+    pub trajectory: TrajectoryConfig,
+    /// `[imu]` (crate `ins-errors`): sensor error statistics.
+    pub imu: ImuConfig,
+    /// `[sighting]` (crate `sighting-model`): landmarks, SD noise, update period.
+    pub sighting: SightingConfig,
+    /// `[filter]`: P₀, Q tuning, R, feedback switch, discretisation, AKF.
+    pub filter: FilterConfig,
+    /// `[monte_carlo]`: runs and master seed.
+    pub monte_carlo: MonteCarloConfig,
+}
+
+/// Step counts derived from a validated scenario.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Plan {
+    pub step_s: f64,
+    pub steps: usize,
+    pub steps_per_update: usize,
+    pub steps_per_sample: usize,
+    pub samples: usize,
+}
+
+fn is_integer_multiple(x: f64, unit: f64) -> Option<usize> {
+    let n = (x / unit).round();
+    if n >= 1.0 && (x - n * unit).abs() <= 1e-9 * x.abs().max(1.0) {
+        Some(n as usize)
+    } else {
+        None
+    }
+}
+
+impl Scenario {
+    /// Parses and validates a scenario document. Unknown sections and keys are rejected; every
+    /// error names its section or its dotted field (`"filter.r_var_m2"`).
+    pub fn from_toml_str(text: &str) -> Result<Scenario, ScenarioError> {
+        let f = config::parse(text)?;
+        let s = Scenario {
+            trajectory: f.trajectory,
+            imu: f.imu,
+            sighting: f.sighting,
+            filter: f.filter,
+            monte_carlo: f.monte_carlo,
+        };
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// The paper's scenario, equal to `configs/paper.toml` (tested).
+    pub fn paper_default() -> Scenario {
+        Scenario {
+            trajectory: TrajectoryConfig::paper(),
+            imu: ImuConfig::paper(),
+            sighting: SightingConfig::paper(),
+            filter: FilterConfig::paper(),
+            monte_carlo: MonteCarloConfig::paper(),
+        }
+    }
+
+    /// Checks every section and the cross-section constraints (integer seconds of flight, SD
+    /// period a multiple of the INS step, three landmarks in view from the start).
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        let ins = |e: InsError| match e {
+            InsError::InvalidConfig {
+                field,
+                requirement,
+                value,
+            } => ScenarioError::Invalid {
+                field,
+                requirement,
+                value,
+            },
+            other => ScenarioError::Invalid {
+                field: "trajectory".to_string(),
+                requirement: other.to_string(),
+                value: String::new(),
+            },
+        };
+        self.trajectory.validate().map_err(ins)?;
+        self.imu.validate().map_err(ins)?;
+        self.sighting.validate().map_err(sighting_err)?;
+        self.sighting.landmarks3().map_err(sighting_err)?;
+        self.filter.validate()?;
+        self.monte_carlo.validate()?;
+        let tr = Trajectory::new(&self.trajectory).map_err(ins)?;
+        self.sighting
+            .check_vehicle(&tr.start())
+            .map_err(sighting_err)?;
+        self.plan()?;
+        Ok(())
+    }
+
+    pub(crate) fn plan(&self) -> Result<Plan, ScenarioError> {
+        let step_s = self.trajectory.step_s;
+        let steps = is_integer_multiple(self.trajectory.end_time_s, step_s).ok_or_else(|| {
+            ScenarioError::invalid(
+                "trajectory.end_time_s",
+                "must be a positive multiple of trajectory.step_s",
+                self.trajectory.end_time_s,
+            )
+        })?;
+        let end = self.trajectory.end_time_s;
+        if (end - end.round()).abs() > 1e-9 || end < 1.0 {
+            return Err(ScenarioError::invalid(
+                "trajectory.end_time_s",
+                "must be a whole number of seconds >= 1 (1 Hz records)",
+                end,
+            ));
+        }
+        let steps_per_sample = is_integer_multiple(1.0, step_s).ok_or_else(|| {
+            ScenarioError::invalid(
+                "trajectory.step_s",
+                "must divide 1 s (1 Hz records)",
+                step_s,
+            )
+        })?;
+        let steps_per_update = is_integer_multiple(self.sighting.update_period_s, step_s)
+            .ok_or_else(|| {
+                ScenarioError::invalid(
+                    "sighting.update_period_s",
+                    "must be a positive multiple of trajectory.step_s",
+                    self.sighting.update_period_s,
+                )
+            })?;
+        if self.filter.phi_subintervals > steps_per_update {
+            return Err(ScenarioError::invalid(
+                "filter.phi_subintervals",
+                "must not exceed the INS steps per SD interval",
+                self.filter.phi_subintervals,
+            ));
+        }
+        Ok(Plan {
+            step_s,
+            steps,
+            steps_per_update,
+            steps_per_sample,
+            samples: end.round() as usize + 1,
+        })
+    }
+
+    /// Flight duration, s (`trajectory.end_time_s`).
+    pub fn duration_s(&self) -> f64 {
+        self.trajectory.end_time_s
+    }
+
+    /// Length of the `out` buffer of [`run`]: duration + 1 records (t = 0, 1, …, duration).
+    pub fn samples_per_run(&self) -> usize {
+        self.trajectory.end_time_s.round().max(0.0) as usize + 1
+    }
+
+    /// Runs per mode from `[monte_carlo]`.
+    pub fn default_runs(&self) -> usize {
+        self.monte_carlo.runs
+    }
+
+    /// The same scenario cut to its first `duration_s` seconds (manoeuvre segments that
+    /// start after it are dropped, the last one shortened). For fast tests.
+    pub fn truncated(&self, duration_s: f64) -> Result<Scenario, ScenarioError> {
+        let mut s = self.clone();
+        let mut t = 0.0;
+        let mut keep = Vec::new();
+        for seg in &self.trajectory.segments {
+            if t >= duration_s - 1e-9 {
+                break;
+            }
+            let mut seg = seg.clone();
+            if t + seg.duration_s > duration_s {
+                seg.duration_s = duration_s - t;
+            }
+            t += seg.duration_s;
+            keep.push(seg);
+        }
+        s.trajectory.segments = keep;
+        s.trajectory.end_time_s = duration_s;
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Human-readable list of the modelling choices (for summary.md).
+    pub fn assumptions(&self) -> Vec<String> {
+        let f = &self.filter;
+        let t = &self.trajectory;
+        vec![
+            format!(
+                "Flight: start {:.4}°, {:.4}°, {} m, {} m/s heading {}°; {} manoeuvre segments, straight to {} s (ins-errors [trajectory]).",
+                t.start_lat_deg,
+                t.start_lon_deg,
+                t.start_alt_m,
+                t.start_speed_mps,
+                t.start_heading_deg,
+                t.segments.len(),
+                t.end_time_s
+            ),
+            format!(
+                "INS starts at the true position, velocity and attitude; step {} s ({} Hz).",
+                t.step_s,
+                (1.0 / t.step_s).round()
+            ),
+            format!(
+                "IMU: random constants per run and axis, σ = {} mg (accelerometer), {} °/h (gyro), {:?}; white noise variance per sample {} mg², {} (°/h)².",
+                self.imu.accel_bias_sigma_mg,
+                self.imu.gyro_drift_sigma_degph,
+                self.imu.bias_model,
+                self.imu.accel_noise_var_per_sample_mg2,
+                self.imu.gyro_noise_var_per_sample_degph2
+            ),
+            format!(
+                "SD: {} landmarks, all always in view, noise variance {} m² on each of w and h, update every {} s; simulated with the nonlinear gimbal/camera model of sighting-model.",
+                self.sighting.landmarks.len(),
+                self.sighting.noise_var_m2,
+                self.sighting.update_period_s
+            ),
+            format!(
+                "Filter: P0 σ = {} m, {} m/s, {} mrad, {} mg, {} °/h; R = {} m²·I6; open loop until {} s, then feedback with reset (P kept).",
+                f.p0_pos_sigma_m,
+                f.p0_vel_sigma_mps,
+                f.p0_psi_sigma_mrad,
+                f.p0_accel_bias_sigma_mg,
+                f.p0_gyro_drift_sigma_degph,
+                f.r_var_m2,
+                f.open_loop_until_s
+            ),
+            format!(
+                "KF Q (continuous, per body axis): accelerometer white {} mg² per sample, gyro white {} (°/h)² per sample, bias random walk {} mg²/s, drift random walk {} (°/h)²/s.",
+                f.q_accel_noise_var_per_sample_mg2,
+                f.q_gyro_noise_var_per_sample_degph2,
+                f.q_accel_bias_rw_psd_mg2_per_s,
+                f.q_gyro_drift_rw_psd_degph2_per_s
+            ),
+            format!(
+                "Φ and Q over each {} s SD interval from A averaged on {} sub-intervals (series Φ, Simpson Q), not propagated at 100 Hz.",
+                self.sighting.update_period_s, f.phi_subintervals
+            ),
+            format!(
+                "AKF: Mohamed–Schwarz Q̂ with window N = {}, projection {:?} (floor {}), used directly as the next interval's Q; the KF's a-priori Q until the window is full.",
+                f.akf_window, f.akf_projection, f.akf_min_variance
+            ),
+            "Common random numbers: the three modes of one run index share truth, IMU error draw and IMU noise.".to_string(),
+            format!(
+                "Monte Carlo: {} runs per mode, master seed {}.",
+                self.monte_carlo.runs, self.monte_carlo.seed
+            ),
+        ]
+    }
+}
+
+fn sighting_err(e: SightingError) -> ScenarioError {
+    match e {
+        SightingError::InvalidField {
+            field,
+            value,
+            requirement,
+        } => ScenarioError::Invalid {
+            field: format!("sighting.{field}"),
+            requirement: requirement.to_string(),
+            value: format!("{value:?}"),
+        },
+        SightingError::LandmarkCount { expected, found } => ScenarioError::Invalid {
+            field: "sighting.landmarks".to_string(),
+            requirement: format!("must hold exactly {expected} landmarks"),
+            value: found.to_string(),
+        },
+        other => ScenarioError::Invalid {
+            field: "sighting.landmarks".to_string(),
+            requirement: other.to_string(),
+            value: String::new(),
+        },
+    }
+}
+
+/// Simulation mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// Stand-alone INS (no updates).
+    Standalone,
+    /// INS/SD with the manually tuned Kalman filter.
+    Kf,
+    /// INS/SD with the adaptive Kalman filter (Mohamed & Schwarz).
+    Akf,
+}
+
+impl Mode {
+    /// All modes, in report order.
+    pub const ALL: [Mode; 3] = [Mode::Standalone, Mode::Kf, Mode::Akf];
+
+    /// `"standalone"`, `"kf"` or `"akf"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Standalone => "standalone",
+            Mode::Kf => "kf",
+            Mode::Akf => "akf",
+        }
+    }
+}
+
+/// One 1 Hz record of one run (t = 0, 1, …, duration).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sample {
+    /// Time, s.
+    pub t_s: f64,
+    /// Position error (computed − true), NED, m — of the navigation output (INS corrected by
+    /// the current estimate; after the feedback correction if any).
+    pub pos_err_ned_m: [f64; 3],
+    /// Velocity error, NED, m/s (same convention).
+    pub vel_err_ned_mps: [f64; 3],
+    /// Misalignment ψ (contract), N, E, D components, rad.
+    pub misalignment_rad: [f64; 3],
+    /// True distance flown since t = 0, m.
+    pub distance_m: f64,
+    /// Filters only, at SD update epochs: eᵀ P⁻¹ e with all 15 states.
+    pub nees: Option<f64>,
+    /// Filters only, at SD update epochs: νᵀ S⁻¹ ν, 6 measurements.
+    pub nis: Option<f64>,
+}
+
+/// What a run did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RunOutcome {
+    /// Records written to `out` (duration + 1 on success).
+    pub samples_written: usize,
+    /// 100 Hz INS epochs simulated.
+    pub epochs: u64,
+}
+
+/// Failures of [`run`]; each says where (time) and what.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The INS or the filter state became NaN/∞.
+    #[error("run became non-finite at t = {t_s} s: {what}")]
+    NonFinite {
+        /// Time of detection, s.
+        t_s: f64,
+        /// Which quantity.
+        what: &'static str,
+    },
+    /// The scenario is invalid.
+    #[error("invalid scenario: {0}")]
+    Scenario(#[from] ScenarioError),
+    /// `out` has the wrong length.
+    #[error("output buffer holds {got} samples, the run needs {expected} (duration + 1)")]
+    OutputLength {
+        /// Required length.
+        expected: usize,
+        /// Length passed.
+        got: usize,
+    },
+    /// `ins-errors` rejected an input (trajectory, IMU parameters, initial state).
+    #[error("ins-errors: {0}")]
+    Ins(InsError),
+    /// The SD model failed (e.g. a landmark behind the camera because the errors exploded).
+    #[error("sighting model at t = {t_s} s: {source}")]
+    Sighting {
+        /// Time, s.
+        t_s: f64,
+        /// The model's error.
+        source: SightingError,
+    },
+    /// The filter rejected a matrix (non-finite, S not positive definite, …).
+    #[error("filter at t = {t_s} s: {source}")]
+    Filter {
+        /// Time, s.
+        t_s: f64,
+        /// The filter's error.
+        source: akf::AkfError,
+    },
+}
+
+/// Simulates one Monte Carlo run. `seed` fully determines the run. `out` has length
+/// duration + 1 ([`Scenario::samples_per_run`]) and is caller-owned; the epoch loop does not
+/// allocate.
+pub fn run(
+    scenario: &Scenario,
+    mode: Mode,
+    seed: u64,
+    out: &mut [Sample],
+) -> Result<RunOutcome, RunError> {
+    engine::run(scenario, mode, seed, out)
+}
+
+/// Seed of run `index` derived from the master seed by SplitMix64, independent of threads
+/// and order. `mode` is deliberately ignored: all modes of one run index share truth, IMU
+/// error draw and noise (common random numbers).
+pub fn run_seed(master_seed: u64, mode: Mode, index: u64) -> u64 {
+    let _ = mode;
+    splitmix64(master_seed ^ splitmix64(index.wrapping_add(0x5851_F42D_4C95_7F2D)))
+}
+
+fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+#[cfg(test)]
+mod tests;
