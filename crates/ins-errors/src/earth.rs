@@ -178,6 +178,71 @@ pub fn gravity_ned_mps2(lat_rad: f64, alt_m: f64) -> Vector3<f64> {
     Vector3::new(0.0, 0.0, normal_gravity_mps2(lat_rad, alt_m))
 }
 
+/// Navigation-frame quantities at one (latitude, altitude), computed with a single sin/cos and a
+/// single square root (the hot-path form of [`radii_of_curvature_m`], [`earth_rate_ned_radps`],
+/// [`normal_gravity_mps2`], [`transport_rate_ned_radps`] and [`geodetic_rates`]; same values).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalFrame {
+    /// Meridian radius of curvature plus altitude R_N + h, m.
+    pub r_n_plus_h_m: f64,
+    /// Prime-vertical radius of curvature plus altitude R_E + h, m.
+    pub r_e_plus_h_m: f64,
+    /// sin L.
+    pub sin_lat: f64,
+    /// cos L.
+    pub cos_lat: f64,
+    /// Earth rate in NED, rad/s.
+    pub earth_rate_ned_radps: Vector3<f64>,
+    /// Normal gravity γ(L, h), m/s² (along +D).
+    pub gravity_mps2: f64,
+}
+
+impl LocalFrame {
+    /// Evaluates the quantities at `lat_rad`, `alt_m`.
+    #[inline]
+    pub fn new(lat_rad: f64, alt_m: f64) -> Self {
+        let (sl, cl) = lat_rad.sin_cos();
+        let s2 = sl * sl;
+        let w2 = 1.0 - WGS84_E2 * s2;
+        let w = w2.sqrt();
+        let r_e = WGS84_A_M / w;
+        let r_n = WGS84_A_M * (1.0 - WGS84_E2) / (w2 * w);
+        let a = WGS84_A_M;
+        let g0 = WGS84_GAMMA_E_MPS2 * (1.0 + WGS84_SOMIGLIANA_K * s2) / w;
+        let gamma = g0
+            * (1.0 - 2.0 / a * (1.0 + WGS84_F + WGS84_M - 2.0 * WGS84_F * s2) * alt_m
+                + 3.0 * alt_m * alt_m / (a * a));
+        Self {
+            r_n_plus_h_m: r_n + alt_m,
+            r_e_plus_h_m: r_e + alt_m,
+            sin_lat: sl,
+            cos_lat: cl,
+            earth_rate_ned_radps: Vector3::new(EARTH_RATE_RADPS * cl, 0.0, -EARTH_RATE_RADPS * sl),
+            gravity_mps2: gamma,
+        }
+    }
+
+    /// Transport rate ρ in NED for the NED velocity `vel_ned_mps`, rad/s.
+    #[inline]
+    pub fn transport_rate_ned_radps(&self, vel_ned_mps: &Vector3<f64>) -> Vector3<f64> {
+        Vector3::new(
+            vel_ned_mps.y / self.r_e_plus_h_m,
+            -vel_ned_mps.x / self.r_n_plus_h_m,
+            -vel_ned_mps.y * self.sin_lat / (self.cos_lat * self.r_e_plus_h_m),
+        )
+    }
+
+    /// Geodetic rates (L̇, λ̇, ḣ) for the NED velocity `vel_ned_mps`.
+    #[inline]
+    pub fn geodetic_rates(&self, vel_ned_mps: &Vector3<f64>) -> Vector3<f64> {
+        Vector3::new(
+            vel_ned_mps.x / self.r_n_plus_h_m,
+            vel_ned_mps.y / (self.r_e_plus_h_m * self.cos_lat),
+            -vel_ned_mps.z,
+        )
+    }
+}
+
 /// Skew-symmetric (cross-product) matrix [v×], so that `skew(v) * w == v.cross(w)`.
 #[inline]
 pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
@@ -431,6 +496,36 @@ mod tests {
         // Ċ_e^n = −[ω_en×] C_e^n.
         let w = -cdot * at(0.0).transpose();
         assert_relative_eq!(w, skew(&rho), epsilon = 1e-12);
+    }
+
+    #[test]
+    fn local_frame_equals_individual_functions() {
+        let g = paper_start();
+        let v = Vector3::new(21.0, -17.0, 1.5);
+        let lf = LocalFrame::new(g.lat_rad, g.alt_m);
+        let (r_n, r_e) = radii_of_curvature_m(g.lat_rad);
+        assert_relative_eq!(lf.r_n_plus_h_m, r_n + g.alt_m, max_relative = 1e-15);
+        assert_relative_eq!(lf.r_e_plus_h_m, r_e + g.alt_m, max_relative = 1e-15);
+        assert_relative_eq!(
+            lf.gravity_mps2,
+            normal_gravity_mps2(g.lat_rad, g.alt_m),
+            max_relative = 1e-15
+        );
+        assert_relative_eq!(
+            lf.earth_rate_ned_radps,
+            earth_rate_ned_radps(g.lat_rad),
+            max_relative = 1e-15
+        );
+        assert_relative_eq!(
+            lf.transport_rate_ned_radps(&v),
+            transport_rate_ned_radps(g.lat_rad, g.alt_m, &v),
+            max_relative = 1e-14
+        );
+        assert_relative_eq!(
+            lf.geodetic_rates(&v),
+            geodetic_rates(g.lat_rad, g.alt_m, &v),
+            max_relative = 1e-14
+        );
     }
 
     #[test]

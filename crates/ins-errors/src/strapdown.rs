@@ -35,9 +35,9 @@
 //! C_c^t the exact rotation between the local-level frames at the old and new positions
 //! (≈ I + [δθ×]; so the attitude is corrected by φ = ψ + δθ).
 
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
-use crate::earth::{self, Geodetic};
+use crate::earth::{self, Geodetic, LocalFrame};
 use crate::error::InsError;
 
 /// Navigation state: position, NED velocity and attitude C_b^n.
@@ -84,6 +84,23 @@ pub struct Strapdown {
     accel_bias_est_body_mps2: Vector3<f64>,
     gyro_drift_est_body_radps: Vector3<f64>,
     last_specific_force_ned_mps2: Vector3<f64>,
+    /// Local frame at the previous step's midpoint (radii for the half-step prediction).
+    frame: LocalFrame,
+}
+
+/// exp of a rotation vector as a unit quaternion; for |v| < 0.01 rad a series exact to rounding
+/// (the next term is (|v|/2)⁸/8! < 1e-23), else the trigonometric form.
+#[inline]
+fn exp_quat(v: &Vector3<f64>) -> UnitQuaternion<f64> {
+    let t2 = v.norm_squared();
+    if t2 < 1e-4 {
+        let h2 = 0.25 * t2;
+        let c = 1.0 - h2 / 2.0 + h2 * h2 / 24.0 - h2 * h2 * h2 / 720.0;
+        let sc = 0.5 * (1.0 - h2 / 6.0 + h2 * h2 / 120.0 - h2 * h2 * h2 / 5040.0);
+        UnitQuaternion::new_unchecked(Quaternion::new(c, sc * v.x, sc * v.y, sc * v.z))
+    } else {
+        UnitQuaternion::from_scaled_axis(*v)
+    }
 }
 
 impl Strapdown {
@@ -114,6 +131,7 @@ impl Strapdown {
             accel_bias_est_body_mps2: Vector3::zeros(),
             gyro_drift_est_body_radps: Vector3::zeros(),
             last_specific_force_ned_mps2: -g,
+            frame: LocalFrame::new(initial.pos.lat_rad, initial.pos.alt_m),
         })
     }
 
@@ -192,25 +210,27 @@ impl Strapdown {
             Some(p) => 1.5 * v_k - 0.5 * p,
             None => v_k,
         };
-        let r0 = earth::geodetic_rates(s.pos.lat_rad, s.pos.alt_m, &v_mid);
+        let r0 = self.frame.geodetic_rates(&v_mid);
         let lat_mid = s.pos.lat_rad + 0.5 * ts * r0.x;
         let alt_mid = s.pos.alt_m + 0.5 * ts * r0.z;
-        let omega = earth::earth_rate_ned_radps(lat_mid);
-        let rho = earth::transport_rate_ned_radps(lat_mid, alt_mid, &v_mid);
-        let hb = UnitQuaternion::from_scaled_axis(w_b * (0.5 * ts));
-        let hn = UnitQuaternion::from_scaled_axis((omega + rho) * (-0.5 * ts));
+        let lf = LocalFrame::new(lat_mid, alt_mid);
+        let omega = lf.earth_rate_ned_radps;
+        let rho = lf.transport_rate_ned_radps(&v_mid);
+        let hb = exp_quat(&(w_b * (0.5 * ts)));
+        let hn = exp_quat(&((omega + rho) * (-0.5 * ts)));
         let q_mid = hn * s.att_b_to_n * hb;
         let mut q_next = hn * q_mid * hb;
         q_next.renormalize_fast();
         let f_n = q_mid * f_b;
-        let g = earth::gravity_ned_mps2(lat_mid, alt_mid);
+        let g = Vector3::new(0.0, 0.0, lf.gravity_mps2);
         let v_next = v_k + ts * (f_n + g - (2.0 * omega + rho).cross(&v_mid));
-        let r = earth::geodetic_rates(lat_mid, alt_mid, &(0.5 * (v_k + v_next)));
+        let r = lf.geodetic_rates(&(0.5 * (v_k + v_next)));
         let pos = Geodetic {
             lat_rad: s.pos.lat_rad + ts * r.x,
             lon_rad: s.pos.lon_rad + ts * r.y,
             alt_m: s.pos.alt_m + ts * r.z,
         };
+        self.frame = lf;
         self.prev_vel_ned_mps = Some(v_k);
         self.last_specific_force_ned_mps2 = f_n;
         self.state = NavState {
