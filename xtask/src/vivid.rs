@@ -9,7 +9,8 @@
 //!
 //! 1. Host packages: `qemu-system-x86`, `busybox-static`, `libclang-dev` (the `v4l` crate's
 //!    bindgen needs libclang). Missing ones are installed with apt-get when running as root
-//!    (fresh machine, CI); otherwise the command stops and says what to install.
+//!    (fresh machine), or in CI (`CI` set) through passwordless `sudo`; otherwise the command
+//!    stops and says what to install.
 //! 2. Guest program: by default `bt848-capture`'s `grab` example, built with
 //!    `-C target-feature=+crt-static` for `x86_64-unknown-linux-gnu`; `--guest-bin PATH` runs
 //!    another static binary instead (e.g. `nav-app`), which must accept the same flags
@@ -335,26 +336,45 @@ pub fn ensure_host_packages(pkgs: &[&str]) -> Result<()> {
     if missing.is_empty() {
         return Ok(());
     }
-    if !is_root() {
-        bail!(
-            "missing Debian packages {missing:?}; install them with `sudo apt-get install -y {}`",
-            missing.join(" ")
-        );
+    // Root installs directly; in CI (env CI set) a passwordless sudo is used if there is one.
+    let sudo = !is_root();
+    if sudo {
+        let ci = std::env::var_os("CI").is_some();
+        let passwordless = Command::new("sudo")
+            .args(["-n", "true"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        if !(ci && passwordless) {
+            bail!(
+                "missing Debian packages {missing:?}; install them with \
+                 `sudo apt-get install -y {}`",
+                missing.join(" ")
+            );
+        }
     }
+    let apt = |args: &[&str]| -> Result<bool> {
+        let mut cmd = if sudo {
+            let mut c = Command::new("sudo");
+            c.args(["-n", "env", "DEBIAN_FRONTEND=noninteractive", "apt-get"]);
+            c
+        } else {
+            let mut c = Command::new("apt-get");
+            c.env("DEBIAN_FRONTEND", "noninteractive");
+            c
+        };
+        Ok(cmd
+            .args(args)
+            .status()
+            .context("running apt-get")?
+            .success())
+    };
     eprintln!("xtask: installing {missing:?} with apt-get");
-    let status = Command::new("apt-get")
-        .args(["update", "-q"])
-        .env("DEBIAN_FRONTEND", "noninteractive")
-        .status()
-        .context("running apt-get update")?;
-    ensure!(status.success(), "apt-get update failed");
-    let status = Command::new("apt-get")
-        .args(["install", "-y", "-q", "--no-install-recommends"])
-        .args(&missing)
-        .env("DEBIAN_FRONTEND", "noninteractive")
-        .status()
-        .context("running apt-get install")?;
-    ensure!(status.success(), "apt-get install {missing:?} failed");
+    ensure!(apt(&["update", "-q"])?, "apt-get update failed");
+    let mut install = vec!["install", "-y", "-q", "--no-install-recommends"];
+    install.extend(missing.iter().copied());
+    ensure!(apt(&install)?, "apt-get install {missing:?} failed");
     Ok(())
 }
 
