@@ -241,6 +241,12 @@ impl TrackerConfig {
             i.min_points,
             "must be ≥ 3",
         )?;
+        check(
+            i.refit_iterations <= 5,
+            "init.refit_iterations",
+            i.refit_iterations,
+            "must be in 0..=5",
+        )?;
         let t = &self.track;
         check(
             (1..=200).contains(&t.window_half_width_px),
@@ -364,9 +370,11 @@ mod tests {
         type Edit = fn(&mut TrackerConfig);
         let cases: &[(&str, Edit)] = &[
             ("gradient.magnitude_threshold", |c| {
-                c.gradient.magnitude_threshold = f32::NAN
+                c.gradient.magnitude_threshold = 3000
             }),
-            ("gradient.adaptive_k", |c| c.gradient.adaptive_k = -1.0),
+            ("gradient.adaptive_keep_fraction", |c| {
+                c.gradient.adaptive_keep_fraction = -0.1
+            }),
             ("gradient.min_edge_angle_deg", |c| {
                 c.gradient.min_edge_angle_deg = 0.0
             }),

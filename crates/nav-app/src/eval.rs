@@ -85,11 +85,11 @@ pub fn score_sequence(truth: &SequenceTruth, reports: &[Option<TrackReport>]) ->
             err_sum += frame_err;
             err_n += 1;
             max_frame_err = max_frame_err.max(frame_err);
-            if let Some(start) = waiting_since {
-                if frame_ok as f64 >= 0.9 * n_rows as f64 {
-                    max_recovery = max_recovery.max(i as u64 - start);
-                    waiting_since = None;
-                }
+            if let Some(start) = waiting_since
+                && frame_ok as f64 >= 0.9 * n_rows as f64
+            {
+                max_recovery = max_recovery.max(i as u64 - start);
+                waiting_since = None;
             }
         }
         if let Some(start) = waiting_since {
@@ -270,7 +270,8 @@ pub fn score_against_instance_label(
         }
     }
     let centre = w as f64 / 2.0;
-    let (mut left, mut right): (Option<(u8, f64)>, Option<(u8, f64)>) = (None, None);
+    type Ego = Option<(u8, f64)>;
+    let (mut left, mut right): (Ego, Ego) = (None, None);
     for (v, &(_, x)) in lowest.iter().enumerate().skip(1) {
         if x.is_nan() {
             continue;

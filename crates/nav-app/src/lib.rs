@@ -1,6 +1,79 @@
 //! # nav-app — the lane tracker of Pimentel & Hemerly
 //!
-//! (work in progress; see the full crate docs once the tracker lands)
+//! The application layer of the lane-mark tracker of Pimentel & Hemerly (ITA; English reading
+//! in `shared/docs/lanes.md`, paper Fig. 1): frame sources, the tracking loop composed of
+//! `vision-gradient` (stage I), `hough-init` (stage II) and `info-filter` / `wrls` (stage III),
+//! configuration presets, overlays, synthetic fixtures with ground truth, and scoring.
+//!
+//! ## Model
+//! Each lane mark is the parabola of eq. 1, `x = a1·y² + a2·y + a3` (x column, y row, pixels of
+//! the **input** image; `a1` in px⁻¹, `a2` dimensionless, `a3` in px), a random walk observed
+//! through the lane's edge pixels (eqs. 2–5):
+//!
+//! ```text
+//! θ_{t+1} = θ_t + w_t,  Cov(w) = Q;      x_i = (y_i², y_i, 1)·θ_t + v_i,  Var(v_i) = σ_R²
+//! ```
+//!
+//! The filters run on normalised rows `u = (y − y_c)/s` (`y_c` the middle ROI row, `s` half its
+//! height), where `x = b1·u² + b2·u + b3` with all `b` in px; `Q = diag(filter.q_sigma_px²)` and
+//! `P0 = diag(filter.p0_sigma_px²)` are given there (px²), `R = filter.r_sigma_px²·I` (px²).
+//! Coefficients are always reported in the pixel convention.
+//!
+//! ## The loop, per frame ([`LaneTracker::track`])
+//! For each lane (left = `/` edges, right = `\` edges):
+//! 1. *Tracking* (state [`LaneState::Tracking`] or [`LaneState::Coasting`]): KIF time update
+//!    (`Y ← (I−B)Y(I−B)ᵀ + BQ⁻¹Bᵀ`, eq. 24); window `x̂(y) ± track.window_half_width_px` on every
+//!    ROI row; directional gradient **inside the windows only**; window pixels of the lane's
+//!    class whose residual `x − x̂(y)` is farther than `track.inlier_half_width_px` from the
+//!    midhinge of the residuals of their third of the ROI are dropped; the rest are uniformly
+//!    decimated (in row order) to at most `track.max_points_per_lane` (paper: 150), so they
+//!    spread over the rows; KIF measurement update (eqs. 6, 12) or WRLS (eqs. 25–27, λ once per
+//!    frame). Too few points (`track.reinit_min_points`) or an update moving the lane by more than
+//!    `track.max_jump_px` at the top or bottom ROI row (the *jump gate*) is a miss: the lane
+//!    coasts on its prediction; after `track.lost_after_frames` misses in a row it is
+//!    [`LaneState::Lost`] and reported without coefficients.
+//! 2. *(Re-)initialisation* (first frame, and every frame a lane is lost): gradient over the
+//!    whole ROI, Hough over the lane's angle band and LS parabola on the band around the line
+//!    (`hough-init`, with `init.refit_iterations` refits); accepted if it spans ≥ 25 % of the
+//!    ROI rows; then refined by one windowed update on the same frame.
+//! 3. *Crossing gate*: the lanes may not cross at the top ROI row nor come closer than
+//!    `track.min_lane_separation_px` at the middle and bottom rows; the estimate just
+//!    initialised, else the one with fewer points, is undone.
+//!
+//! No allocation in [`LaneTracker::track`] (tested with a counting allocator).
+//!
+//! ## Frame sources
+//! [`FrameSource`] fills a caller-owned [`GreyFrame`]. [`sources::StillImage`] (PNG, JPEG,
+//! PGM; colour → grey), [`sources::ImageDirectory`] (sorted), [`y4m::Y4mSource`] (file or
+//! stdin; `C mono` and 4:2:0, Y plane), [`sources::open_device`] (no capture in this build).
+//! Errors are [`NavError`]; [`NavError::is_fatal`] separates a fatal error from one bad frame
+//! that is reported, counted and skipped.
+//!
+//! ## Units of the configuration
+//! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field
+//! carries its unit.
+//!
+//! ## Example
+//! ```
+//! use nav_app::synth::{SceneRenderer, SCENES};
+//! use nav_app::{Estimator, GreyFrame, LaneState, LaneTracker, TrackerConfig};
+//!
+//! let cfg = TrackerConfig::outdoor()?;
+//! let mut scene = SceneRenderer::new(SCENES[0], 320, 240); // straight road, solid marks
+//! let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240)?;
+//! let mut frame = GreyFrame::default();
+//! for i in 0..5 {
+//!     scene.render(i, &mut frame);
+//!     let report = tracker.track(&frame)?;
+//!     let truth = scene.truth(i);
+//!     for (lane, gt) in report.lanes.iter().zip(truth.lanes.iter()) {
+//!         assert_eq!(lane.state, LaneState::Tracking);
+//!         let x = lane.col_at_row(220.0).unwrap();
+//!         assert!((x - gt.col_at_row(220.0)).abs() < 2.0);
+//!     }
+//! }
+//! # Ok::<(), nav_app::NavError>(())
+//! ```
 
 mod config;
 mod error;
@@ -21,6 +94,6 @@ pub use tracker::{
     Estimator, LaneReport, LaneState, LaneTracker, LaneView, Side, TrackReport, TrackerCounters,
 };
 pub mod eval;
+pub mod ins_sd;
 pub mod overlay;
 pub mod synth;
-pub mod ins_sd;

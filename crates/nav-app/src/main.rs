@@ -75,6 +75,8 @@ struct FrameJson<'a> {
     frame: u64,
     t_s: f64,
     lanes: &'a [LaneReport; 2],
+    /// Wall time of `LaneTracker::track` on this frame, µs.
+    track_us: f64,
 }
 
 fn open_source(args: &Args) -> Result<Box<dyn FrameSource>> {
@@ -175,7 +177,8 @@ fn run(args: &Args) -> Result<()> {
         };
         let t0 = Instant::now();
         let report = t.track(&frame)?;
-        track_time += t0.elapsed();
+        let dt = t0.elapsed();
+        track_time += dt;
         frames += 1;
         let index = loop_base + meta.index;
         if args.json {
@@ -185,6 +188,7 @@ fn run(args: &Args) -> Result<()> {
                     frame: index,
                     t_s: meta.t_s,
                     lanes: &report.lanes,
+                    track_us: dt.as_secs_f64() * 1e6,
                 },
             )
             .context("cannot write JSON to stdout")?;

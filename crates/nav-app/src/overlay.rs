@@ -40,7 +40,7 @@ pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8
         for &(x, y) in view.points {
             put(x as i64, y as i64, POINT_RGB[k]);
         }
-        if let Some(_) = view.report.coeffs {
+        if view.report.coeffs.is_some() {
             let colour = if view.report.state == LaneState::Coasting {
                 COAST_RGB
             } else {

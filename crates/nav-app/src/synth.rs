@@ -235,7 +235,7 @@ impl SceneRenderer {
         let (w, h) = (self.width as f64, self.height as f64);
         let t = self.t_frac(frame);
         let kappa = (self.spec.curvature.0 + t * (self.spec.curvature.1 - self.spec.curvature.0))
-            * (h / 240.0).powi(-1)
+            * (240.0 / h).powi(2)
             * (w / 320.0);
         let sway = 0.12 * (2.0 * std::f64::consts::PI * frame as f64 / 30.0).sin() * (w / 320.0)
             / (h / 240.0);
@@ -374,12 +374,12 @@ impl SceneRenderer {
                 *px = v.round().clamp(0.0, 255.0) as u8;
             }
         }
-        if spec.noise_sigma > 0.0 {
-            if let Ok(normal) = Normal::new(0.0, spec.noise_sigma) {
-                for px in out.data.iter_mut() {
-                    let n: f64 = normal.sample(&mut self.rng);
-                    *px = (f64::from(*px) + n).round().clamp(0.0, 255.0) as u8;
-                }
+        if spec.noise_sigma > 0.0
+            && let Ok(normal) = Normal::new(0.0, spec.noise_sigma)
+        {
+            for px in out.data.iter_mut() {
+                let n: f64 = normal.sample(&mut self.rng);
+                *px = (f64::from(*px) + n).round().clamp(0.0, 255.0) as u8;
             }
         }
     }

@@ -550,7 +550,8 @@ impl LaneTracker {
             .map(|&y| (new.col_at_row(y) - pred.col_at_row(y)).abs())
             .fold(0.0f64, f64::max);
         // The first update after an initialisation corrects the LS fit (P0) and is not gated.
-        if !lane.fresh && !(jump <= self.cfg.track.max_jump_px) {
+        let within = jump <= self.cfg.track.max_jump_px; // false for NaN too
+        if !lane.fresh && !within {
             self.counters.gated_jumps[i] += 1;
             lane.filter.clone_from(&lane.predicted);
             Self::miss(lane, &self.cfg);
@@ -685,9 +686,11 @@ impl LaneTracker {
             (0.5 * (top + bottom - 1) as f64, sep),
             ((bottom - 1) as f64, sep),
         ];
-        let crossed = rows
-            .iter()
-            .any(|&(y, s)| !(rf.col_at_row(y) - lf.col_at_row(y) >= s));
+        let crossed = rows.iter().any(|&(y, s)| {
+            (rf.col_at_row(y) - lf.col_at_row(y))
+                .partial_cmp(&s)
+                .is_none_or(|o| o.is_lt())
+        });
         if !crossed {
             return;
         }

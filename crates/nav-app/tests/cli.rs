@@ -1,0 +1,235 @@
+//! The `nav-app` binary end to end: JSON schema, overlays, bad input and exit codes.
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn nav_app(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_nav-app"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("nav-app-cli")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn fixture(rel: &str) -> String {
+    format!("{}/../../fixtures/{rel}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn with_no_input_it_runs_on_the_bundled_sample() {
+    let o = nav_app(&["--max-frames", "5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("bundled sample") && e.contains("5 frames"),
+        "{e}"
+    );
+    assert!(o.stdout.is_empty(), "human output goes to stderr");
+}
+
+#[test]
+fn json_is_one_object_per_frame_with_the_documented_schema() {
+    let o = nav_app(&[
+        "--input",
+        &fixture("synthetic/straight_solid.y4m"),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(o.stderr.is_empty(), "quiet under --json: {}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 24);
+    for (i, line) in lines.iter().enumerate() {
+        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+        assert_eq!(v["frame"].as_u64(), Some(i as u64));
+        assert!((v["t_s"].as_f64().unwrap() - i as f64 / 25.0).abs() < 1e-9);
+        let lanes = v["lanes"].as_array().unwrap();
+        assert_eq!(lanes.len(), 2);
+        assert_eq!(lanes[0]["side"], "left");
+        assert_eq!(lanes[1]["side"], "right");
+        for lane in lanes {
+            assert_eq!(lane["state"], "tracking");
+            assert_eq!(lane["coeffs"].as_array().unwrap().len(), 3);
+            assert_eq!(lane["rows"].as_array().unwrap().len(), 2);
+            assert!(lane["points"].as_u64().unwrap() > 0);
+        }
+    }
+}
+
+#[test]
+fn a_still_image_is_one_frame() {
+    let dir = scratch("still");
+    let png = dir.join("frame.png");
+    image::GrayImage::from_pixel(64, 48, image::Luma([90]))
+        .save(&png)
+        .unwrap();
+    let o = nav_app(&["--input", png.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(text.lines().count(), 1);
+    let v: serde_json::Value = serde_json::from_str(text.trim()).unwrap();
+    assert_eq!(v["lanes"][0]["state"], "initialising");
+    assert!(
+        v["lanes"][0]["coeffs"].is_null(),
+        "no lane on a blank frame: no coefficients"
+    );
+}
+
+#[test]
+fn overlays_are_written_as_pngs_or_a_colour_y4m() {
+    let dir = scratch("overlay");
+    let png_dir = dir.join("pngs");
+    let o = nav_app(&["--max-frames", "3", "--overlay", png_dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut files: Vec<_> = std::fs::read_dir(&png_dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 3);
+    let img = image::open(&files[1]).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (320, 240));
+    // The fitted parabolas are drawn in colour: some pixels are strongly red or blue.
+    let coloured = img
+        .pixels()
+        .filter(|p| p[0] > 200 && p[1] < 80 || p[2] > 200 && p[0] < 100)
+        .count();
+    assert!(coloured > 50, "{coloured} coloured pixels");
+
+    let y4m = dir.join("ov.y4m");
+    let o = nav_app(&["--max-frames", "4", "--overlay", y4m.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&y4m).unwrap();
+    assert!(bytes.starts_with(b"YUV4MPEG2 W320 H240"));
+    assert_eq!(
+        bytes.len(),
+        bytes.iter().position(|&b| b == b'\n').unwrap() + 1 + 4 * (6 + 320 * 240 * 3 / 2)
+    );
+}
+
+#[test]
+fn device_exits_non_zero_saying_capture_is_unavailable() {
+    let o = nav_app(&["--device", "/dev/video0"]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("not available in this build"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn fatal_bad_input_exits_non_zero_naming_the_file() {
+    let dir = scratch("fatal");
+    let bad_header = dir.join("bad_header.y4m");
+    std::fs::write(&bad_header, b"YUV4MPEG2 W320 Hx Cmono\n").unwrap();
+    let chroma = dir.join("chroma.y4m");
+    std::fs::write(&chroma, b"YUV4MPEG2 W4 H4 C422\nFRAME\n").unwrap();
+    let corrupt = dir.join("corrupt.png");
+    std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnope").unwrap();
+    let mixed = dir.join("mixed");
+    std::fs::create_dir_all(&mixed).unwrap();
+    std::fs::write(mixed.join("readme.md"), b"x").unwrap();
+    for (path, needle) in [
+        (&bad_header, "bad_header.y4m"),
+        (&chroma, "C422"),
+        (&corrupt, "corrupt.png"),
+        (&mixed, "readme.md"),
+    ] {
+        let o = nav_app(&["--input", path.to_str().unwrap()]);
+        assert!(!o.status.success(), "{}", path.display());
+        assert!(
+            stderr(&o).contains(needle),
+            "{}: {}",
+            path.display(),
+            stderr(&o)
+        );
+    }
+    let size_change = dir.join("size.y4m");
+    let mut s = b"YUV4MPEG2 W4 H4 Cmono\nFRAME\n".to_vec();
+    s.extend_from_slice(&[0; 16]);
+    s.extend_from_slice(b"YUV4MPEG2 W8 H4 Cmono\nFRAME\n");
+    s.extend_from_slice(&[0; 32]);
+    std::fs::write(&size_change, &s).unwrap();
+    let o = nav_app(&["--input", size_change.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("frame 1") && stderr(&o).contains("size changed"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn a_short_last_frame_is_reported_and_skipped_and_the_run_succeeds() {
+    let dir = scratch("short");
+    let mut bytes = std::fs::read(fixture("synthetic/straight_solid.y4m")).unwrap();
+    let frame_len = 6 + 320 * 240;
+    let header_len = bytes.iter().position(|&b| b == b'\n').unwrap() + 1;
+    bytes.truncate(header_len + 3 * frame_len + 1000);
+    let path = dir.join("short.y4m");
+    std::fs::write(&path, &bytes).unwrap();
+    let o = nav_app(&["--input", path.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        String::from_utf8(o.stdout.clone()).unwrap().lines().count(),
+        3
+    );
+    let e = stderr(&o);
+    assert!(
+        e.contains("frame 3") && e.contains("short frame") && e.contains("1 bad frames"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_bad_config_exits_non_zero_naming_the_field() {
+    let dir = scratch("config");
+    let text = std::fs::read_to_string(format!(
+        "{}/../../configs/outdoor.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+    .replace("r_sigma_px = 2.0", "r_sigma_px = -2.0");
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, text).unwrap();
+    let o = nav_app(&["--config", path.to_str().unwrap(), "--max-frames", "1"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("filter.r_sigma_px"), "{}", stderr(&o));
+}
+
+#[test]
+fn loop_repeats_a_file_up_to_max_frames() {
+    let o = nav_app(&[
+        "--input",
+        &fixture("synthetic/straight_solid.y4m"),
+        "--loop",
+        "--max-frames",
+        "60",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let frames: Vec<u64> = text
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<serde_json::Value>(l).unwrap()["frame"]
+                .as_u64()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(frames, (0..60).collect::<Vec<_>>());
+}
