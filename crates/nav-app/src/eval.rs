@@ -242,8 +242,8 @@ pub struct LabelScore {
 
 /// Score `report` against `label` (`width × height` instance image). Rows are scored every
 /// `row_step_px` from `first_row_px` down (TuSimple: 160, 170, … on 720-row frames); the label x
-/// of a lane at a row is the mean column of its pixels there. The ego lanes are the labelled
-/// lanes nearest the image centre at their lowest row, one on each side.
+/// of a lane at a row is the mean column of its pixels there. The ego lanes are, on each side of
+/// the image centre, the labelled lane whose pixels in the lower 40 % of the frame lie nearest it.
 pub fn score_against_instance_label(
     report: &crate::TrackReport,
     label: &crate::GreyFrame,
@@ -252,30 +252,25 @@ pub fn score_against_instance_label(
 ) -> LabelScore {
     let (w, h) = (label.width, label.height);
     let tol = tusimple_tolerance_px(w);
-    // Per instance grey level: lowest labelled row and its mean x.
-    let mut lowest: [(usize, f64); 256] = [(0, f64::NAN); 256];
-    for y in 0..h {
-        let row = &label.data[y * w..(y + 1) * w];
-        let mut sums = [(0.0f64, 0u32); 256];
-        for (x, &v) in row.iter().enumerate() {
+    // Per instance grey level: mean column of its pixels in the lower 40 % of the frame (lanes
+    // that end higher up are not ego lanes).
+    let mut sums = [(0.0f64, 0u64); 256];
+    for y in (h * 3 / 5)..h {
+        for (x, &v) in label.data[y * w..(y + 1) * w].iter().enumerate() {
             if v != 0 {
                 sums[usize::from(v)].0 += x as f64;
                 sums[usize::from(v)].1 += 1;
-            }
-        }
-        for (v, &(sx, n)) in sums.iter().enumerate() {
-            if n > 0 {
-                lowest[v] = (y, sx / f64::from(n));
             }
         }
     }
     let centre = w as f64 / 2.0;
     type Ego = Option<(u8, f64)>;
     let (mut left, mut right): (Ego, Ego) = (None, None);
-    for (v, &(_, x)) in lowest.iter().enumerate().skip(1) {
-        if x.is_nan() {
+    for (v, &(sx, n)) in sums.iter().enumerate().skip(1) {
+        if n == 0 {
             continue;
         }
+        let x = sx / n as f64;
         let d = (x - centre).abs();
         let slot = if x < centre { &mut left } else { &mut right };
         if slot.is_none_or(|(_, best)| d < best) {

@@ -201,11 +201,29 @@ pub struct LaneTracker {
     hough: HoughWorkspace,
     init_params: LaneInitParams,
     candidates: Vec<(f32, f32)>,
+    scratch: Vec<Candidate>,
     row_norm: RowNorm,
     q: ProcessNoise<3>,
     p0: ThetaCov,
     lanes: [Lane; 2],
     counters: TrackerCounters,
+}
+
+/// A window pixel during point selection.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    col_px: u16,
+    row_px: u16,
+    /// Residual `x − x̂(y)` rounded, plus the window half-width (0..=2w).
+    bin: u16,
+    /// Third of the ROI rows (0, 1, 2).
+    band: u8,
+}
+
+/// `a1·y² + a2·y + a3`.
+#[inline]
+fn eval_parabola([a1, a2, a3]: [f64; 3], y: f64) -> f64 {
+    (a1 * y + a2) * y + a3
 }
 
 /// Largest window half-width accepted by the configuration, px.
@@ -314,6 +332,7 @@ impl LaneTracker {
             hough,
             init_params,
             candidates: Vec::with_capacity(capacity),
+            scratch: Vec::with_capacity(capacity),
             row_norm,
             q,
             p0,
@@ -448,9 +467,10 @@ impl LaneTracker {
         let Some(filter) = lane.filter.as_mut() else {
             return Ok(());
         };
+        let coeffs = filter.coeffs();
         for (row, span) in lane.spans.iter_mut().enumerate() {
             *span = if row >= top && row < bottom {
-                let x = filter.col_at_row(row as f64);
+                let x = eval_parabola(coeffs, row as f64);
                 if x.is_finite() && x.abs() < 1e6 {
                     let c = x.round() as i64;
                     ColSpan::clamped(c - w, c + w + 1, self.width)
@@ -468,21 +488,31 @@ impl LaneTracker {
         // in three row bands; pixels farther than `inlier_half_width_px` from their band's
         // midhinge residual (mean of the quartiles) are dropped (clutter, noise, the edges of a shadow).
         const BANDS: usize = 3;
-        let mut hist = [[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS];
-        let band_of = |row: u16| {
-            ((usize::from(row).saturating_sub(top)) * BANDS / (bottom - top)).min(BANDS - 1)
-        };
+        let band_rows = [top + (bottom - top) / 3, top + 2 * (bottom - top) / 3];
         let w_us = w as usize;
-        let residual = |p: &vision_gradient::EdgePixel| -> i64 {
-            (f64::from(p.col_px) - filter.col_at_row(f64::from(p.row_px))).round() as i64
-        };
+        // One pass over the window pixels of the lane's class: residual bin (r + w, rounded;
+        // window pixels are within ±w of the prediction) and row band, histogrammed per band.
+        let mut hist = [[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS];
+        self.scratch.clear();
         for p in self.edges.iter_class(lane.class) {
-            let r = (residual(p) + w).clamp(0, 2 * w) as usize;
-            hist[band_of(p.row_px)][r] += 1;
+            let v = f64::from(p.col_px) - eval_parabola(coeffs, f64::from(p.row_px));
+            // Truncation of a non-negative value is floor: this rounds v to the nearest bin.
+            let bin = ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w_us);
+            let row = usize::from(p.row_px);
+            let band = usize::from(row >= band_rows[0]) + usize::from(row >= band_rows[1]);
+            hist[band][bin] += 1;
+            if self.scratch.len() < self.scratch.capacity() {
+                self.scratch.push(Candidate {
+                    col_px: p.col_px,
+                    row_px: p.row_px,
+                    bin: bin as u16,
+                    band: band as u8,
+                });
+            }
         }
         // Band centre = midhinge (mean of the quartiles): with the two edges of a mark it
         // lands between them, where a median would pick one edge.
-        let mut median = [0i64; BANDS];
+        let mut centre = [w; BANDS];
         for (b, h) in hist.iter().enumerate() {
             let n: u32 = h[..=2 * w_us].iter().sum();
             if n == 0 {
@@ -501,29 +531,19 @@ impl LaneTracker {
                 }
             }
             if let (Some(a), Some(c)) = (r1, r3) {
-                median[b] = (a + c).div_euclid(2) - w;
+                centre[b] = (a + c).div_euclid(2);
             }
         }
         let inlier = self.cfg.track.inlier_half_width_px;
-        let is_inlier = |p: &vision_gradient::EdgePixel| {
-            (residual(p) - median[band_of(p.row_px)]).abs() as f64 <= inlier
-        };
+        let is_inlier =
+            |c: &Candidate| (i64::from(c.bin) - centre[usize::from(c.band)]).abs() as f64 <= inlier;
         // Uniform decimation of the row-ordered inliers down to max_points: spreads the points
         // over the rows in proportion to the edge density, and over both edges of a mark.
-        let total = self
-            .edges
-            .iter_class(lane.class)
-            .filter(|p| is_inlier(p))
-            .count();
+        let total = self.scratch.iter().filter(|c| is_inlier(c)).count();
         lane.points.clear();
-        for (j, p) in self
-            .edges
-            .iter_class(lane.class)
-            .filter(|p| is_inlier(p))
-            .enumerate()
-        {
+        for (j, c) in self.scratch.iter().filter(|c| is_inlier(c)).enumerate() {
             if total <= max_points || (j + 1) * max_points / total > j * max_points / total {
-                lane.points.push((f32::from(p.col_px), f32::from(p.row_px)));
+                lane.points.push((f32::from(c.col_px), f32::from(c.row_px)));
             }
         }
         if lane.points.len() < self.cfg.track.reinit_min_points {
