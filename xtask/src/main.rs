@@ -8,6 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
 mod fixtures;
+mod monte_carlo;
 mod regress;
 mod vivid;
 
@@ -28,6 +29,8 @@ enum Cmd {
     Fixtures(fixtures::FixturesArgs),
     /// Run the lane tracker over every fixture and compare with the recorded expectations.
     Regress(regress::RegressArgs),
+    /// The paper's Monte Carlo experiment (stand-alone, KF, AKF): summaries, CSV, Figs. 1–6; `merge` combines shards.
+    MonteCarlo(monte_carlo::MonteCarloArgs),
 }
 
 fn main() -> Result<()> {
@@ -36,6 +39,7 @@ fn main() -> Result<()> {
         Cmd::Vivid(args) => vivid::run(args),
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
+        Cmd::MonteCarlo(args) => monte_carlo::run(args),
     }
 }
 

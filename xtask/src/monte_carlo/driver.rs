@@ -1,0 +1,206 @@
+//! Runs the simulations of one shard on a rayon pool and folds them, in run-index order, into
+//! [`ModeStats`].
+//!
+//! Run indices are processed in blocks of `16 × threads`: the runs of a block (all modes) are
+//! simulated in parallel, each into its own record buffer, then folded sequentially in
+//! (index, mode) order. The statistics are therefore bit-identical for any thread count, and
+//! memory stays bounded (one block of records) however many runs a shard holds.
+
+use std::io::IsTerminal;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use nav_app::ins_sd::{Mode, RunError, RunOutcome, Sample};
+use rayon::prelude::*;
+
+use super::stats::{Exclusion, ModeStats};
+
+/// What to simulate.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// Modes, in report order.
+    pub modes: Vec<Mode>,
+    /// Records per run (duration + 1).
+    pub samples: usize,
+    /// Half-open range of run indices.
+    pub range: (u64, u64),
+    /// Worker threads (≥ 1).
+    pub threads: usize,
+    /// Draw a progress bar on stderr if it is a terminal.
+    pub progress: bool,
+}
+
+/// The result of simulating a shard.
+#[derive(Clone, Debug)]
+pub struct Simulated {
+    /// Per mode, in `Plan::modes` order.
+    pub modes: Vec<ModeStats>,
+    /// Runs left out, in (index, mode) order.
+    pub exclusions: Vec<Exclusion>,
+    /// Wall time of the simulation, s.
+    pub wall_s: f64,
+}
+
+struct Job {
+    index: u64,
+    mode_slot: usize,
+    samples: Vec<Sample>,
+    result: Result<RunOutcome, RunError>,
+    elapsed_s: f64,
+}
+
+/// First record holding a non-finite value, with the field's name.
+pub fn first_non_finite(samples: &[Sample]) -> Option<(f64, &'static str)> {
+    for s in samples {
+        let checks: [(&'static str, bool); 6] = [
+            (
+                "position error",
+                s.pos_err_ned_m.iter().all(|x| x.is_finite()),
+            ),
+            (
+                "velocity error",
+                s.vel_err_ned_mps.iter().all(|x| x.is_finite()),
+            ),
+            (
+                "misalignment",
+                s.misalignment_rad.iter().all(|x| x.is_finite()),
+            ),
+            ("distance", s.distance_m.is_finite()),
+            ("NEES", s.nees.is_none_or(f64::is_finite)),
+            ("NIS", s.nis.is_none_or(f64::is_finite)),
+        ];
+        if let Some((what, _)) = checks.iter().find(|(_, ok)| !ok) {
+            return Some((s.t_s, what));
+        }
+    }
+    None
+}
+
+/// Simulates `plan.range` × `plan.modes` with `runner(mode, index, out)` and folds the records.
+///
+/// Runs that fail ([`RunError::NonFinite`], a sighting or filter failure, …) or return a
+/// non-finite record are excluded from the mode's statistics and listed (index, time, reason);
+/// they are also reported on stderr as they happen. An invalid scenario or a wrong buffer
+/// length aborts the whole simulation (these are not properties of one run).
+pub fn simulate<F>(plan: &Plan, runner: F) -> Result<Simulated>
+where
+    F: Fn(Mode, u64, &mut [Sample]) -> Result<RunOutcome, RunError> + Sync,
+{
+    if plan.threads == 0 {
+        bail!("--threads must be at least 1");
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(plan.threads)
+        .build()
+        .context("could not build the rayon thread pool")?;
+    let (lo, hi) = plan.range;
+    let total_jobs = (hi - lo) * plan.modes.len() as u64;
+    let bar = if plan.progress && std::io::stderr().is_terminal() {
+        let bar = ProgressBar::with_draw_target(Some(total_jobs), ProgressDrawTarget::stderr());
+        if let Ok(style) =
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} runs, ETA {eta}")
+        {
+            bar.set_style(style);
+        }
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+
+    let mut modes: Vec<ModeStats> = plan
+        .modes
+        .iter()
+        .map(|&m| ModeStats::new(m, plan.samples))
+        .collect();
+    let mut exclusions = Vec::new();
+    let block = 16 * plan.threads as u64;
+    let start = Instant::now();
+    let mut block_lo = lo;
+    while block_lo < hi {
+        let block_hi = (block_lo + block).min(hi);
+        let jobs: Vec<(u64, usize)> = (block_lo..block_hi)
+            .flat_map(|i| (0..plan.modes.len()).map(move |m| (i, m)))
+            .collect();
+        let done: Vec<Job> = pool.install(|| {
+            jobs.par_iter()
+                .map(|&(index, mode_slot)| {
+                    let mut samples = vec![Sample::default(); plan.samples];
+                    let t0 = Instant::now();
+                    let result = runner(plan.modes[mode_slot], index, &mut samples);
+                    let elapsed_s = t0.elapsed().as_secs_f64();
+                    bar.inc(1);
+                    Job {
+                        index,
+                        mode_slot,
+                        samples,
+                        result,
+                        elapsed_s,
+                    }
+                })
+                .collect()
+        });
+        for job in done {
+            let stats = &mut modes[job.mode_slot];
+            stats.run_time_s += job.elapsed_s;
+            let mode = plan.modes[job.mode_slot].name().to_string();
+            let excluded = match job.result {
+                Ok(outcome) => {
+                    stats.epochs += outcome.epochs;
+                    if outcome.samples_written != plan.samples {
+                        Some((
+                            None,
+                            format!(
+                                "run wrote {} of {} records",
+                                outcome.samples_written, plan.samples
+                            ),
+                        ))
+                    } else {
+                        first_non_finite(&job.samples).map(|(t, what)| {
+                            (Some(t), format!("non-finite {what} in the 1 Hz record"))
+                        })
+                    }
+                }
+                Err(e @ (RunError::Scenario(_) | RunError::OutputLength { .. })) => {
+                    bar.finish_and_clear();
+                    return Err(anyhow::Error::new(e)
+                        .context(format!("run {} ({mode}) could not start", job.index)));
+                }
+                Err(e) => {
+                    let t = match &e {
+                        RunError::NonFinite { t_s, .. }
+                        | RunError::Sighting { t_s, .. }
+                        | RunError::Filter { t_s, .. } => Some(*t_s),
+                        _ => None,
+                    };
+                    Some((t, e.to_string()))
+                }
+            };
+            match excluded {
+                None => stats.push_run(&job.samples),
+                Some((t_s, reason)) => {
+                    bar.suspend(|| {
+                        eprintln!(
+                            "monte-carlo: run {} ({mode}) excluded{}: {reason}",
+                            job.index,
+                            t_s.map_or(String::new(), |t| format!(" at t = {t} s"))
+                        );
+                    });
+                    exclusions.push(Exclusion {
+                        mode,
+                        run_index: job.index,
+                        t_s,
+                        reason,
+                    });
+                }
+            }
+        }
+        block_lo = block_hi;
+    }
+    bar.finish_and_clear();
+    Ok(Simulated {
+        modes,
+        exclusions,
+        wall_s: start.elapsed().as_secs_f64(),
+    })
+}

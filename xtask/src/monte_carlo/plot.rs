@@ -1,0 +1,219 @@
+//! Figures equivalent to the paper's Figs. 1–6 (mean and σ over runs of the position and
+//! misalignment errors vs time, per configuration), as SVG and PNG, drawn with plotters.
+//!
+//! Text needs a font: plotters' `ab_glyph` feature with DejaVu Sans bundled in
+//! `xtask/assets/` (Bitstream Vera licence, `DejaVuSans-LICENSE.txt` beside it), so the PNGs
+//! and the SVGs carry the same labels and no system font is looked up. PNGs are rendered into
+//! an RGB buffer (plotters' bitmap backend without its own encoder) and encoded with the
+//! workspace's `image` crate.
+
+use std::error::Error;
+use std::sync::Once;
+
+use anyhow::{Result, anyhow};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+
+use super::stats::{ModeStats, Stats, qi};
+
+static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+static REGISTER: Once = Once::new();
+
+const W: u32 = 1000;
+const H: u32 = 760;
+
+/// Mean or σ figure.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Kind {
+    /// Mean over runs (paper Figs. 1–3).
+    Mean,
+    /// Standard deviation over runs (paper Figs. 4–6).
+    Sigma,
+}
+
+/// The paper's figure number for (mode, kind): 1 stand-alone, 2 AKF, 3 KF (means); 4–6 σ.
+pub fn figure_number(mode: &str, kind: Kind) -> Option<u32> {
+    let base = match mode {
+        "standalone" => 1,
+        "akf" => 2,
+        "kf" => 3,
+        _ => return None,
+    };
+    Some(if kind == Kind::Mean { base } else { base + 3 })
+}
+
+fn register_font() -> Result<()> {
+    let mut err = None;
+    REGISTER.call_once(|| {
+        if plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_err() {
+            err = Some(anyhow!("the bundled DejaVu Sans font could not be parsed"));
+        }
+    });
+    err.map_or(Ok(()), Err)
+}
+
+type Series = (&'static str, RGBColor, Vec<(f64, f64)>);
+
+fn series(m: &ModeStats, kind: Kind, qs: [usize; 3], scale: f64) -> Vec<Series> {
+    let names = ["N", "E", "D"];
+    let colours = [
+        RGBColor(0, 90, 180),
+        RGBColor(220, 80, 0),
+        RGBColor(0, 150, 60),
+    ];
+    (0..3)
+        .map(|k| {
+            let pts = m
+                .bins
+                .iter()
+                .enumerate()
+                .map(|(t, b)| {
+                    let v = match kind {
+                        Kind::Mean => b[qs[k]].mean(),
+                        Kind::Sigma => b[qs[k]].std_dev(),
+                    };
+                    (t as f64, scale * v)
+                })
+                .filter(|(_, v)| v.is_finite())
+                .collect();
+            (names[k], colours[k], pts)
+        })
+        .collect()
+}
+
+fn y_range(all: &[Series]) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (_, _, pts) in all {
+        for &(_, y) in pts {
+            lo = lo.min(y);
+            hi = hi.max(y);
+        }
+    }
+    if !lo.is_finite() || !hi.is_finite() {
+        return (-1.0, 1.0);
+    }
+    let pad = 0.05 * (hi - lo).max(1e-9 * hi.abs().max(1e-9));
+    (lo - pad, hi + pad)
+}
+
+fn panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+    y_desc: &str,
+    t_end: f64,
+    data: &[Series],
+) -> Result<(), Box<dyn Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let (lo, hi) = y_range(data);
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..t_end.max(1.0), lo..hi)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc(y_desc)
+        .label_style(("sans-serif", 14))
+        .draw()?;
+    for (name, colour, pts) in data {
+        let c = *colour;
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))?
+            .label(*name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()?;
+    Ok(())
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    m: &ModeStats,
+    kind: Kind,
+    title: &str,
+) -> Result<(), Box<dyn Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let t_end = m.bins.len().saturating_sub(1) as f64;
+    let (upper, lower) = root.split_vertically(H / 2);
+    let what = if kind == Kind::Mean { "mean" } else { "σ" };
+    panel(
+        &upper,
+        &format!("{title}: position error, {what} over runs"),
+        "position error (m)",
+        t_end,
+        &series(m, kind, [qi::POS_N, qi::POS_E, qi::POS_D], 1.0),
+    )?;
+    panel(
+        &lower,
+        &format!("{title}: misalignment ψ, {what} over runs"),
+        "misalignment (mrad)",
+        t_end,
+        &series(m, kind, [qi::PSI_N, qi::PSI_E, qi::PSI_D], 1e3),
+    )?;
+    root.present()?;
+    Ok(())
+}
+
+/// One figure as (SVG text, PNG bytes).
+pub fn figure(m: &ModeStats, kind: Kind, runs: u64) -> Result<(String, Vec<u8>)> {
+    register_font()?;
+    let label = match m.mode.as_str() {
+        "standalone" => "Stand-alone INS",
+        "kf" => "INS/SD, manually tuned KF",
+        "akf" => "INS/SD, adaptive KF",
+        other => other,
+    };
+    let title = format!("{label} ({runs} runs)");
+    let mut svg = String::new();
+    draw(
+        SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area(),
+        m,
+        kind,
+        &title,
+    )
+    .map_err(|e| anyhow!("SVG figure for {}: {e}", m.mode))?;
+    let mut rgb = vec![0u8; (W * H * 3) as usize];
+    draw(
+        BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area(),
+        m,
+        kind,
+        &title,
+    )
+    .map_err(|e| anyhow!("PNG figure for {}: {e}", m.mode))?;
+    let img = image::RgbImage::from_raw(W, H, rgb)
+        .ok_or_else(|| anyhow!("PNG buffer has the wrong size"))?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    Ok((svg, png))
+}
+
+/// All figures: `(file name, bytes)`, e.g. `fig3_kf_mean.svg`.
+pub fn figures(stats: &Stats) -> Result<Vec<(String, Vec<u8>)>> {
+    let mut out = Vec::new();
+    for m in &stats.modes {
+        for kind in [Kind::Mean, Kind::Sigma] {
+            let Some(n) = figure_number(&m.mode, kind) else {
+                continue;
+            };
+            let suffix = if kind == Kind::Mean { "mean" } else { "sigma" };
+            let stem = format!("fig{n}_{}_{suffix}", m.mode);
+            let (svg, png) = figure(m, kind, m.runs_used)?;
+            out.push((format!("{stem}.svg"), svg.into_bytes()));
+            out.push((format!("{stem}.png"), png));
+        }
+    }
+    Ok(out)
+}

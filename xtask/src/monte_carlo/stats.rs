@@ -1,0 +1,351 @@
+//! Mergeable Monte Carlo statistics: per mode, per 1 Hz time bin, per quantity the count, Σx
+//! and Σx² over the runs that were kept.
+//!
+//! Sums are exactly associative up to floating-point round-off, so the statistics of shards
+//! added together equal those of one run over all indices to round-off (tested). Within one
+//! process the per-run records are folded in run-index order (see `driver`), so the result
+//! does not depend on the thread count either (bit-identical, tested).
+
+use nav_app::ins_sd::{Mode, Sample};
+use serde::{Deserialize, Serialize};
+
+/// Number of accumulated quantities per time bin.
+pub const Q: usize = 14;
+
+/// Index of each accumulated quantity in a bin.
+pub mod qi {
+    /// Position error N, m.
+    pub const POS_N: usize = 0;
+    /// Position error E, m.
+    pub const POS_E: usize = 1;
+    /// Position error D, m.
+    pub const POS_D: usize = 2;
+    /// Horizontal position error √(N² + E²), m.
+    pub const POS_H: usize = 3;
+    /// 3-D position error |δp|, m.
+    pub const POS_3D: usize = 4;
+    /// Velocity error N, m/s.
+    pub const VEL_N: usize = 5;
+    /// Velocity error E, m/s.
+    pub const VEL_E: usize = 6;
+    /// Velocity error D, m/s.
+    pub const VEL_D: usize = 7;
+    /// Misalignment ψ N, rad.
+    pub const PSI_N: usize = 8;
+    /// Misalignment ψ E, rad.
+    pub const PSI_E: usize = 9;
+    /// Misalignment ψ D (azimuth), rad.
+    pub const PSI_D: usize = 10;
+    /// True distance flown, m.
+    pub const DIST: usize = 11;
+    /// NEES (15 states), filters at SD epochs only.
+    pub const NEES: usize = 12;
+    /// NIS (6 measurements), filters at SD epochs only.
+    pub const NIS: usize = 13;
+}
+
+/// Count, Σx and Σx² of one quantity in one time bin.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Moments {
+    /// Number of values.
+    pub n: u64,
+    /// Σx.
+    pub sum: f64,
+    /// Σx².
+    pub sum_sq: f64,
+}
+
+impl Moments {
+    /// Adds one value.
+    pub fn push(&mut self, x: f64) {
+        self.n += 1;
+        self.sum += x;
+        self.sum_sq += x * x;
+    }
+
+    /// Adds another accumulator (merge).
+    pub fn merge(&mut self, other: &Moments) {
+        self.n += other.n;
+        self.sum += other.sum;
+        self.sum_sq += other.sum_sq;
+    }
+
+    /// Mean (NaN when empty).
+    pub fn mean(&self) -> f64 {
+        if self.n == 0 {
+            f64::NAN
+        } else {
+            self.sum / self.n as f64
+        }
+    }
+
+    /// Sample standard deviation over runs (divisor n − 1; 0 for one value, NaN when empty).
+    /// Σx² − n·mean² is clamped at 0 against round-off.
+    pub fn std_dev(&self) -> f64 {
+        match self.n {
+            0 => f64::NAN,
+            1 => 0.0,
+            n => {
+                let n = n as f64;
+                let m = self.sum / n;
+                ((self.sum_sq - n * m * m).max(0.0) / (n - 1.0)).sqrt()
+            }
+        }
+    }
+
+    /// Root mean square √(Σx²/n) (NaN when empty).
+    pub fn rms(&self) -> f64 {
+        if self.n == 0 {
+            f64::NAN
+        } else {
+            (self.sum_sq / self.n as f64).sqrt()
+        }
+    }
+}
+
+/// Statistics of one mode over the runs kept.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModeStats {
+    /// Mode name (`standalone`, `kf`, `akf`).
+    pub mode: String,
+    /// Runs kept (finite throughout).
+    pub runs_used: u64,
+    /// 100 Hz INS epochs simulated by all runs attempted (kept or not).
+    pub epochs: u64,
+    /// Σ over runs of the run's own wall time, s (CPU time per core, approximately).
+    pub run_time_s: f64,
+    /// One entry per 1 Hz record (t = 0, 1, …, duration), quantities in [`qi`] order.
+    pub bins: Vec<[Moments; Q]>,
+}
+
+impl ModeStats {
+    /// Empty statistics for `mode` with `samples` time bins.
+    pub fn new(mode: Mode, samples: usize) -> Self {
+        Self {
+            mode: mode.name().to_string(),
+            runs_used: 0,
+            epochs: 0,
+            run_time_s: 0.0,
+            bins: vec![[Moments::default(); Q]; samples],
+        }
+    }
+
+    /// Adds one finite run's records (length = number of bins, checked by the caller).
+    pub fn push_run(&mut self, samples: &[Sample]) {
+        self.runs_used += 1;
+        for (bin, s) in self.bins.iter_mut().zip(samples) {
+            let [n, e, d] = s.pos_err_ned_m;
+            let h = n.hypot(e);
+            let values = [
+                (qi::POS_N, n),
+                (qi::POS_E, e),
+                (qi::POS_D, d),
+                (qi::POS_H, h),
+                (qi::POS_3D, h.hypot(d)),
+                (qi::VEL_N, s.vel_err_ned_mps[0]),
+                (qi::VEL_E, s.vel_err_ned_mps[1]),
+                (qi::VEL_D, s.vel_err_ned_mps[2]),
+                (qi::PSI_N, s.misalignment_rad[0]),
+                (qi::PSI_E, s.misalignment_rad[1]),
+                (qi::PSI_D, s.misalignment_rad[2]),
+                (qi::DIST, s.distance_m),
+            ];
+            for (i, x) in values {
+                bin[i].push(x);
+            }
+            if let Some(x) = s.nees {
+                bin[qi::NEES].push(x);
+            }
+            if let Some(x) = s.nis {
+                bin[qi::NIS].push(x);
+            }
+        }
+    }
+
+    /// Adds another mode's statistics (same mode and bin count, checked by the caller).
+    pub fn merge(&mut self, other: &ModeStats) {
+        self.runs_used += other.runs_used;
+        self.epochs += other.epochs;
+        self.run_time_s += other.run_time_s;
+        for (a, b) in self.bins.iter_mut().zip(&other.bins) {
+            for (x, y) in a.iter_mut().zip(b) {
+                x.merge(y);
+            }
+        }
+    }
+}
+
+/// A run left out of the statistics of one mode, and why.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Exclusion {
+    /// Mode name.
+    pub mode: String,
+    /// Run index (0-based, over all shards).
+    pub run_index: u64,
+    /// Time at which the run failed or first held a non-finite record, s (if known).
+    pub t_s: Option<f64>,
+    /// What happened.
+    pub reason: String,
+}
+
+/// Which slice of the run indices a statistics file covers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ShardInfo {
+    /// Shard number, 1-based.
+    pub index: u64,
+    /// Number of shards.
+    pub count: u64,
+}
+
+/// Everything needed to produce the reports: written as `stats.json` by every run (shard or
+/// not) and read back by `merge`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Stats {
+    /// File format tag.
+    pub format: String,
+    /// FNV-1a hash of the scenario (shards must agree).
+    pub scenario_fingerprint: String,
+    /// Where the scenario came from (path, or "built-in paper default").
+    pub scenario_source: String,
+    /// `Scenario::assumptions()`.
+    pub assumptions: Vec<String>,
+    /// Flight duration, s.
+    pub duration_s: f64,
+    /// Master seed.
+    pub seed: u64,
+    /// Runs per mode over all shards.
+    pub runs_total: u64,
+    /// Run indices covered by the shards merged here: half-open ranges, sorted.
+    pub run_ranges: Vec<(u64, u64)>,
+    /// Shards merged into this file (one entry for a single run).
+    pub shards: Vec<ShardInfo>,
+    /// Per mode, in `Mode::ALL` order.
+    pub modes: Vec<ModeStats>,
+    /// Runs left out, sorted by mode then index.
+    pub exclusions: Vec<Exclusion>,
+    /// Σ over shards of the wall time of the simulation phase, s.
+    pub wall_s: f64,
+    /// Σ over shards of thread count × wall time, core·s.
+    pub core_s: f64,
+}
+
+/// The format tag of `stats.json`.
+pub const FORMAT: &str = "ita-nav-monte-carlo-stats/1";
+
+/// FNV-1a 64 of a string, as 16 hex digits.
+pub fn fingerprint(text: &str) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+impl Stats {
+    /// Statistics of one mode by name.
+    pub fn mode(&self, name: &str) -> Option<&ModeStats> {
+        self.modes.iter().find(|m| m.mode == name)
+    }
+
+    /// Runs covered (Σ of the range lengths).
+    pub fn runs_covered(&self) -> u64 {
+        self.run_ranges.iter().map(|(a, b)| b - a).sum()
+    }
+}
+
+/// Merges shard statistics (any order) into one. Checks that they describe the same scenario,
+/// seed and total run count and that their run ranges are disjoint; sums in the order of the
+/// ranges' starts.
+pub fn merge(mut parts: Vec<Stats>) -> anyhow::Result<Stats> {
+    use anyhow::{bail, ensure};
+    ensure!(!parts.is_empty(), "merge: no statistics to merge");
+    parts.sort_by_key(|p| p.run_ranges.first().map_or(0, |r| r.0));
+    let first = parts[0].clone();
+    for p in &parts {
+        ensure!(
+            p.format == FORMAT,
+            "merge: format `{}` is not `{FORMAT}`",
+            p.format
+        );
+        ensure!(
+            p.scenario_fingerprint == first.scenario_fingerprint,
+            "merge: shards come from different scenarios (fingerprint {} vs {})",
+            p.scenario_fingerprint,
+            first.scenario_fingerprint
+        );
+        ensure!(
+            p.seed == first.seed,
+            "merge: different master seeds ({} vs {})",
+            p.seed,
+            first.seed
+        );
+        ensure!(
+            p.runs_total == first.runs_total,
+            "merge: different total run counts ({} vs {})",
+            p.runs_total,
+            first.runs_total
+        );
+        ensure!(
+            p.modes.len() == first.modes.len()
+                && p.modes
+                    .iter()
+                    .zip(&first.modes)
+                    .all(|(a, b)| a.mode == b.mode && a.bins.len() == b.bins.len()),
+            "merge: shards hold different modes or durations"
+        );
+    }
+    let mut out = first;
+    for p in &parts[1..] {
+        for (a, b) in out.modes.iter_mut().zip(&p.modes) {
+            a.merge(b);
+        }
+        out.run_ranges.extend_from_slice(&p.run_ranges);
+        out.shards.extend_from_slice(&p.shards);
+        out.exclusions.extend_from_slice(&p.exclusions);
+        out.wall_s += p.wall_s;
+        out.core_s += p.core_s;
+    }
+    out.run_ranges.sort_unstable();
+    for w in out.run_ranges.windows(2) {
+        if w[1].0 < w[0].1 {
+            bail!(
+                "merge: run ranges {}..{} and {}..{} overlap (the same shard given twice?)",
+                w[0].0,
+                w[0].1,
+                w[1].0,
+                w[1].1
+            );
+        }
+    }
+    out.shards.sort_by_key(|s| s.index);
+    out.exclusions.sort_by(|a, b| {
+        let rank = |m: &str| Mode::ALL.iter().position(|x| x.name() == m);
+        (rank(&a.mode), a.run_index).cmp(&(rank(&b.mode), b.run_index))
+    });
+    Ok(out)
+}
+
+/// Run indices of shard `index` (1-based) of `count` over `runs`: a contiguous slice, sizes
+/// differing by at most one.
+pub fn shard_range(runs: u64, index: u64, count: u64) -> (u64, u64) {
+    let lo = (index - 1) * runs / count;
+    let hi = index * runs / count;
+    (lo, hi)
+}
+
+/// Missing run indices (as ranges) of a merged file.
+pub fn missing_ranges(stats: &Stats) -> Vec<(u64, u64)> {
+    let mut missing = Vec::new();
+    let mut next = 0;
+    for &(a, b) in &stats.run_ranges {
+        if a > next {
+            missing.push((next, a));
+        }
+        next = next.max(b);
+    }
+    if next < stats.runs_total {
+        missing.push((next, stats.runs_total));
+    }
+    missing
+}

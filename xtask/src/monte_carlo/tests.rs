@@ -1,0 +1,1 @@
+//! Tests of the Monte Carlo driver, statistics and reports.
