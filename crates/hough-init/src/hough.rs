@@ -9,6 +9,13 @@ pub const MAX_IMAGE_SIDE_PX: usize = 1 << 14;
 /// Points converted to centred `f32` coordinates at a time while voting.
 const VOTE_CHUNK: usize = 256;
 
+/// 1.5·2²³: adding it to an `f32` in `[0, 2²²)` leaves the value rounded to the nearest
+/// integer in the low 22 mantissa bits.
+const ROUND_MAGIC: f32 = 12_582_912.0;
+// Every shifted ρ index stays below 2²²: rho_bins ≤ 2·(hypot(W/2, H/2)/Δρ + 2) + 1 with
+// hypot(W/2, H/2) ≤ MAX_IMAGE_SIDE_PX and Δρ ≥ 0.1 px.
+const _: () = assert!(MAX_IMAGE_SIDE_PX * 20 + 5 < 1 << 22);
+
 /// Largest accepted accumulator, cells (`u32` each).
 pub const MAX_ACCUMULATOR_CELLS: usize = 1 << 25;
 
@@ -272,9 +279,8 @@ impl HoughWorkspace {
         let nr = self.rho_bins;
         let cx = self.center_col_px;
         let cy = self.center_row_px;
-        // +0.5 turns the truncating cast into round-to-nearest; all values are positive
-        // because |ρ_c/Δρ| ≤ rho_zero_bin − 1 for in-image points.
-        let offset = self.rho_zero_bin as f32 + 0.5;
+        // All shifted values are positive: |ρ_c/Δρ| ≤ rho_zero_bin − 1 for in-image points.
+        let offset = self.rho_zero_bin as f32;
         self.acc[k0 * nr..(k1 + 1) * nr].fill(0);
         // Points are processed in stack-sized chunks of centred f32 coordinates, so the
         // per-vote work is a multiply-add, a conversion and an increment (no heap buffer).
@@ -291,7 +297,9 @@ impl HoughWorkspace {
                 let c = self.cos_over_step[k];
                 let s = self.sin_over_step[k];
                 for ((j, &x), &y) in idx[..m].iter_mut().zip(&xs[..m]).zip(&ys[..m]) {
-                    *j = (x * c + y * s + offset) as i32 as u32;
+                    // Round to nearest by the float-magic trick (branch-free, vectorises):
+                    // for 0 ≤ v < 2²², the low mantissa bits of v + 1.5·2²³ are round(v).
+                    *j = (x * c + y * s + offset + ROUND_MAGIC).to_bits() & 0x003F_FFFF;
                 }
                 let row = &mut self.acc[k * nr..(k + 1) * nr];
                 for &j in &idx[..m] {
