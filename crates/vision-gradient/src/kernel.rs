@@ -11,8 +11,11 @@ pub(crate) const BAND_SCALE: f64 = 16384.0;
 /// Columns processed per chunk (stack buffers, so any width works without allocation).
 const CHUNK: usize = 512;
 
-/// Number of histogram bins: one per magnitude value `0..=2040`.
-pub(crate) const HIST_BINS: usize = MAX_MAGNITUDE as usize + 1;
+/// Number of histogram bins: one per magnitude value `0..=2040`, rounded up to a power of two.
+pub(crate) const HIST_BINS: usize = (MAX_MAGNITUDE as usize + 1).next_power_of_two();
+
+/// First of four spare histogram bins (above any magnitude) that absorb uncounted pixels.
+pub(crate) const SPARE_BIN: usize = MAX_MAGNITUDE as usize + 1;
 
 /// Fixed-point orientation band: keep iff
 /// `|gx|·cos_min ≥ |gy|·sin_min` (α ≥ α_min) and `|gx|·cos_max ≤ |gy|·sin_max` (α ≤ α_max),
@@ -50,8 +53,13 @@ pub(crate) enum CheckedRegion<'a> {
 
 /// What a pass does with its kept pixels.
 pub(crate) enum Sink<'s> {
-    /// Count the magnitudes of kept pixels (four interleaved histograms, summed by the caller).
-    Histogram(&'s mut [[u32; HIST_BINS]; 4]),
+    /// Count the kept pixels (`in_band`) and histogram the magnitudes of those at or above
+    /// `floor` (four interleaved histograms, summed by the caller).
+    Histogram {
+        hists: &'s mut [[u32; HIST_BINS]; 4],
+        floor: u16,
+        in_band: usize,
+    },
     /// Store kept pixels, optionally paint the class image, count classes.
     Emit {
         edges: &'s mut EdgeBuffer,
@@ -278,27 +286,40 @@ fn pass_impl(
 #[inline(always)]
 fn consume(sink: &mut Sink<'_>, r: usize, c: usize, mag: &[u16], cls: &[u8], w: usize) {
     match sink {
-        Sink::Histogram(hists) => {
-            // Branch-free: dropped pixels go to bin 0, which no in-band pixel can reach
-            // (gx, gy != 0 implies magnitude >= 2); the caller ignores bin 0. Four interleaved
-            // histograms break the store-to-load dependency on popular bins.
+        Sink::Histogram {
+            hists,
+            floor,
+            in_band,
+        } => {
+            // Count every in-band pixel; histogram only those at or above `floor` (the others
+            // cannot move the threshold above the floor, they only count in N). Branch-free:
+            // compact the magnitudes first, then scatter into four interleaved histograms
+            // (breaks the store-to-load dependency on popular bins).
+            *in_band += cls.iter().map(|&k| u32::from(k != 0)).sum::<u32>() as usize;
+            // Pixels not to be counted go to spare bins 2041..=2044 (above MAX_MAGNITUDE,
+            // cleared by the caller), rotated so no single bin forms a long dependency chain.
+            let floor = *floor;
             let [h0, h1, h2, h3] = &mut **hists;
-            let idx = |k: u8, m: u16| usize::from(m) & 0usize.wrapping_sub(usize::from(k != 0));
-            let mut kc = cls.chunks_exact(4);
-            let mut mc = mag.chunks_exact(4);
-            for (k, m) in kc.by_ref().zip(mc.by_ref()) {
-                for (h, j) in [(&mut *h0, 0), (&mut *h1, 1), (&mut *h2, 2), (&mut *h3, 3)] {
-                    if let (Some(&kk), Some(&mm)) = (k.get(j), m.get(j))
-                        && let Some(bin) = h.get_mut(idx(kk, mm))
-                    {
-                        *bin += 1;
-                    }
-                }
+            let bin = |k: u8, m: u16, spare: usize| {
+                let sel = (k != 0) & (m >= floor);
+                // `& (HIST_BINS - 1)`: m <= 2040 < HIST_BINS; the mask only spares a bounds check.
+                (if sel {
+                    usize::from(m)
+                } else {
+                    SPARE_BIN + spare
+                }) & (HIST_BINS - 1)
+            };
+            let mut kq = cls.chunks_exact(4);
+            let mut mq = mag.chunks_exact(4);
+            for (q, (k, m)) in kq.by_ref().zip(mq.by_ref()).enumerate() {
+                let spare = q & 3;
+                h0[bin(k[0], m[0], spare)] += 1;
+                h1[bin(k[1], m[1], spare)] += 1;
+                h2[bin(k[2], m[2], spare)] += 1;
+                h3[bin(k[3], m[3], spare)] += 1;
             }
-            for (&k, &m) in kc.remainder().iter().zip(mc.remainder()) {
-                if let Some(bin) = h0.get_mut(idx(k, m)) {
-                    *bin += 1;
-                }
+            for (&k, &m) in kq.remainder().iter().zip(mq.remainder()) {
+                h0[bin(k, m, 0)] += 1;
             }
         }
         Sink::Emit {

@@ -54,11 +54,12 @@
 //!
 //! ## Threshold
 //! * [`Threshold::Fixed`]: keep `magnitude ≥ min_magnitude` (`0` disables).
-//! * [`Threshold::Adaptive`]: a first pass counts, in a 2041-bin histogram on the stack (no
+//! * [`Threshold::Adaptive`]: a first pass counts, in a 2048-bin histogram on the stack (no
 //!   allocation), the magnitudes of all `N` pixels of the region that pass the orientation band
 //!   (any magnitude). With `K = ⌈keep_fraction·N⌉`, the threshold is the largest `t` with
 //!   `#{magnitude ≥ t} ≥ K` — the `(1 − keep_fraction)` quantile, ties kept — and then
-//!   `max(t, min_magnitude)`. Scaling the image contrast by `c` scales every magnitude by `c`, so
+//!   `max(t, min_magnitude)`. (Only pixels with magnitude `≥ min_magnitude` are binned — the
+//!   others count in `N` but cannot lift `t` above the floor — so a higher floor is cheaper.) Scaling the image contrast by `c` scales every magnitude by `c`, so
 //!   the threshold follows and the kept set stays about the same (tested at `c = 1` and
 //!   `c = 0.3`); `min_magnitude` stops a featureless frame from keeping pure noise. It costs a
 //!   second gradient pass plus the histogram.
@@ -288,13 +289,22 @@ impl GradientDetector {
                 min_magnitude,
             } => {
                 let mut hists = [[0u32; HIST_BINS]; 4];
-                self.run(image, checked, 0, &mut Sink::Histogram(&mut hists));
+                let mut sink = Sink::Histogram {
+                    hists: &mut hists,
+                    floor: min_magnitude,
+                    in_band: 0,
+                };
+                self.run(image, checked, 0, &mut sink);
+                let Sink::Histogram { in_band: total, .. } = sink else {
+                    return Ok(EdgeStats::default());
+                };
                 let [mut hist, h1, h2, h3] = hists;
                 for (((a, b), c), d) in hist.iter_mut().zip(h1).zip(h2).zip(h3) {
                     *a += b + c + d;
                 }
-                hist[0] = 0; // dropped pixels were parked there (see kernel::consume)
-                let (t, total) = upper_quantile(&hist, keep_fraction);
+                // Spare bins above MAX_MAGNITUDE parked the uncounted pixels (kernel::consume).
+                hist[usize::from(MAX_MAGNITUDE) + 1..].fill(0);
+                let t = upper_quantile(&hist, total, keep_fraction);
                 (t.max(min_magnitude), Some(total))
             }
         };
@@ -338,21 +348,22 @@ impl GradientDetector {
     }
 }
 
-/// Largest `t` with `#{m ≥ t} ≥ ⌈f·N⌉`, and `N`. Returns `(0, 0)` for an empty histogram.
-fn upper_quantile(hist: &[u32; HIST_BINS], keep_fraction: f64) -> (u16, usize) {
-    let total: usize = hist.iter().map(|&c| c as usize).sum();
+/// Largest `t` with `#{m ≥ t} ≥ ⌈f·N⌉` among `N = total` pixels, of which `hist` holds those
+/// at or above some floor; `0` if the histogram does not reach `⌈f·N⌉` (then `t` is below the
+/// floor, which the caller applies) or `N = 0`.
+fn upper_quantile(hist: &[u32; HIST_BINS], total: usize, keep_fraction: f64) -> u16 {
     if total == 0 {
-        return (0, 0);
+        return 0;
     }
     let k = ((keep_fraction * total as f64).ceil() as usize).clamp(1, total);
     let mut acc = 0usize;
     for (m, &count) in hist.iter().enumerate().rev() {
         acc += count as usize;
         if acc >= k {
-            return (m as u16, total);
+            return m as u16;
         }
     }
-    (0, total)
+    0
 }
 
 fn check_region<'a>(
