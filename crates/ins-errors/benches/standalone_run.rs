@@ -60,6 +60,42 @@ fn bench(c: &mut Criterion) {
             black_box(acc)
         })
     });
+    let mut buf = vec![tr.samples().next().unwrap(); tr.n_samples()];
+    tr.fill(&mut buf).unwrap();
+    g.bench_function("ins_only/900s", |b| {
+        b.iter(|| {
+            let s0 = &buf[0];
+            let mut ins = Strapdown::new(
+                NavState {
+                    pos: s0.pos,
+                    vel_ned_mps: s0.vel_ned_mps,
+                    att_b_to_n: s0.att_b_to_n,
+                },
+                tr.step_s(),
+            )
+            .unwrap();
+            for s in &buf[..buf.len() - 1] {
+                ins.step(&s.specific_force_body_mps2, &s.ang_rate_ib_body_radps);
+            }
+            black_box(*ins.state())
+        })
+    });
+    let imu = ImuErrors::draw(&params, &mut ChaCha8Rng::seed_from_u64(2));
+    g.bench_function("imu_only/900s", |b| {
+        b.iter(|| {
+            let mut rng = ChaCha8Rng::seed_from_u64(3);
+            let mut acc = nalgebra::Vector3::zeros();
+            for s in &buf[..buf.len() - 1] {
+                let (f, _) = imu.measure(
+                    &s.specific_force_body_mps2,
+                    &s.ang_rate_ib_body_radps,
+                    &mut rng,
+                );
+                acc += f;
+            }
+            black_box(acc)
+        })
+    });
     g.finish();
 }
 

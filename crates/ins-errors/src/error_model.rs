@@ -297,68 +297,82 @@ impl Transition {
     }
 }
 
-/// Non-zero 3×3 block columns of Φ's rows (δp, δv, ψ): ψ depends only on ψ and ε.
-const PHI_NONZERO: [&[usize]; 3] = [&[0, 1, 2, 3, 4], &[0, 1, 2, 3, 4], &[2, 4]];
+/// acc[0..L] += c[0..L]·s (fixed length so that the compiler unrolls and vectorises it).
+#[inline(always)]
+fn axpy<const L: usize>(acc: &mut [f64; 9], c: &[f64], s: f64) {
+    for (a, &v) in acc[..L].iter_mut().zip(&c[..L]) {
+        *a += v * s;
+    }
+}
 
-/// P ← Φ P Φᵀ + Q_d in place, exploiting Φ's block structure: bias rows [0 I], and the ψ rows
-/// coupled only to ψ and ε (exact for [`system_matrix`]: ψ̇ has no δp, δv or ∇ terms). Works on
-/// 3×3 blocks, ≈ 2200 multiply-adds instead of 6750 for the dense form; only the upper block
-/// triangle is formed, so the result is exactly symmetric for symmetric P and Q_d. The Φ entries assumed zero
-/// (ψ rows × δp, δv, ∇ columns) are ignored.
-#[allow(clippy::needless_range_loop)] // block indices read clearer than iterator chains here
+/// P ← Φ P Φᵀ + Q_d in place, exploiting Φ's structure: the bias rows are [0 I], and the ψ
+/// rows are coupled only to ψ and ε (exact for [`system_matrix`]: ψ̇ has no δp, δv or ∇
+/// terms, so Φ's (ψ; δp, δv, ∇) entries are zero and are ignored here). With Φ_top = Φ[0..9, :]:
+/// X = Φ_top P (9×15, ≈ 1600 multiply-adds), the 9×9 block X Φ_topᵀ (≈ 970), the 9×6 cross
+/// block X[:, 9..15] (Φ's bias rows are [0 I]) and P₂₂ unchanged, instead of 6750 multiply-adds
+/// for the dense form. The 9×9 block is symmetrised, so the result is exactly symmetric for
+/// symmetric Q_d.
+#[allow(clippy::needless_range_loop)] // index loops over fixed column ranges read clearest here
 pub fn propagate_covariance(p: &mut Mat15, phi: &Transition, qd: &Mat15) {
-    let fb = |r: usize, c: usize| -> Matrix3<f64> {
-        if c < 3 {
-            phi.phi11.fixed_view::<3, 3>(3 * r, 3 * c).into_owned()
+    let f11 = phi.phi11.as_slice(); // column-major 9×9
+    let f12 = phi.phi12.as_slice(); // column-major 9×6
+    let col = |k: usize| -> &[f64] {
+        if k < 9 {
+            &f11[9 * k..9 * k + 9]
         } else {
-            phi.phi12
-                .fixed_view::<3, 3>(3 * r, 3 * (c - 3))
-                .into_owned()
+            &f12[9 * (k - 9)..9 * (k - 9) + 9]
         }
     };
-    let f: [[Matrix3<f64>; 5]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| fb(r, c)));
-    let pb: [[Matrix3<f64>; 5]; 5] = std::array::from_fn(|r| {
-        std::array::from_fn(|c| p.fixed_view::<3, 3>(3 * r, 3 * c).into_owned())
-    });
-    // X = Φ[rows δp, δv, ψ] · P  (3 × 5 blocks).
-    let mut x = [[Matrix3::<f64>::zeros(); 5]; 3];
-    for (r, xr) in x.iter_mut().enumerate() {
-        for &k in PHI_NONZERO[r] {
-            for (j, xrj) in xr.iter_mut().enumerate() {
-                *xrj += f[r][k] * pb[k][j];
+    // X = Φ_top P, column by column (column j of X = Σ_k Φ_top[:, k] P[k, j]); Φ_top's columns
+    // for δp, δv, ∇ have zero ψ rows (length 6), those for ψ, ε are full (length 9).
+    let mut x = [[0.0f64; 9]; 15];
+    {
+        let ps = p.as_slice();
+        for j in 0..15 {
+            let pj = &ps[15 * j..15 * j + 15];
+            let acc = &mut x[j];
+            for k in 0..6 {
+                axpy::<6>(acc, col(k), pj[k]);
+            }
+            for k in 6..9 {
+                axpy::<9>(acc, col(k), pj[k]);
+            }
+            for k in 9..12 {
+                axpy::<6>(acc, col(k), pj[k]);
+            }
+            for k in 12..15 {
+                axpy::<9>(acc, col(k), pj[k]);
             }
         }
     }
-    // Upper blocks of X Φᵀ for the 9×9 part.
-    for r in 0..3 {
-        for s in r..3 {
-            let mut n = Matrix3::<f64>::zeros();
-            for &k in PHI_NONZERO[s] {
-                n += x[r][k] * f[s][k].transpose();
+    // N = X Φ_topᵀ (9×9): column i of N = Σ_k X[:, k] Φ_top[i, k].
+    let mut n = [[0.0f64; 9]; 9];
+    for i in 0..9 {
+        let acc = &mut n[i];
+        if i < 6 {
+            for k in 0..15 {
+                axpy::<9>(acc, &x[k], col(k)[i]);
             }
-            if r == s {
-                n = 0.5 * (n + n.transpose());
+        } else {
+            for k in (6..9).chain(12..15) {
+                axpy::<9>(acc, &x[k], col(k)[i]);
             }
-            let q = qd.fixed_view::<3, 3>(3 * r, 3 * s);
-            p.fixed_view_mut::<3, 3>(3 * r, 3 * s).copy_from(&(n + q));
-            if r != s {
-                let qt = qd.fixed_view::<3, 3>(3 * s, 3 * r);
-                p.fixed_view_mut::<3, 3>(3 * s, 3 * r)
-                    .copy_from(&(n.transpose() + qt));
-            }
-        }
-        // Cross blocks with the bias states: X[r][3 + j] (Φ's bias rows are [0 I]).
-        for j in 3..5 {
-            let v = x[r][j] + qd.fixed_view::<3, 3>(3 * r, 3 * j);
-            p.fixed_view_mut::<3, 3>(3 * r, 3 * j).copy_from(&v);
-            p.fixed_view_mut::<3, 3>(3 * j, 3 * r)
-                .copy_from(&v.transpose());
         }
     }
-    for i in 3..5 {
-        for j in 3..5 {
-            let v = pb[i][j] + qd.fixed_view::<3, 3>(3 * i, 3 * j);
-            p.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&v);
+    for i in 0..9 {
+        for r in 0..=i {
+            let v = 0.5 * (n[i][r] + n[r][i]);
+            p[(r, i)] = v + qd[(r, i)];
+            p[(i, r)] = v + qd[(i, r)];
+        }
+    }
+    for j in 9..15 {
+        for r in 0..9 {
+            p[(r, j)] = x[j][r] + qd[(r, j)];
+            p[(j, r)] = x[j][r] + qd[(j, r)];
+        }
+        for i in 9..15 {
+            p[(i, j)] += qd[(i, j)];
         }
     }
 }
