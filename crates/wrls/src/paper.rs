@@ -68,7 +68,9 @@ impl std::fmt::Debug for Workspace {
 /// `(λ I_N + φᵀPφ)` is factorised by a faer Cholesky (`O(N³/3)`) rather than explicitly
 /// inverted; it is this `N×N` step that the paper's 22.2 ms measures. All buffers are
 /// preallocated for `max_points`; a frame with more points grows them once (that call
-/// allocates), later frames up to the new size do not.
+/// allocates), later frames up to the new size do not. The first update in the process also
+/// allocates once inside faer (lazily initialised state); a test checks that later updates
+/// allocate nothing.
 #[derive(Debug, Clone)]
 pub struct WrlsPaper {
     theta: Vector3<f64>,

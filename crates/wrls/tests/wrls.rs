@@ -358,3 +358,11 @@ fn bad_inputs_are_typed_errors() {
         }))
     ));
 }
+
+#[test]
+fn config_rejects_unknown_fields_and_defaults_to_the_paper_lambda() {
+    let c: WrlsConfig = serde_json::from_str(r#"{"lambda": 0.9}"#).unwrap();
+    assert!(c.validate().is_ok());
+    assert!(serde_json::from_str::<WrlsConfig>(r#"{"lambda": 0.9, "lamda": 0.8}"#).is_err());
+    assert_eq!(WrlsConfig::default().lambda, 0.70);
+}
