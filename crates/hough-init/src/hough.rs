@@ -67,7 +67,7 @@ impl HoughLine {
 /// θ bins: `θ_k = −90° + k·Δθ`, `k = 0 … n_θ − 1`, `n_θ = ⌈180°/Δθ⌉`. Votes are cast relative to
 /// the image centre `((W−1)/2, (H−1)/2)` so the ρ range is the half-diagonal `±hypot(W/2, H/2)`;
 /// the reported [`HoughLine`] is converted to the top-left origin.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct HoughWorkspace {
     width_px: usize,
     height_px: usize,
@@ -86,6 +86,19 @@ pub struct HoughWorkspace {
     acc: Vec<u32>,
     /// Three rows of ρ-direction 3-sums (ring buffer) and one zero row, for the 3×3 smoothing.
     ring: Vec<u32>,
+}
+
+impl core::fmt::Debug for HoughWorkspace {
+    /// Shape and parameters only (the accumulator itself can hold millions of cells).
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("HoughWorkspace")
+            .field("width_px", &self.width_px)
+            .field("height_px", &self.height_px)
+            .field("params", &self.params)
+            .field("theta_bins", &self.theta_bins)
+            .field("rho_bins", &self.rho_bins)
+            .finish_non_exhaustive()
+    }
 }
 
 impl HoughWorkspace {

@@ -194,3 +194,41 @@ fn check_range(
         })
     }
 }
+
+/// Everything stage II needs, as one config section (e.g. `[hough_init]` in a TOML file).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InitConfig {
+    /// Accumulator geometry and peak picking.
+    pub hough: HoughParams,
+    /// Band, minimum counts and refits.
+    pub lane: LaneInitParams,
+    /// θ band of the left lane, degrees. Default [`AngleBand::LEFT_LANE`].
+    pub left_band: AngleBand,
+    /// θ band of the right lane, degrees. Default [`AngleBand::RIGHT_LANE`].
+    pub right_band: AngleBand,
+}
+
+impl Default for InitConfig {
+    fn default() -> Self {
+        Self {
+            hough: HoughParams::default(),
+            lane: LaneInitParams::default(),
+            left_band: AngleBand::LEFT_LANE,
+            right_band: AngleBand::RIGHT_LANE,
+        }
+    }
+}
+
+impl InitConfig {
+    /// Validate every part.
+    ///
+    /// # Errors
+    /// The first [`HoughError::InvalidParam`] / [`HoughError::InvalidBand`] found.
+    pub fn validate(&self) -> Result<(), HoughError> {
+        self.hough.validate()?;
+        self.lane.validate()?;
+        self.left_band.validate()?;
+        self.right_band.validate()
+    }
+}
