@@ -59,6 +59,26 @@ impl<const N: usize> ProcessNoise<N> {
 ///
 /// Invariant: `Y` is symmetric positive definite (checked by a Cholesky factorisation at every
 /// measurement update) and `θ̂ = Y⁻¹ ŷ` is cached.
+///
+/// ```
+/// use info_filter::{InformationFilter, ProcessNoise};
+/// use nalgebra::{Matrix2, SMatrix, Vector2};
+///
+/// # fn main() -> Result<(), info_filter::KifError> {
+/// // A 2-parameter random walk observed through three scalar measurements per step.
+/// let mut f = InformationFilter::<2>::new(&Vector2::zeros(), &(Matrix2::identity() * 100.0))?;
+/// let q = ProcessNoise::new(&(Matrix2::identity() * 1e-6))?;
+/// let phi = SMatrix::<f64, 2, 3>::new(1.0, 1.0, 1.0, -1.0, 0.0, 1.0); // columns φ_j
+/// let r = SMatrix::<f64, 3, 3>::identity() * 0.01;
+/// let truth = Vector2::new(2.0, 0.5);
+/// for _ in 0..20 {
+///     f.predict(&q)?;
+///     f.update(&phi, &r, &(phi.transpose() * truth))?;
+/// }
+/// assert!((f.estimate() - truth).norm() < 1e-4);
+/// # Ok(())
+/// # }
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct InformationFilter<const N: usize> {
     info: SMatrix<f64, N, N>,

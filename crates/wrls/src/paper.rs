@@ -70,7 +70,7 @@ impl std::fmt::Debug for Workspace {
 /// preallocated for `max_points`; a frame with more points grows them once (that call
 /// allocates), later frames up to the new size do not. The first update in the process also
 /// allocates once inside faer (lazily initialised state); a test checks that later updates
-/// allocate nothing.
+/// allocate nothing. `clone()` allocates fresh buffers of the same capacity.
 #[derive(Debug, Clone)]
 pub struct WrlsPaper {
     theta: Vector3<f64>,
