@@ -346,16 +346,16 @@ pub(crate) fn run(
         let t_s = k as f64 * plan.step_s;
         let update_due = mode != Mode::Standalone && k % plan.steps_per_update == 0;
         let sample_due = k % plan.steps_per_sample == 0;
-        if !(update_due || sample_due) {
-            continue;
-        }
-        let truth = nav_state(&s);
         if !nav_finite(lp.ins.state()) {
             return Err(RunError::NonFinite {
                 t_s,
                 what: "INS navigation state",
             });
         }
+        if !(update_due || sample_due) {
+            continue;
+        }
+        let truth = nav_state(&s);
         if update_due {
             last_nis = Some(lp.sd_update(t_s, &truth)?);
         }

@@ -1,8 +1,8 @@
 //! Φ and Q_d over one SD update interval, from the error model averaged on sub-intervals.
 //!
 //! The INS runs at T_s = 0.01 s; the filter only needs (Φ_T, Q_T) between two SD updates
-//! T = 1 s apart. The interval is cut into `m` sub-intervals of length τ = T/m (here m = 10,
-//! τ = 0.1 s). On each, the INS's linearisation quantities are averaged over its 100 Hz steps
+//! T = 1 s apart. The interval is cut into `m` sub-intervals of length τ = T/m (default m = 2,
+//! τ = 0.5 s). On each, the INS's linearisation quantities are averaged over its 100 Hz steps
 //! (latitude, height, velocity, f_n = C̃ f_b and C̃ itself — A is affine in f_n and C̃, so
 //! averaging them is averaging A's force and bias columns exactly), A(τ-average) is built with
 //! [`ins_errors::error_model::system_matrix`] and discretised by

@@ -1,0 +1,153 @@
+//! Scenario file: `configs/paper.toml` equals `Scenario::paper_default()`, bad input is rejected
+//! with an error naming the section or the dotted field.
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use nav_app::ins_sd::{Mode, Scenario, ScenarioError, run_seed};
+
+fn paper_toml() -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../configs/paper.toml"
+    ))
+    .unwrap()
+}
+
+/// Replaces the first line `key = …` (after `[section]`) with `key = value`.
+fn with_value(text: &str, section: &str, key: &str, value: &str) -> String {
+    let start = text.find(&format!("\n[{section}]")).expect("section");
+    let rel = text[start..].find(&format!("\n{key} = ")).expect("key") + start + 1;
+    let end = rel + text[rel..].find('\n').unwrap();
+    format!("{}{key} = {value}{}", &text[..rel], &text[end..])
+}
+
+fn field_of(e: &ScenarioError) -> String {
+    match e {
+        ScenarioError::Invalid { field, .. } => field.clone(),
+        ScenarioError::Parse { section, .. } => section.clone(),
+    }
+}
+
+#[test]
+fn paper_toml_equals_paper_default() {
+    let s = Scenario::from_toml_str(&paper_toml()).unwrap();
+    assert_eq!(s, Scenario::paper_default());
+    assert_eq!(s.duration_s(), 900.0);
+    assert_eq!(s.default_runs(), 100);
+    assert_eq!(s.samples_per_run(), 901);
+    assert_eq!(s.filter.open_loop_until_s, 195.0);
+    assert_eq!(s.filter.akf_window, 10);
+    assert!(s.assumptions().len() >= 8);
+}
+
+#[test]
+fn invalid_values_name_the_field() {
+    let base = paper_toml();
+    let cases = [
+        ("filter", "r_var_m2", "0.0", "filter.r_var_m2"),
+        ("filter", "p0_pos_sigma_m", "-1.0", "filter.p0_pos_sigma_m"),
+        (
+            "filter",
+            "q_accel_bias_rw_psd_mg2_per_s",
+            "-1e-3",
+            "filter.q_accel_bias_rw_psd_mg2_per_s",
+        ),
+        ("filter", "phi_subintervals", "0", "filter.phi_subintervals"),
+        (
+            "filter",
+            "phi_subintervals",
+            "1000",
+            "filter.phi_subintervals",
+        ),
+        ("filter", "akf_window", "0", "filter.akf_window"),
+        (
+            "filter",
+            "open_loop_until_s",
+            "-5.0",
+            "filter.open_loop_until_s",
+        ),
+        ("monte_carlo", "runs", "0", "monte_carlo.runs"),
+        (
+            "imu",
+            "accel_bias_sigma_mg",
+            "-3.0",
+            "imu.accel_bias_sigma_mg",
+        ),
+        ("sighting", "noise_var_m2", "-40.0", "sighting.noise_var_m2"),
+        (
+            "sighting",
+            "update_period_s",
+            "0.015",
+            "sighting.update_period_s",
+        ),
+        ("trajectory", "end_time_s", "900.5", "trajectory.end_time_s"),
+    ];
+    for (section, key, value, want) in cases {
+        let text = with_value(&base, section, key, value);
+        let e = Scenario::from_toml_str(&text).expect_err(want);
+        assert_eq!(field_of(&e), want, "{section}.{key} = {value}: {e}");
+        assert!(e.to_string().contains(want), "{e}");
+    }
+}
+
+#[test]
+fn unknown_keys_sections_and_types_name_the_section_and_key() {
+    let base = paper_toml();
+    // Unknown key in [filter].
+    let text = base.replace("\n[filter]\n", "\n[filter]\nr_sigma_m = 6.0\n");
+    let e = Scenario::from_toml_str(&text).unwrap_err();
+    assert_eq!(field_of(&e), "filter");
+    assert!(e.to_string().contains("r_sigma_m"), "{e}");
+    // Unknown section.
+    let e = Scenario::from_toml_str(&format!("{base}\n[camera]\nfov_deg = 3.0\n")).unwrap_err();
+    assert_eq!(field_of(&e), "camera", "{e}");
+    // Missing section.
+    let start = base.find("\n[monte_carlo]").unwrap();
+    let e = Scenario::from_toml_str(&base[..start]).unwrap_err();
+    assert_eq!(field_of(&e), "monte_carlo", "{e}");
+    // Wrong type.
+    let e =
+        Scenario::from_toml_str(&with_value(&base, "filter", "akf_window", "\"ten\"")).unwrap_err();
+    assert_eq!(field_of(&e), "filter");
+    assert!(e.to_string().contains("akf_window"), "{e}");
+    // Bad projection name.
+    let e = Scenario::from_toml_str(&with_value(&base, "filter", "akf_projection", "\"svd\""))
+        .unwrap_err();
+    assert_eq!(field_of(&e), "filter", "{e}");
+    // Not TOML at all.
+    let e = Scenario::from_toml_str("[filter\n").unwrap_err();
+    assert_eq!(field_of(&e), "(document)", "{e}");
+}
+
+#[test]
+fn two_landmarks_are_rejected_by_name() {
+    let mut s = Scenario::paper_default();
+    s.sighting.landmarks.pop();
+    let e = s.validate().unwrap_err();
+    assert_eq!(field_of(&e), "sighting.landmarks", "{e}");
+}
+
+#[test]
+fn truncation_keeps_the_start_and_validates() {
+    let s = Scenario::paper_default().truncated(100.0).unwrap();
+    assert_eq!(s.duration_s(), 100.0);
+    assert_eq!(s.samples_per_run(), 101);
+    let total: f64 = s.trajectory.segments.iter().map(|g| g.duration_s).sum();
+    assert!(total <= 100.0 + 1e-9);
+    assert_eq!(
+        s.trajectory.segments[0],
+        Scenario::paper_default().trajectory.segments[0]
+    );
+    assert!(Scenario::paper_default().truncated(10.5).is_err());
+}
+
+#[test]
+fn run_seeds_are_distinct_and_shared_across_modes() {
+    let mut seen = std::collections::HashSet::new();
+    for i in 0..1000 {
+        let s = run_seed(2009, Mode::Kf, i);
+        assert_eq!(s, run_seed(2009, Mode::Standalone, i));
+        assert_eq!(s, run_seed(2009, Mode::Akf, i));
+        assert!(seen.insert(s), "collision at {i}");
+    }
+    assert_ne!(run_seed(1, Mode::Kf, 0), run_seed(2, Mode::Kf, 0));
+}
