@@ -233,3 +233,25 @@ fn loop_repeats_a_file_up_to_max_frames() {
         .collect();
     assert_eq!(frames, (0..60).collect::<Vec<_>>());
 }
+
+#[test]
+fn a_y4m_stream_on_stdin_is_read_with_input_dash() {
+    use std::io::Write;
+    let bytes = std::fs::read(fixture("synthetic/shadows.y4m")).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nav-app"))
+        .args(["--input", "-", "--json", "--max-frames", "10"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    // The tracker may stop reading after 10 frames: a broken pipe here is fine.
+    let writer = std::thread::spawn(move || {
+        let _ = stdin.write_all(&bytes);
+    });
+    let o = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(String::from_utf8(o.stdout).unwrap().lines().count(), 10);
+}
