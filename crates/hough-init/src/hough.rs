@@ -221,23 +221,23 @@ impl HoughWorkspace {
     /// [`HoughError::InvalidBand`]; [`HoughError::NonFinitePoint`];
     /// [`HoughError::PointOutsideImage`] for a point outside
     /// `[−0.5, W − 0.5] × [−0.5, H − 0.5]`; [`HoughError::TooFewPoints`] for fewer than 2 points.
-    pub fn find_line<P: EdgePoint>(
-        &mut self,
-        points: &[P],
-        band: &AngleBand,
-    ) -> Result<HoughLine, HoughError> {
+    pub fn find_line<I>(&mut self, points: I, band: &AngleBand) -> Result<HoughLine, HoughError>
+    where
+        I: IntoIterator + Clone,
+        I::Item: EdgePoint,
+    {
         let (k0, k1) = self.band_bins(band)?;
-        self.check_points(points)?;
-        if points.len() > u32::MAX as usize {
+        let count = self.check_points(points.clone())?;
+        if count > u32::MAX as usize {
             return Err(HoughError::TooManyPoints {
-                found: points.len(),
+                found: count,
                 limit: u32::MAX as usize,
             });
         }
-        if points.len() < 2 {
+        if count < 2 {
             return Err(HoughError::TooFewPoints {
                 set: PointSet::Candidates,
-                found: points.len(),
+                found: count,
                 required: 2,
             });
         }
@@ -263,10 +263,17 @@ impl HoughWorkspace {
         })
     }
 
-    fn check_points<P: EdgePoint>(&self, points: &[P]) -> Result<(), HoughError> {
+    /// Validate every point; returns their number.
+    fn check_points<I>(&self, points: I) -> Result<usize, HoughError>
+    where
+        I: IntoIterator,
+        I::Item: EdgePoint,
+    {
+        let mut count = 0;
         let col_max = self.width_px as f64 - 0.5;
         let row_max = self.height_px as f64 - 0.5;
-        for (index, p) in points.iter().enumerate() {
+        for (index, p) in points.into_iter().enumerate() {
+            count += 1;
             let (x, y) = (p.col_px(), p.row_px());
             if !(x.is_finite() && y.is_finite()) {
                 return Err(HoughError::NonFinitePoint {
@@ -285,10 +292,14 @@ impl HoughWorkspace {
                 });
             }
         }
-        Ok(())
+        Ok(count)
     }
 
-    fn vote<P: EdgePoint>(&mut self, points: &[P], k0: usize, k1: usize) {
+    fn vote<I>(&mut self, points: I, k0: usize, k1: usize)
+    where
+        I: IntoIterator,
+        I::Item: EdgePoint,
+    {
         let nr = self.rho_bins;
         let cx = self.center_col_px;
         let cy = self.center_row_px;
@@ -300,11 +311,18 @@ impl HoughWorkspace {
         let mut xs = [0f32; VOTE_CHUNK];
         let mut ys = [0f32; VOTE_CHUNK];
         let mut idx = [0u32; VOTE_CHUNK];
-        for chunk in points.chunks(VOTE_CHUNK) {
-            let m = chunk.len();
-            for ((p, x), y) in chunk.iter().zip(&mut xs).zip(&mut ys) {
+        let mut iter = points.into_iter();
+        loop {
+            // The buffer side of the zip comes first so that a full chunk does not pull (and
+            // lose) one more point from `iter`.
+            let mut m = 0;
+            for ((x, y), p) in xs.iter_mut().zip(ys.iter_mut()).zip(iter.by_ref()) {
                 *x = (p.col_px() - cx) as f32;
                 *y = (p.row_px() - cy) as f32;
+                m += 1;
+            }
+            if m == 0 {
+                break;
             }
             for k in k0..=k1 {
                 let c = self.cos_over_step[k];
@@ -323,6 +341,9 @@ impl HoughWorkspace {
                         *cell += 1;
                     }
                 }
+            }
+            if m < VOTE_CHUNK {
+                break;
             }
         }
     }
@@ -519,25 +540,34 @@ mod tests {
         assert_eq!(parabolic_offset(0.0, 1.0, 1.9), 0.5); // vertex beyond the bin → clamped
     }
 
-    /// Every in-image point votes exactly once per θ bin of the band.
+    /// Every in-image point (corners included) votes exactly once per θ bin of the band,
+    /// also across vote-chunk boundaries and for iterator inputs.
     #[test]
     fn each_point_votes_once_per_theta_bin() {
         let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
+        let band = AngleBand::new(-90.0, 90.0);
+        let (k0, k1) = ws.band_bins(&band).unwrap();
+        assert_eq!((k0, k1), (0, 359));
         let corners = [
             Point::new(-0.5, -0.5),
             Point::new(319.5, -0.5),
             Point::new(-0.5, 239.5),
             Point::new(319.5, 239.5),
-            Point::new(160.0, 120.0),
         ];
-        let band = AngleBand::new(-90.0, 90.0);
-        let (k0, k1) = ws.band_bins(&band).unwrap();
-        assert_eq!((k0, k1), (0, 359));
-        ws.vote(&corners, k0, k1);
-        let nr = ws.rho_bins;
-        for k in k0..=k1 {
-            let total: u32 = ws.acc[k * nr..(k + 1) * nr].iter().sum();
-            assert_eq!(total, corners.len() as u32, "θ bin {k}");
+        for n in [4, VOTE_CHUNK, VOTE_CHUNK + 1, 2 * VOTE_CHUNK + 3] {
+            // Cycle the corners and the centre through n points, fed as an iterator.
+            let pts = (0..n).map(|i| {
+                corners
+                    .get(i % 5)
+                    .copied()
+                    .unwrap_or(Point::new(160.0, 120.0))
+            });
+            ws.vote(pts, k0, k1);
+            let nr = ws.rho_bins;
+            for k in k0..=k1 {
+                let total: u32 = ws.acc[k * nr..(k + 1) * nr].iter().sum();
+                assert_eq!(total as usize, n, "θ bin {k}, {n} points");
+            }
         }
     }
 }

@@ -37,26 +37,31 @@ pub struct LaneInit {
 /// # Errors
 /// Any [`HoughError`] from the parameters, the band, the points (non-finite, outside the
 /// workspace's image), too few points at any stage, or a degenerate fit.
-pub fn init_lane<P: EdgePoint>(
-    points: &[P],
+pub fn init_lane<I>(
+    points: I,
     band: &AngleBand,
     workspace: &mut HoughWorkspace,
     params: &LaneInitParams,
-) -> Result<LaneInit, HoughError> {
+) -> Result<LaneInit, HoughError>
+where
+    I: IntoIterator + Clone,
+    I::Item: EdgePoint,
+{
     params.validate()?;
-    if points.len() < params.min_points {
+    let count = points.clone().into_iter().count();
+    if count < params.min_points {
         return Err(HoughError::TooFewPoints {
             set: PointSet::Candidates,
-            found: points.len(),
+            found: count,
             required: params.min_points,
         });
     }
-    let line = workspace.find_line(points, band)?;
+    let line = workspace.find_line(points.clone(), band)?;
     let band_px = params.band_px;
     let (sin_t, cos_t) = line.theta_rad.sin_cos();
     let rho_px = line.rho_px;
     let mut fit = fit_impl(
-        points,
+        points.clone(),
         |x, y| (x * cos_t + y * sin_t - rho_px).abs() <= band_px,
         params.min_points,
         PointSet::NearLine,
@@ -64,7 +69,7 @@ pub fn init_lane<P: EdgePoint>(
     for _ in 0..params.refit_iterations {
         let p = fit.parabola;
         fit = fit_impl(
-            points,
+            points.clone(),
             |x, y| (x - p.col_at_row(y)).abs() <= band_px,
             params.min_points,
             PointSet::NearParabola,

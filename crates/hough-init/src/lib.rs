@@ -15,8 +15,12 @@
 //! # Coordinates
 //!
 //! Image coordinates in pixels: `x = col_px` to the right, `y = row_px` downwards, origin at
-//! the **centre of the top-left pixel**. Inputs are anything implementing [`EdgePoint`]
-//! ([`Point`], `(col, row)` tuples or `[col, row]` arrays of `f32`/`f64`/`u16`/`u32`/`i32`).
+//! the **centre of the top-left pixel**. Point inputs are any re-iterable collection
+//! (`IntoIterator + Clone`) of [`EdgePoint`] items: slices or `&Vec` of [`Point`], of
+//! `(col, row)` tuples or `[col, row]` arrays of `f32`/`f64`/`u16`/`u32`/`i32`, or a cheap
+//! iterator chain such as `pixels.iter().filter(..).map(|p| (p.col_px, p.row_px))` (no copy
+//! needed). The points are iterated several times (Hough: check + vote; each least-squares
+//! fit: three passes), so the iterator must be cheap to clone and yield the same sequence.
 //!
 //! # Hough transform
 //!

@@ -72,7 +72,11 @@ pub struct ParabolaFit {
 /// than 3 points; [`HoughError::SingleRow`] when all rows are equal;
 /// [`HoughError::RankDeficient`] (naming the failed pivot) for fewer than three distinct rows or
 /// a numerically singular system; [`HoughError::NonFiniteResult`] on overflow.
-pub fn fit_parabola<P: EdgePoint>(points: &[P]) -> Result<ParabolaFit, HoughError> {
+pub fn fit_parabola<I>(points: I) -> Result<ParabolaFit, HoughError>
+where
+    I: IntoIterator + Clone,
+    I::Item: EdgePoint,
+{
     fit_impl(points, |_, _| true, 3, PointSet::Fit)
 }
 
@@ -82,9 +86,10 @@ pub fn fit_parabola<P: EdgePoint>(points: &[P]) -> Result<ParabolaFit, HoughErro
 ///
 /// # Errors
 /// As [`fit_parabola`], counting only the kept points.
-pub fn fit_parabola_where<P, F>(points: &[P], keep: F) -> Result<ParabolaFit, HoughError>
+pub fn fit_parabola_where<I, F>(points: I, keep: F) -> Result<ParabolaFit, HoughError>
 where
-    P: EdgePoint,
+    I: IntoIterator + Clone,
+    I::Item: EdgePoint,
     F: Fn(f64, f64) -> bool,
 {
     fit_impl(points, keep, 3, PointSet::Fit)
@@ -92,14 +97,15 @@ where
 
 /// Shared implementation: three passes over `points` (range, normal equations, residuals),
 /// no allocation.
-pub(crate) fn fit_impl<P, F>(
-    points: &[P],
+pub(crate) fn fit_impl<I, F>(
+    points: I,
     keep: F,
     min_points: usize,
     set: PointSet,
 ) -> Result<ParabolaFit, HoughError>
 where
-    P: EdgePoint,
+    I: IntoIterator + Clone,
+    I::Item: EdgePoint,
     F: Fn(f64, f64) -> bool,
 {
     let min_points = min_points.max(3);
@@ -107,7 +113,7 @@ where
     let mut count = 0usize;
     let mut row_min = f64::INFINITY;
     let mut row_max = f64::NEG_INFINITY;
-    for (index, p) in points.iter().enumerate() {
+    for (index, p) in points.clone().into_iter().enumerate() {
         let (x, y) = (p.col_px(), p.row_px());
         if !(x.is_finite() && y.is_finite()) {
             return Err(HoughError::NonFinitePoint {
@@ -142,7 +148,7 @@ where
     // Pass 2: normal equations in (1, y', y'^2), averaged over the points.
     let mut sy = [0.0f64; 5]; // Σ y'^k, k = 0..4
     let mut sxy = [0.0f64; 3]; // Σ x·y'^k, k = 0..2
-    for p in points {
+    for p in points.clone() {
         let (x, y) = (p.col_px(), p.row_px());
         if !keep(x, y) {
             continue;

@@ -265,3 +265,36 @@ fn points_outside_the_workspace_image_are_rejected() {
         })
     ));
 }
+
+/// An iterator chain over a mixed pixel list (e.g. an edge buffer holding both lanes with a
+/// class tag) gives exactly the result of a copied per-lane slice.
+#[test]
+fn iterator_input_equals_slice_input() {
+    let s = scene(320, 240, 5.0, 2.0, 0.5, 0.3, 6);
+    // (col, row, class) as u16 + tag, like an edge detector's output.
+    let mixed: Vec<(u16, u16, u8)> = s
+        .left
+        .iter()
+        .map(|p| (p.col_px.round() as u16, p.row_px.round() as u16, 1))
+        .chain(
+            s.right
+                .iter()
+                .map(|p| (p.col_px.round() as u16, p.row_px.round() as u16, 2)),
+        )
+        .collect();
+    let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
+    let params = LaneInitParams {
+        refit_iterations: 1,
+        ..LaneInitParams::default()
+    };
+    for (class, band) in [(1u8, AngleBand::LEFT_LANE), (2, AngleBand::RIGHT_LANE)] {
+        let iter = mixed
+            .iter()
+            .filter(move |p| p.2 == class)
+            .map(|p| (p.0, p.1));
+        let copy: Vec<(u16, u16)> = iter.clone().collect();
+        let a = init_lane(iter, &band, &mut ws, &params).unwrap();
+        let b = init_lane(&copy, &band, &mut ws, &params).unwrap();
+        assert_eq!(a, b);
+    }
+}
