@@ -48,6 +48,26 @@ struct Job {
     samples: Vec<Sample>,
     result: Result<RunOutcome, RunError>,
     elapsed_s: f64,
+    cpu_s: f64,
+}
+
+/// CPU time consumed by the calling thread, s (None where the platform has no such clock).
+#[cfg(unix)]
+pub fn thread_cpu_s() -> Option<f64> {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec for the duration of the call, and
+    // CLOCK_THREAD_CPUTIME_ID is a clock every supported Unix provides.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    (rc == 0).then_some(ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64)
+}
+
+/// CPU time consumed by the calling thread (not available on this platform).
+#[cfg(not(unix))]
+pub fn thread_cpu_s() -> Option<f64> {
+    None
 }
 
 /// First record holding a non-finite value, with the field's name.
@@ -127,8 +147,13 @@ where
                 .map(|&(index, mode_slot)| {
                     let mut samples = vec![Sample::default(); plan.samples];
                     let t0 = Instant::now();
+                    let c0 = thread_cpu_s();
                     let result = runner(plan.modes[mode_slot], index, &mut samples);
                     let elapsed_s = t0.elapsed().as_secs_f64();
+                    let cpu_s = match (c0, thread_cpu_s()) {
+                        (Some(a), Some(b)) => b - a,
+                        _ => 0.0,
+                    };
                     bar.inc(1);
                     Job {
                         index,
@@ -136,6 +161,7 @@ where
                         samples,
                         result,
                         elapsed_s,
+                        cpu_s,
                     }
                 })
                 .collect()
@@ -143,6 +169,7 @@ where
         for job in done {
             let stats = &mut modes[job.mode_slot];
             stats.run_time_s += job.elapsed_s;
+            stats.run_cpu_s += job.cpu_s;
             let mode = plan.modes[job.mode_slot].name().to_string();
             let excluded = match job.result {
                 Ok(outcome) => {

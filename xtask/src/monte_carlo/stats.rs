@@ -112,8 +112,11 @@ pub struct ModeStats {
     pub runs_used: u64,
     /// 100 Hz INS epochs simulated by all runs attempted (kept or not).
     pub epochs: u64,
-    /// Σ over runs of the run's own wall time, s (CPU time per core, approximately).
+    /// Σ over runs of the run's own wall time, s.
     pub run_time_s: f64,
+    /// Σ over runs of the CPU time of the thread that simulated it, s (0 where unavailable).
+    #[serde(default)]
+    pub run_cpu_s: f64,
     /// One entry per 1 Hz record (t = 0, 1, …, duration), quantities in [`qi`] order.
     pub bins: Vec<[Moments; Q]>,
 }
@@ -126,6 +129,7 @@ impl ModeStats {
             runs_used: 0,
             epochs: 0,
             run_time_s: 0.0,
+            run_cpu_s: 0.0,
             bins: vec![[Moments::default(); Q]; samples],
         }
     }
@@ -167,6 +171,7 @@ impl ModeStats {
         self.runs_used += other.runs_used;
         self.epochs += other.epochs;
         self.run_time_s += other.run_time_s;
+        self.run_cpu_s += other.run_cpu_s;
         for (a, b) in self.bins.iter_mut().zip(&other.bins) {
             for (x, y) in a.iter_mut().zip(b) {
                 x.merge(y);
