@@ -21,7 +21,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// Every check CI runs: formatting, clippy with warnings denied, all tests and doc tests.
+    /// Every check CI runs: formatting, clippy with warnings denied, all tests and doc tests,
+    /// the lane regression and the vivid V4L2 VM test.
     Test,
     /// Boot Debian's kernel under qemu with the vivid V4L2 driver and run the capture cases.
     Vivid(vivid::VividArgs),
@@ -43,48 +44,84 @@ fn main() -> Result<()> {
     }
 }
 
-/// One step of the test gate: a name and a cargo invocation.
-struct Step {
-    name: &'static str,
-    args: &'static [&'static str],
+/// What one step of the test gate runs.
+enum Run {
+    /// `cargo <args>`.
+    Cargo(&'static [&'static str]),
+    /// This xtask binary again, `cargo xtask <args>` (in release, like the alias).
+    Xtask(&'static [&'static str]),
 }
 
+/// One step of the test gate: a name and what it runs.
+struct Step {
+    name: &'static str,
+    run: Run,
+}
+
+/// The test gate, in order. Steps run even when an earlier one failed, so one CI run reports all.
 const STEPS: &[Step] = &[
     Step {
         name: "fmt",
-        args: &["fmt", "--all", "--", "--check"],
+        run: Run::Cargo(&["fmt", "--all", "--", "--check"]),
     },
     Step {
         name: "clippy",
-        args: &[
+        run: Run::Cargo(&[
             "clippy",
             "--workspace",
             "--all-targets",
+            "--all-features",
             "--",
             "-D",
             "warnings",
-        ],
+        ]),
     },
     Step {
         name: "test",
-        args: &["test", "--workspace", "--all-targets"],
+        run: Run::Cargo(&["test", "--workspace", "--all-targets", "--all-features"]),
     },
     Step {
         name: "doctest",
-        args: &["test", "--workspace", "--doc"],
+        run: Run::Cargo(&["test", "--workspace", "--doc", "--all-features"]),
+    },
+    Step {
+        name: "regress",
+        run: Run::Xtask(&["regress"]),
+    },
+    Step {
+        name: "vivid",
+        run: Run::Xtask(&["vivid"]),
     },
 ];
 
+/// `cargo xtask test`: the README's test command and `.ci/run`'s.
+///
+/// First makes sure the one system package the workspace build needs is present (Debian
+/// `libclang-dev`, for the `v4l` crate's bindgen step; installed with apt-get when missing and
+/// running as root or under CI with passwordless sudo), then runs every step and closes with one
+/// `xtask: N passed, M failed` line.
 fn test() -> Result<()> {
+    vivid::ensure_libclang().context("the workspace build needs libclang (Debian libclang-dev)")?;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    let this = std::env::current_exe().context("cannot locate the xtask binary")?;
     let mut failed = Vec::new();
     for step in STEPS {
-        eprintln!("xtask: {} — cargo {}", step.name, step.args.join(" "));
-        let status = Command::new(&cargo)
-            .args(step.args)
+        let (program, args) = match &step.run {
+            Run::Cargo(args) => (std::ffi::OsStr::new(&cargo), *args),
+            Run::Xtask(args) => (this.as_os_str(), *args),
+        };
+        eprintln!(
+            "xtask: {} — {} {}",
+            step.name,
+            program.to_string_lossy(),
+            args.join(" ")
+        );
+        let status = Command::new(program)
+            .args(args)
             .status()
-            .with_context(|| format!("could not start cargo for step `{}`", step.name))?;
+            .with_context(|| format!("could not start step `{}`", step.name))?;
         if !status.success() {
+            eprintln!("xtask: step `{}` FAILED ({status})", step.name);
             failed.push(step.name);
         }
     }

@@ -380,7 +380,6 @@ pub fn ensure_host_packages(pkgs: &[&str]) -> Result<()> {
 
 /// Make sure libclang (Debian `libclang-dev`) is present for the `v4l` crate's bindgen build.
 /// Meant to be called by the test gate before building the workspace.
-#[allow(dead_code)] // wired into `cargo xtask test` by the lead
 pub fn ensure_libclang() -> Result<()> {
     ensure_host_packages(&["libclang-dev"])
 }
