@@ -26,14 +26,8 @@ fn main() {
             ))
         });
     let mut cfg = TrackerConfig::outdoor().unwrap();
-    let k = 4.0;
+    cfg.scale_pixels(4.0);
     cfg.roi.top_row_fraction = 0.40;
-    cfg.track.window_half_width_px = (cfg.track.window_half_width_px as f64 * k) as usize;
-    cfg.track.inlier_half_width_px *= k;
-    cfg.track.max_jump_px *= k;
-    cfg.track.min_lane_separation_px *= k;
-    cfg.init.band_half_width_px *= k;
-    cfg.filter.r_sigma_px *= k;
     let (mut frame, mut label) = (GreyFrame::default(), GreyFrame::default());
     let (mut points, mut correct) = (0u64, 0u64);
     println!("frame  points correct accuracy mean_err_px  left right");

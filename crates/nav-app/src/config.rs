@@ -318,6 +318,23 @@ impl TrackerConfig {
         Ok(())
     }
 
+    /// Multiply every pixel-valued parameter by `k` (> 0): the presets are tuned for 320-px-wide
+    /// frames, so a 1280-px frame takes `k = 4`. Scaled: window and inlier half-widths, jump
+    /// gate, lane separation, Hough band, R, Q and P0 standard deviations. Not scaled: the
+    /// gradient threshold (grey levels), fractions, angles, counts.
+    pub fn scale_pixels(&mut self, k: f64) {
+        let t = &mut self.track;
+        t.window_half_width_px = ((t.window_half_width_px as f64 * k).round() as usize).max(1);
+        t.inlier_half_width_px *= k;
+        t.max_jump_px *= k;
+        t.min_lane_separation_px *= k;
+        self.init.band_half_width_px *= k;
+        let f = &mut self.filter;
+        f.r_sigma_px *= k;
+        f.q_sigma_px = f.q_sigma_px.map(|q| q * k);
+        f.p0_sigma_px = f.p0_sigma_px.map(|q| q * k);
+    }
+
     /// The ROI row range `[top, bottom)` for an image `height_px` rows high (at least 3 rows).
     pub fn roi_rows(&self, height_px: usize) -> (usize, usize) {
         let top = ((self.roi.top_row_fraction * height_px as f64).floor() as usize)
@@ -423,6 +440,27 @@ mod tests {
                 other => panic!("{field}: expected a field error, got {other:?}"),
             }
         }
+    }
+
+    #[test]
+    fn scale_pixels_scales_pixel_fields_only() {
+        let base = TrackerConfig::outdoor().unwrap();
+        let mut c = base;
+        c.scale_pixels(4.0);
+        c.validate().unwrap();
+        assert_eq!(
+            c.track.window_half_width_px,
+            4 * base.track.window_half_width_px
+        );
+        assert_eq!(c.filter.r_sigma_px, 4.0 * base.filter.r_sigma_px);
+        assert_eq!(c.filter.q_sigma_px[0], 4.0 * base.filter.q_sigma_px[0]);
+        assert_eq!(
+            c.init.band_half_width_px,
+            4.0 * base.init.band_half_width_px
+        );
+        assert_eq!(c.gradient, base.gradient);
+        assert_eq!(c.roi, base.roi);
+        assert_eq!(c.track.max_points_per_lane, base.track.max_points_per_lane);
     }
 
     #[test]

@@ -318,3 +318,134 @@ pub fn score_against_instance_label(
     };
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::{SequenceTruth, TruthFrame, TruthLane};
+    use crate::{LaneReport, Side, TrackReport};
+
+    fn truth(frames: usize, visible: impl Fn(usize) -> bool) -> SequenceTruth {
+        let lane = |v, a3| TruthLane {
+            visible: v,
+            coeffs: [0.001, -0.5, a3],
+        };
+        SequenceTruth {
+            name: "t".into(),
+            description: String::new(),
+            config: "outdoor".into(),
+            width: 320,
+            height: 240,
+            eval_rows: vec![150.0, 200.0, 239.0],
+            frames: (0..frames)
+                .map(|f| TruthFrame {
+                    frame: f as u64,
+                    lanes: [lane(visible(f), 100.0), lane(visible(f), 250.0)],
+                })
+                .collect(),
+        }
+    }
+
+    fn report(dx: f64, tracked: bool) -> TrackReport {
+        let lane = |side, a3: f64| LaneReport {
+            side,
+            state: if tracked {
+                LaneState::Tracking
+            } else {
+                LaneState::Lost
+            },
+            coeffs: tracked.then_some([0.001, -0.5, a3 + dx]),
+            rows: [150.0, 239.0],
+            points: 100,
+            initialised: false,
+        };
+        TrackReport {
+            lanes: [lane(Side::Left, 100.0), lane(Side::Right, 250.0)],
+            full_gradient: false,
+        }
+    }
+
+    #[test]
+    fn a_perfect_run_scores_zero_error_and_full_accuracy() {
+        let t = truth(5, |_| true);
+        let s = score_sequence(&t, &vec![Some(report(0.0, true)); 5]);
+        assert_eq!(s.mean_lateral_error_px, 0.0);
+        assert_eq!(s.accuracy, 1.0);
+        assert_eq!(s.max_recovery_frames, 0);
+        assert_eq!(tusimple_tolerance_px(320), 5.0);
+    }
+
+    #[test]
+    fn a_constant_offset_is_the_lateral_error_and_the_tolerance_decides_accuracy() {
+        let t = truth(4, |_| true);
+        let s = score_sequence(&t, &vec![Some(report(3.0, true)); 4]);
+        assert!((s.mean_lateral_error_px - 3.0).abs() < 1e-9);
+        assert_eq!(s.accuracy, 1.0, "3 px < 5 px tolerance at 320 px");
+        let s = score_sequence(&t, &vec![Some(report(-6.0, true)); 4]);
+        assert!((s.mean_lateral_error_px - 6.0).abs() < 1e-9);
+        assert_eq!(s.accuracy, 0.0, "6 px > 5 px tolerance");
+    }
+
+    #[test]
+    fn missing_reports_lower_accuracy_and_recovery_counts_frames_after_reappearance() {
+        // Visible, invisible on frames 2..4, visible again from 4; tracked again from frame 6.
+        let t = truth(8, |f| !(2..4).contains(&f));
+        let reps: Vec<_> = (0..8)
+            .map(|f| Some(report(0.0, f < 2 || f >= 6 || (2..4).contains(&f))))
+            .collect();
+        let s = score_sequence(&t, &reps);
+        assert_eq!(s.missed_lane_frames, 4, "frames 4 and 5, two lanes");
+        assert_eq!(
+            s.false_lane_frames, 4,
+            "frames 2 and 3 reported while invisible"
+        );
+        assert_eq!(s.max_recovery_frames, 2);
+        assert!((s.accuracy - 4.0 / 6.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn continuity_measures_frame_to_frame_bottom_row_changes() {
+        let reps: Vec<_> = [0.0, 1.0, 3.0, 3.0]
+            .iter()
+            .map(|&dx| Some(report(dx, true)))
+            .collect();
+        let c = continuity(&reps, 239.0);
+        assert_eq!(c.frames, 4);
+        assert_eq!(c.frames_both_reported, 4);
+        // Changes per lane: 1, 2, 0 → sorted over both lanes 0,0,1,1,2,2.
+        assert_eq!(c.median_bottom_change_px, 1.0);
+        assert_eq!(c.max_bottom_change_px, 2.0);
+    }
+
+    #[test]
+    fn label_scoring_picks_the_ego_lanes_and_counts_points_within_tolerance() {
+        // 1280×720 label: ego lanes at x = 400 and 900 (vertical, grey 10 and 20), an outer lane
+        // at 100 (grey 30) that must not be chosen.
+        let (w, h) = (1280usize, 720usize);
+        let mut label = crate::GreyFrame::new(w, h);
+        for y in 300..h {
+            for (x, v) in [(400usize, 10u8), (900, 20), (100, 30)] {
+                label.data[y * w + x] = v;
+                label.data[y * w + x + 1] = v;
+            }
+        }
+        let lane = |side, a3: f64| LaneReport {
+            side,
+            state: LaneState::Tracking,
+            coeffs: Some([0.0, 0.0, a3]),
+            rows: [300.0, 719.0],
+            points: 100,
+            initialised: true,
+        };
+        // Left lane 10 px off (correct at 20 px tolerance), right lane 30 px off (wrong).
+        let r = TrackReport {
+            lanes: [lane(Side::Left, 410.5), lane(Side::Right, 930.5)],
+            full_gradient: true,
+        };
+        let s = score_against_instance_label(&r, &label, 300, 10);
+        assert_eq!(s.points, 2 * 42);
+        assert_eq!(s.correct, 42);
+        assert!((s.accuracy - 0.5).abs() < 1e-12);
+        assert!((s.mean_error_px - 20.0).abs() < 1e-9);
+    }
+}

@@ -397,3 +397,59 @@ impl SceneRenderer {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ground_truth_is_where_the_marks_are_drawn() {
+        // Noise-free solid scene: in each row the intensity-weighted centre of the mark's bright
+        // pixels must sit on the true curve (the truth is what is rendered, not a guess).
+        let spec = SceneSpec {
+            noise_sigma: 0.0,
+            ..SCENES[0]
+        };
+        let mut r = SceneRenderer::new(spec, 320, 240);
+        let mut frame = GreyFrame::default();
+        for f in [0, 7, 15] {
+            r.render(f, &mut frame);
+            let truth = r.truth(f);
+            for y in [150usize, 190, 235] {
+                for lane in truth.lanes {
+                    let xt = lane.col_at_row(y as f64);
+                    let (mut sw, mut sx) = (0.0, 0.0);
+                    for x in (xt as usize).saturating_sub(8)..((xt as usize) + 9).min(320) {
+                        let excess =
+                            (f64::from(frame.data[y * 320 + x]) - spec.ground_grey).max(0.0);
+                        sw += excess;
+                        sx += excess * x as f64;
+                    }
+                    let centre = sx / sw;
+                    assert!(
+                        (centre - xt).abs() < 0.15,
+                        "frame {f} row {y}: drawn {centre}, truth {xt}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rendering_is_deterministic_and_the_wall_hides_the_lanes() {
+        let spec = SCENES.iter().find(|s| s.wall.is_some()).copied().unwrap();
+        let (a, b) = spec.wall.unwrap();
+        let (mut r1, mut r2) = (
+            SceneRenderer::new(spec, 320, 240),
+            SceneRenderer::new(spec, 320, 240),
+        );
+        let (mut f1, mut f2) = (GreyFrame::default(), GreyFrame::default());
+        for f in 0..spec.frames {
+            r1.render(f, &mut f1);
+            r2.render(f, &mut f2);
+            assert_eq!(f1, f2);
+            let visible = r1.truth(f).lanes.iter().all(|l| l.visible);
+            assert_eq!(visible, !(a..b).contains(&f));
+        }
+    }
+}

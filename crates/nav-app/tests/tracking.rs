@@ -17,15 +17,7 @@ fn run_scene(
 ) -> (Vec<Option<TrackReport>>, nav_app::synth::SequenceTruth) {
     let mut cfg = TrackerConfig::load(spec.config).unwrap();
     // The presets' pixel parameters are for 320-px-wide frames: scale them with the width.
-    let k = w as f64 / 320.0;
-    cfg.track.window_half_width_px = (cfg.track.window_half_width_px as f64 * k).round() as usize;
-    cfg.track.inlier_half_width_px *= k;
-    cfg.track.max_jump_px *= k;
-    cfg.track.min_lane_separation_px *= k;
-    cfg.init.band_half_width_px *= k;
-    cfg.filter.r_sigma_px *= k;
-    cfg.filter.q_sigma_px = cfg.filter.q_sigma_px.map(|q| q * k);
-    cfg.filter.p0_sigma_px = cfg.filter.p0_sigma_px.map(|q| q * k);
+    cfg.scale_pixels(w as f64 / 320.0);
     let mut renderer = SceneRenderer::new(spec, w, h);
     let mut tracker = LaneTracker::new(&cfg, estimator, w, h).unwrap();
     let mut frame = GreyFrame::default();
