@@ -122,11 +122,47 @@ pub enum NavError {
     },
     /// Live capture was requested but this build has none.
     #[error(
-        "{device}: live capture is not available in this build (the `capture` feature will wire the \
-         bt848-capture crate); use --input with an image, a directory of images or a .y4m file"
+        "{device}: live capture is not available in this build (nav-app was built without its \
+         `capture` feature; rebuild with `--features capture`, which needs libclang); use --input \
+         with an image, a directory of images or a .y4m file"
     )]
     CaptureUnavailable {
         /// The device path asked for.
+        device: String,
+    },
+    /// The capture device could not be opened or configured, or failed while streaming (bad
+    /// device node, unknown input, unsupported standard or format, ioctl failure). Fatal.
+    #[error("{device}: {source}")]
+    Capture {
+        /// The device path.
+        device: String,
+        /// What the capture layer reported.
+        #[source]
+        source: bt848_capture::CaptureError,
+    },
+    /// No frame arrived within the capture timeout; the stream has been restarted. Not fatal
+    /// while `consecutive < limit` (the frame loop reports it and asks again); the
+    /// `limit`-th timeout in a row is fatal.
+    #[error(
+        "{device}: no frame within {timeout_ms} ms (timeout {consecutive} of at most {limit} in a \
+         row; stream restarted: {restarted})"
+    )]
+    CaptureTimeout {
+        /// The device path.
+        device: String,
+        /// The timeout, ms.
+        timeout_ms: u32,
+        /// Timeouts in a row, this one included.
+        consecutive: u32,
+        /// Timeouts in a row that end the run.
+        limit: u32,
+        /// Whether the stream restart after the timeout succeeded.
+        restarted: bool,
+    },
+    /// The capture device went away (`ENODEV`: unplugged, driver unbound). Fatal.
+    #[error("{device}: capture device is gone (ENODEV)")]
+    DeviceGone {
+        /// The device path.
         device: String,
     },
     /// A configuration file is not valid TOML or does not match the schema.
@@ -179,13 +215,17 @@ pub enum NavError {
 
 impl NavError {
     /// `false` for errors that concern a single frame of a stream ([`NavError::BadFrame`],
-    /// [`NavError::ShortFrame`]): the caller reports and counts it and asks for the next frame.
+    /// [`NavError::ShortFrame`]) and for a capture timeout that is not yet the `limit`-th in a row
+    /// ([`NavError::CaptureTimeout`]): the caller reports and counts it and asks for the next frame.
     /// `true` for everything else: the run cannot go on.
     pub fn is_fatal(&self) -> bool {
-        !matches!(
-            self,
-            NavError::BadFrame { .. } | NavError::ShortFrame { .. }
-        )
+        match self {
+            NavError::BadFrame { .. } | NavError::ShortFrame { .. } => false,
+            NavError::CaptureTimeout {
+                consecutive, limit, ..
+            } => consecutive >= limit,
+            _ => true,
+        }
     }
 
     pub(crate) fn io(path: impl Into<String>, source: io::Error) -> Self {

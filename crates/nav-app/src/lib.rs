@@ -45,9 +45,11 @@
 //! ## Frame sources
 //! [`FrameSource`] fills a caller-owned [`GreyFrame`]. [`sources::StillImage`] (PNG, JPEG,
 //! PGM; colour → grey), [`sources::ImageDirectory`] (sorted), [`y4m::Y4mSource`] (file or
-//! stdin; `C mono` and 4:2:0, Y plane), [`sources::open_device`] (no capture in this build).
+//! stdin; `C mono` and 4:2:0, Y plane), and live V4L2 capture from a BT848/878 card
+//! ([`capture_source`]: `CaptureSource` over the `bt848-capture` crate, feature `capture`,
+//! default on; without it `--device` says capture is not in the build).
 //! Errors are [`NavError`]; [`NavError::is_fatal`] separates a fatal error from one bad frame
-//! that is reported, counted and skipped.
+//! (or one capture timeout) that is reported, counted and skipped.
 //!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field
@@ -75,6 +77,7 @@
 //! # Ok::<(), nav_app::NavError>(())
 //! ```
 
+pub mod capture_source;
 mod config;
 mod error;
 mod frame;

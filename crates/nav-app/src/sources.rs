@@ -223,9 +223,10 @@ pub fn open_input(path: &Path, dir_fps: f64) -> Result<Box<dyn FrameSource>, Nav
     Ok(Box::new(StillImage::new(path)))
 }
 
-/// Open `--device PATH`. This build has no capture: always [`NavError::CaptureUnavailable`].
+/// Open `--device PATH` with the default capture options (current input, NTSC-M, 320×240; see
+/// [`crate::capture_source`] for the options and the per-frame device fields). Without the
+/// `capture` feature always [`NavError::CaptureUnavailable`].
 pub fn open_device(path: &Path) -> Result<Box<dyn FrameSource>, NavError> {
-    Err(NavError::CaptureUnavailable {
-        device: path.display().to_string(),
-    })
+    crate::capture_source::open(path, &crate::capture_source::DeviceOptions::default())
+        .map(|(source, _monitor)| source)
 }

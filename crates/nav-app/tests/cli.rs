@@ -120,6 +120,7 @@ fn overlays_are_written_as_pngs_or_a_colour_y4m() {
     );
 }
 
+#[cfg(not(feature = "capture"))]
 #[test]
 fn device_exits_non_zero_saying_capture_is_unavailable() {
     let o = nav_app(&["--device", "/dev/video0"]);
