@@ -213,7 +213,7 @@ impl Strapdown {
         let r0 = self.frame.geodetic_rates(&v_mid);
         let lat_mid = s.pos.lat_rad + 0.5 * ts * r0.x;
         let alt_mid = s.pos.alt_m + 0.5 * ts * r0.z;
-        let lf = LocalFrame::new(lat_mid, alt_mid);
+        let lf = self.frame.near(lat_mid, alt_mid);
         let omega = lf.earth_rate_ned_radps;
         let rho = lf.transport_rate_ned_radps(&v_mid);
         let hb = exp_quat(&(w_b * (0.5 * ts)));

@@ -32,7 +32,7 @@
 //! values are the interval means to O(T_s²) — the representation that a second-order
 //! mechanization ([`crate::strapdown`]) integrates with O(T_s²) global error.
 
-use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use crate::config::TrajectoryConfig;
 use crate::earth::{Geodetic, LocalFrame};
@@ -65,9 +65,9 @@ struct Segment {
     accel_mps2: f64,
     heading_rate_radps: f64,
     path_rate_radps: f64,
-    /// sin/cos of χ̇·T_s/2 and γ̇·T_s/2.
-    half_step_heading_sin_cos: (f64, f64),
-    half_step_path_sin_cos: (f64, f64),
+    /// sin/cos of χ̇·T_s/4 and γ̇·T_s/4 (half-angle increments per half step).
+    quarter_step_heading_sin_cos: (f64, f64),
+    quarter_step_path_sin_cos: (f64, f64),
 }
 
 /// Kinematic state (V, χ, γ) and rates at an instant.
@@ -81,6 +81,8 @@ struct Kin {
     cos_heading: f64,
     sin_path: f64,
     cos_path: f64,
+    /// sin(χ/2), cos(χ/2), sin(γ/2), cos(γ/2).
+    half: [f64; 4],
 }
 
 impl Kin {
@@ -96,8 +98,10 @@ impl Kin {
         Matrix3::new(cc * cg, -sc, cc * sg, sc * cg, cc, sc * sg, -sg, 0.0, cg)
     }
 
+    /// q_b^n = q_z(χ) ⊗ q_y(γ) = (c_χ c_γ, −s_χ s_γ, c_χ s_γ, s_χ c_γ) in half angles.
     fn att_b_to_n(&self) -> UnitQuaternion<f64> {
-        UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(self.c_b_to_n()))
+        let [sc, cc, sg, cg] = self.half;
+        UnitQuaternion::new_unchecked(Quaternion::new(cc * cg, -sc * sg, cc * sg, sc * cg))
     }
 }
 
@@ -106,27 +110,35 @@ impl Segment {
         let dt = t_s - self.t0_s;
         let chi = self.heading0_rad + self.heading_rate_radps * dt;
         let gam = self.path0_rad + self.path_rate_radps * dt;
-        let (sc, cc) = chi.sin_cos();
-        let (sg, cg) = gam.sin_cos();
-        self.kin_from_trig(t_s, sc, cc, sg, cg)
+        let (sc, cc) = (0.5 * chi).sin_cos();
+        let (sg, cg) = (0.5 * gam).sin_cos();
+        self.kin_from_trig(t_s, [sc, cc, sg, cg])
     }
 
-    /// Kinematics at `t_s` (= t(prev) + T_s/2) by rotating `prev`'s heading and path angles by
-    /// the half-step increments (angle-addition recurrence; no trigonometric calls; rounding
-    /// drift ~1e-16 per step, tested against the direct evaluation).
+    /// Kinematics at `t_s` (= t(prev) + T_s/2) by rotating `prev`'s half heading and path angles
+    /// by the quarter-step increments (angle-addition recurrence, no trigonometric calls;
+    /// rounding drift ~1e-16 per step, tested against the direct evaluation).
     #[inline]
     fn advance_half_step(&self, prev: &Kin, t_s: f64) -> Kin {
-        let (sd, cd) = self.half_step_heading_sin_cos;
-        let (sp, cp) = self.half_step_path_sin_cos;
-        let sc = prev.sin_heading * cd + prev.cos_heading * sd;
-        let cc = prev.cos_heading * cd - prev.sin_heading * sd;
-        let sg = prev.sin_path * cp + prev.cos_path * sp;
-        let cg = prev.cos_path * cp - prev.sin_path * sp;
-        self.kin_from_trig(t_s, sc, cc, sg, cg)
+        let (sd, cd) = self.quarter_step_heading_sin_cos;
+        let (sp, cp) = self.quarter_step_path_sin_cos;
+        let [sc0, cc0, sg0, cg0] = prev.half;
+        self.kin_from_trig(
+            t_s,
+            [
+                sc0 * cd + cc0 * sd,
+                cc0 * cd - sc0 * sd,
+                sg0 * cp + cg0 * sp,
+                cg0 * cp - sg0 * sp,
+            ],
+        )
     }
 
     #[inline]
-    fn kin_from_trig(&self, t_s: f64, sc: f64, cc: f64, sg: f64, cg: f64) -> Kin {
+    fn kin_from_trig(&self, t_s: f64, half: [f64; 4]) -> Kin {
+        let [hsc, hcc, hsg, hcg] = half;
+        let (sc, cc) = (2.0 * hsc * hcc, hcc * hcc - hsc * hsc);
+        let (sg, cg) = (2.0 * hsg * hcg, hcg * hcg - hsg * hsg);
         let v = self.speed0_mps + self.accel_mps2 * (t_s - self.t0_s);
         let u = Vector3::new(cg * cc, cg * sc, -sg);
         let du_dg = Vector3::new(-sg * cc, -sg * sc, -cg);
@@ -141,6 +153,7 @@ impl Segment {
             cos_heading: cc,
             sin_path: sg,
             cos_path: cg,
+            half,
         }
     }
 }
@@ -174,10 +187,12 @@ impl Trajectory {
                 accel_mps2: s.along_accel_mps2,
                 heading_rate_radps: s.turn_rate_degps.to_radians(),
                 path_rate_radps: s.path_angle_rate_degps.to_radians(),
-                half_step_heading_sin_cos: (0.5 * cfg.step_s * s.turn_rate_degps.to_radians())
+                quarter_step_heading_sin_cos: (0.25 * cfg.step_s * s.turn_rate_degps.to_radians())
                     .sin_cos(),
-                half_step_path_sin_cos: (0.5 * cfg.step_s * s.path_angle_rate_degps.to_radians())
-                    .sin_cos(),
+                quarter_step_path_sin_cos: (0.25
+                    * cfg.step_s
+                    * s.path_angle_rate_degps.to_radians())
+                .sin_cos(),
             };
             t = seg.t1_s;
             v += seg.accel_mps2 * s.duration_s;
@@ -194,8 +209,8 @@ impl Trajectory {
             accel_mps2: 0.0,
             heading_rate_radps: 0.0,
             path_rate_radps: 0.0,
-            half_step_heading_sin_cos: (0.0, 1.0),
-            half_step_path_sin_cos: (0.0, 1.0),
+            quarter_step_heading_sin_cos: (0.0, 1.0),
+            quarter_step_path_sin_cos: (0.0, 1.0),
         });
         let n_steps = (cfg.end_time_s / cfg.step_s).round() as usize;
         Ok(Self {
@@ -322,7 +337,7 @@ impl Iterator for TruthGenerator<'_> {
         let d_full = (v0 + 4.0 * vm + v1) * (ts / 6.0);
         let p0 = self.pos;
         let pm = p0 + self.frame.geodetic_rates(&d_half);
-        let lf = LocalFrame::new(pm.x, pm.z);
+        let lf = self.frame.near(pm.x, pm.z);
         // Radii at the midpoint: the product error is ~T_s³·(d/dt 1/(R+h))·a ≈ 1e-21 rad/step.
         let p1 = p0 + lf.geodetic_rates(&d_full);
         // Ideal IMU at the midpoint.
@@ -410,6 +425,17 @@ mod tests {
             q.angle_to(&last.att_b_to_n)
         );
         assert!((direct.vel_ned_mps - last.vel_ned_mps).norm() < 1e-10);
+        // Half-angle quaternion and C_b^n = R_z(χ) R_y(γ) agree with nalgebra's yaw-pitch-roll.
+        let (chi, gam) = (2.3_f64, -0.2_f64);
+        let k = Segment {
+            heading0_rad: chi,
+            path0_rad: gam,
+            ..*seg
+        }
+        .kin(seg.t0_s);
+        let reference = UnitQuaternion::from_euler_angles(0.0, gam, chi);
+        assert!(k.att_b_to_n().angle_to(&reference) < 1e-15);
+        assert!((k.c_b_to_n() - reference.to_rotation_matrix().into_inner()).norm() < 1e-15);
     }
 
     #[test]
