@@ -163,3 +163,87 @@ fn dense_and_block_transitions_agree() {
         }
     }
 }
+
+#[test]
+fn propagated_covariance_matches_the_standalone_monte_carlo_spread() {
+    use nav_app::ins_sd::{Mode, Sample, run, run_seed};
+    // Stand-alone INS, 150 s: the spread of 200 seeded runs against the covariance propagated
+    // through the interval model (1 s steps, true sensor statistics, P0 = bias and drift σ only:
+    // the INS starts at the truth). Checks the error model, its averaging and the noise
+    // conversion together against the nonlinear simulation.
+    let t_end = 150usize;
+    let sc = Scenario::paper_default().truncated(t_end as f64).unwrap();
+    let runs = 200u64;
+    let mut sum2 = [0.0f64; 9];
+    let mut out = vec![Sample::default(); sc.samples_per_run()];
+    for i in 0..runs {
+        run(
+            &sc,
+            Mode::Standalone,
+            run_seed(99, Mode::Standalone, i),
+            &mut out,
+        )
+        .unwrap();
+        let s = out[t_end];
+        for k in 0..3 {
+            sum2[k] += s.pos_err_ned_m[k].powi(2);
+            sum2[3 + k] += s.vel_err_ned_mps[k].powi(2);
+            sum2[6 + k] += s.misalignment_rad[k].powi(2);
+        }
+    }
+    // Covariance along the error-free INS (its linearisation points are those of any run to
+    // first order).
+    let tr = Trajectory::new(&sc.trajectory).unwrap();
+    let step_s = tr.step_s();
+    let params = ImuErrorParams::from_config(&sc.imu).unwrap();
+    let psd = {
+        let e = ImuErrors::draw(&params, &mut ChaCha8Rng::seed_from_u64(0));
+        let (qa, qg) = e.noise_psd(step_s);
+        [qa, qg, 0.0, 0.0]
+    };
+    let mut it = tr.samples();
+    let s0 = it.next().unwrap();
+    let mut ins = Strapdown::new(
+        NavState {
+            pos: s0.pos,
+            vel_ned_mps: s0.vel_ned_mps,
+            att_b_to_n: s0.att_b_to_n,
+        },
+        step_s,
+    )
+    .unwrap();
+    let mut p = Mat15::zeros();
+    for i in 0..3 {
+        p[(9 + i, 9 + i)] = params.accel_bias_sigma_mps2.powi(2);
+        p[(12 + i, 12 + i)] = params.gyro_drift_sigma_radps.powi(2);
+    }
+    let mut model = IntervalModel::new(100, 2, step_s, psd);
+    let mut ideal = s0;
+    for (k, s) in it.enumerate() {
+        ins.step(
+            &ideal.specific_force_body_mps2,
+            &ideal.ang_rate_ib_body_radps,
+        );
+        ideal = s;
+        model.push(&ins.linearization_point());
+        if (k + 1) % 100 == 0 {
+            let (phi, q) = model.take();
+            p = phi * p * phi.transpose() + q;
+        }
+    }
+    let names = [
+        "δp_N", "δp_E", "δp_D", "δv_N", "δv_E", "δv_D", "ψ_N", "ψ_E", "ψ_D",
+    ];
+    for k in 0..9 {
+        let sample = sum2[k] / runs as f64;
+        let ratio = sample / p[(k, k)];
+        println!(
+            "t = {t_end} s {}: MC σ = {:.3e}, model σ = {:.3e}, ratio of variances {ratio:.3}",
+            names[k],
+            sample.sqrt(),
+            p[(k, k)].sqrt()
+        );
+        // 200 runs: the sample variance has ≈ 10 % relative σ; band ±30 %.
+        assert!((0.7..1.3).contains(&ratio), "{}: ratio {ratio}", names[k]);
+    }
+}

@@ -278,3 +278,24 @@ fn exploding_sensors_give_non_finite_with_time_or_a_sighting_error() {
         other => panic!("expected a typed failure, got {other:?}"),
     }
 }
+
+#[test]
+fn akf_equals_kf_until_its_window_fills_then_adapts() {
+    // Same seed → same truth, IMU and SD noise (common random numbers). The AKF predicts with
+    // the KF's a-priori Q until N = 10 updates have filled its window, so both filters are
+    // identical up to t = 10 s; from the 11th update on it uses Q̂ and departs.
+    let sc = Scenario::paper_default().truncated(30.0).unwrap();
+    assert_eq!(sc.filter.akf_window, 10);
+    let seed = run_seed(sc.monte_carlo.seed, Mode::Kf, 4);
+    let kf = run_once(&sc, Mode::Kf, seed);
+    let akf = run_once(&sc, Mode::Akf, seed);
+    for t in 0..=10 {
+        assert_eq!(kf[t], akf[t], "t = {t}");
+    }
+    for t in 11..=30 {
+        assert_ne!(kf[t].pos_err_ned_m, akf[t].pos_err_ned_m, "t = {t}");
+        assert_ne!(kf[t].nis, akf[t].nis, "t = {t}");
+    }
+    // The truth is shared: same distance flown.
+    assert_eq!(kf[30].distance_m, akf[30].distance_m);
+}

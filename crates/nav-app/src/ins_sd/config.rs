@@ -49,6 +49,9 @@ impl ScenarioError {
 /// random-walk densities of the bias/drift states. The white-noise figures use the same units
 /// as `[imu]` (variance of one IMU sample at `trajectory.step_s`; PSD = variance · step_s), so
 /// "true statistics" means copying the `[imu]` values and zero random walks.
+///
+/// The SD update period is not repeated here: it is `[sighting] update_period_s` (one source
+/// of truth for the simulated device and the filter).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FilterConfig {

@@ -19,9 +19,9 @@ type Vec15 = SVector<f64, 15>;
 pub(crate) enum Filter {
     /// Stand-alone INS: no filter.
     None,
-    /// Manually tuned KF.
-    Kf(KalmanFilter<15>),
-    /// Adaptive KF (window in the box to keep the enum small).
+    /// Manually tuned KF (boxed: the filter holds a 15×15 P).
+    Kf(Box<KalmanFilter<15>>),
+    /// Adaptive KF (boxed: P, Φ and the Δx window).
     Akf(Box<AdaptiveKalmanFilter<15>>),
 }
 
@@ -128,10 +128,10 @@ impl Loop {
         let f = &scenario.filter;
         let filter = match mode {
             Mode::Standalone => Filter::None,
-            Mode::Kf => Filter::Kf(
+            Mode::Kf => Filter::Kf(Box::new(
                 KalmanFilter::new(Vec15::zeros(), p0)
                     .map_err(|source| RunError::Filter { t_s: 0.0, source })?,
-            ),
+            )),
             Mode::Akf => Filter::Akf(Box::new(
                 AdaptiveKalmanFilter::new(
                     Vec15::zeros(),
