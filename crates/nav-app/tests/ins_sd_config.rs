@@ -138,6 +138,7 @@ fn truncation_keeps_the_start_and_validates() {
         Scenario::paper_default().trajectory.segments[0]
     );
     assert!(Scenario::paper_default().truncated(10.5).is_err());
+    assert!(Scenario::paper_default().truncated(901.0).is_err());
 }
 
 #[test]

@@ -241,7 +241,11 @@ fn akf_nees_and_nis_are_reported() {
     }
     let (nees, nis) = (nees / n as f64, nis / n as f64);
     println!("AKF over {runs} runs: mean NEES {nees:.2} (n = 15), mean NIS {nis:.2} (m = 6)");
-    assert!(nees.is_finite() && nis.is_finite() && nees > 0.0 && nis > 0.0);
+    // Documented behaviour of the Mohamed–Schwarz AKF here (module doc): before 600 s its Q̂
+    // over-estimates the process noise, so it is under-confident: NEES and NIS both below their
+    // dimensions (≈ 6 and ≈ 4 over 100 runs), yet not collapsed to zero.
+    assert!((3.0..12.0).contains(&nees), "AKF NEES {nees}");
+    assert!((2.5..5.5).contains(&nis), "AKF NIS {nis}");
 }
 
 #[test]

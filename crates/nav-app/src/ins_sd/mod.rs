@@ -299,8 +299,17 @@ impl Scenario {
     }
 
     /// The same scenario cut to its first `duration_s` seconds (manoeuvre segments that
-    /// start after it are dropped, the last one shortened). For fast tests.
+    /// start after it are dropped, the last one shortened). For fast tests and `--duration`.
+    /// Errors (naming `trajectory.end_time_s`) when longer than the scenario or not a whole
+    /// number of seconds.
     pub fn truncated(&self, duration_s: f64) -> Result<Scenario, ScenarioError> {
+        if !(duration_s.is_finite() && duration_s <= self.trajectory.end_time_s) {
+            return Err(ScenarioError::invalid(
+                "trajectory.end_time_s",
+                "a truncated scenario must not be longer than the original",
+                duration_s,
+            ));
+        }
         let mut s = self.clone();
         let mut t = 0.0;
         let mut keep = Vec::new();
