@@ -391,7 +391,7 @@ mod tests {
         // Visible, invisible on frames 2..4, visible again from 4; tracked again from frame 6.
         let t = truth(8, |f| !(2..4).contains(&f));
         let reps: Vec<_> = (0..8)
-            .map(|f| Some(report(0.0, f < 2 || f >= 6 || (2..4).contains(&f))))
+            .map(|f| Some(report(0.0, !(4..6).contains(&f))))
             .collect();
         let s = score_sequence(&t, &reps);
         assert_eq!(s.missed_lane_frames, 4, "frames 4 and 5, two lanes");
