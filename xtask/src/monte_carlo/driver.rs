@@ -14,7 +14,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nav_app::ins_sd::{Mode, RunError, RunOutcome, Sample};
 use rayon::prelude::*;
 
-use super::stats::{Exclusion, ModeStats};
+use super::stats::{Exclusion, ModeStats, RunSummary};
 
 /// What to simulate.
 #[derive(Clone, Debug)]
@@ -38,6 +38,8 @@ pub struct Simulated {
     pub modes: Vec<ModeStats>,
     /// Runs left out, in (index, mode) order.
     pub exclusions: Vec<Exclusion>,
+    /// Kept runs in brief, in (index, mode) order.
+    pub runs: Vec<RunSummary>,
     /// Wall time of the simulation, s.
     pub wall_s: f64,
 }
@@ -134,6 +136,7 @@ where
         .map(|&m| ModeStats::new(m, plan.samples))
         .collect();
     let mut exclusions = Vec::new();
+    let mut runs = Vec::new();
     let block = 16 * plan.threads as u64;
     let start = Instant::now();
     let mut block_lo = lo;
@@ -204,7 +207,14 @@ where
                 }
             };
             match excluded {
-                None => stats.push_run(&job.samples),
+                None => {
+                    stats.push_run(&job.samples);
+                    runs.push(RunSummary::of(
+                        plan.modes[job.mode_slot],
+                        job.index,
+                        &job.samples,
+                    ));
+                }
                 Some((t_s, reason)) => {
                     bar.suspend(|| {
                         eprintln!(
@@ -228,6 +238,7 @@ where
     Ok(Simulated {
         modes,
         exclusions,
+        runs,
         wall_s: start.elapsed().as_secs_f64(),
     })
 }

@@ -352,8 +352,11 @@ pub fn simulate_stats(r: &Resolved, progress: bool) -> Result<Stats> {
 pub fn build_stats(r: &Resolved, range: (u64, u64), sim: driver::Simulated) -> Stats {
     let mut exclusions = sim.exclusions;
     exclusions.sort_by(|a, b| {
-        let rank = |m: &str| Mode::ALL.iter().position(|x| x.name() == m);
-        (rank(&a.mode), a.run_index).cmp(&(rank(&b.mode), b.run_index))
+        stats::order_key(&a.mode, a.run_index).cmp(&stats::order_key(&b.mode, b.run_index))
+    });
+    let mut runs = sim.runs;
+    runs.sort_by(|a, b| {
+        stats::order_key(&a.mode, a.run_index).cmp(&stats::order_key(&b.mode, b.run_index))
     });
     Stats {
         format: FORMAT.to_string(),
@@ -367,6 +370,7 @@ pub fn build_stats(r: &Resolved, range: (u64, u64), sim: driver::Simulated) -> S
         shards: vec![r.shard],
         modes: sim.modes,
         exclusions,
+        runs,
         wall_s: sim.wall_s,
         core_s: sim.wall_s * r.threads as f64,
     }

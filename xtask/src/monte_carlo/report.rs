@@ -75,13 +75,22 @@ pub struct Consistency {
     pub above: f64,
     /// … below the band (filter under-confident: P or S too large).
     pub below: f64,
+    /// First and last epoch (s) above the band.
+    pub above_span: Option<(f64, f64)>,
+    /// First and last epoch (s) below the band.
+    pub below_span: Option<(f64, f64)>,
 }
 
 /// NEES or NIS consistency of one mode (None for a mode without a filter).
 pub fn consistency(m: &ModeStats, q: usize, dof: usize) -> Option<Consistency> {
     let mut total = Moments::default();
     let (mut epochs, mut inside, mut above, mut below) = (0usize, 0usize, 0usize, 0usize);
-    for bin in &m.bins {
+    let (mut above_span, mut below_span) = (None, None);
+    let widen = |span: &mut Option<(f64, f64)>, t: f64| {
+        *span = Some(span.map_or((t, t), |(a, _)| (a, t)));
+    };
+    for (t, bin) in m.bins.iter().enumerate() {
+        let t = t as f64;
         let b = bin[q];
         if b.n == 0 {
             continue;
@@ -90,8 +99,14 @@ pub fn consistency(m: &ModeStats, q: usize, dof: usize) -> Option<Consistency> {
         epochs += 1;
         let avg = b.mean();
         match band(dof, b.n) {
-            Some((lo, _)) if avg < lo => below += 1,
-            Some((_, hi)) if avg > hi => above += 1,
+            Some((lo, _)) if avg < lo => {
+                below += 1;
+                widen(&mut below_span, t);
+            }
+            Some((_, hi)) if avg > hi => {
+                above += 1;
+                widen(&mut above_span, t);
+            }
             _ => inside += 1,
         }
     }
@@ -103,6 +118,8 @@ pub fn consistency(m: &ModeStats, q: usize, dof: usize) -> Option<Consistency> {
             inside: inside as f64 / e,
             above: above as f64 / e,
             below: below as f64 / e,
+            above_span,
+            below_span,
         }
     })
 }
@@ -168,6 +185,14 @@ pub fn summary_json(stats: &Stats) -> Result<String> {
             json_num(last[qi::POS_D].rms()),
         );
         o.insert("distance_m".into(), json_num(dist));
+        o.insert(
+            "final_position_error_median_m".into(),
+            json_num(median_final(stats, &m.mode)),
+        );
+        o.insert(
+            "worst_runs".into(),
+            serde_json::to_value(worst_runs(stats, &m.mode, 5))?,
+        );
         o.insert(
             "final_error_percent_of_distance".into(),
             json_num(100.0 * last[qi::POS_3D].rms() / dist),
@@ -284,21 +309,76 @@ pub fn timeseries_csv(m: &ModeStats) -> String {
     s
 }
 
+/// One word for a consistency result.
+fn state(c: &Consistency) -> &'static str {
+    if c.inside >= 0.9 {
+        "consistent"
+    } else if c.above >= 0.05 && c.below >= 0.05 {
+        "inconsistent both ways"
+    } else if c.above >= c.below {
+        "over-confident"
+    } else {
+        "under-confident"
+    }
+}
+
 /// How a χ² statistic sits against its band, in words.
 fn verdict(c: &Consistency) -> String {
-    let word = if c.inside >= 0.9 {
-        "consistent"
-    } else if c.above >= c.below {
-        "**over-confident** (its covariance is smaller than its actual errors)"
-    } else {
-        "**under-confident** (its covariance is larger than its actual errors)"
+    let span =
+        |x: Option<(f64, f64)>| x.map_or(String::new(), |(a, b)| format!(" (t = {a:.0}…{b:.0} s)"));
+    let word = match state(c) {
+        "consistent" => "consistent".to_string(),
+        "over-confident" => {
+            "**over-confident** (its covariance is smaller than its actual errors)".to_string()
+        }
+        "under-confident" => {
+            "**under-confident** (its covariance is larger than its actual errors)".to_string()
+        }
+        other => format!(
+            "**{other}**: under-confident at some epochs, over-confident (covariance too small) at others"
+        ),
     };
     format!(
-        "run average inside its 95 % band at {:.0} % of the epochs, above at {:.0} %, below at {:.0} % → {word}",
+        "run average inside its 95 % band at {:.0} % of the epochs, above at {:.0} %{}, below at {:.0} %{} → {word}",
         100.0 * c.inside,
         100.0 * c.above,
-        100.0 * c.below
+        span(c.above_span),
+        100.0 * c.below,
+        span(c.below_span)
     )
+}
+
+/// Median of the final 3-D errors of the kept runs of `mode`.
+pub fn median_final(stats: &Stats, mode: &str) -> f64 {
+    let mut v: Vec<f64> = stats
+        .runs
+        .iter()
+        .filter(|r| r.mode == mode)
+        .map(|r| r.final_pos_3d_m)
+        .collect();
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// The `k` kept runs of `mode` with the largest peak 3-D error, largest first.
+pub fn worst_runs(stats: &Stats, mode: &str, k: usize) -> Vec<super::stats::RunSummary> {
+    let mut v: Vec<_> = stats
+        .runs
+        .iter()
+        .filter(|r| r.mode == mode)
+        .cloned()
+        .collect();
+    v.sort_by(|a, b| b.peak_pos_3d_m.total_cmp(&a.peak_pos_3d_m));
+    v.truncate(k);
+    v
 }
 
 /// `summary.md`.
@@ -337,20 +417,21 @@ pub fn summary_md(stats: &Stats) -> String {
     let _ = writeln!(s, "## At the final time, beside the paper\n");
     let _ = writeln!(
         s,
-        "| configuration | runs used | excluded | 3-D error RMS (m) | horizontal RMS (m) | vertical RMS (m) | distance (km) | 3-D error / distance | paper |"
+        "| configuration | runs used | excluded | 3-D error RMS (m) | 3-D error median (m) | horizontal RMS (m) | vertical RMS (m) | distance (km) | 3-D error / distance | paper |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
     for m in &stats.modes {
         let last = m.bins.last().copied().unwrap_or_default();
         let dist = last[qi::DIST].mean();
         let excluded = stats.exclusions.iter().filter(|e| e.mode == m.mode).count();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} % | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} % | {} |",
             m.mode,
             m.runs_used,
             excluded,
             f(last[qi::POS_3D].rms(), 1),
+            f(median_final(stats, &m.mode), 1),
             f(last[qi::POS_H].rms(), 1),
             f(last[qi::POS_D].rms(), 1),
             f(dist / 1000.0, 2),
@@ -410,6 +491,26 @@ pub fn summary_md(stats: &Stats) -> String {
                     verdict(&c)
                 );
             }
+        }
+        let worst = worst_runs(stats, &m.mode, 3);
+        if !worst.is_empty() {
+            let _ = writeln!(
+                s,
+                "- Worst runs by peak 3-D position error: {}.",
+                worst
+                    .iter()
+                    .map(|r| format!(
+                        "run {} peaks at {} m at t = {} s (final {} m{})",
+                        r.run_index,
+                        f(r.peak_pos_3d_m, 1),
+                        r.peak_t_s,
+                        f(r.final_pos_3d_m, 1),
+                        r.peak_nees
+                            .map_or(String::new(), |x| format!(", peak NEES {}", f(x, 0)))
+                    ))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            );
         }
         s.push('\n');
     }
@@ -568,15 +669,6 @@ fn differences(s: &mut String, stats: &Stats) {
         let Some(paper_m) = p.error_m else { continue };
         let ratio = final_rms(m) / paper_m;
         let nis = consistency(m, qi::NIS, NIS_DOF).unwrap_or_default();
-        let state = |c: &Consistency| {
-            if c.inside >= 0.9 {
-                "consistent"
-            } else if c.above >= c.below {
-                "over-confident"
-            } else {
-                "under-confident"
-            }
-        };
         let _ = write!(
             s,
             "- **{}**: {} × the paper's error (NEES {}, NIS {}). ",

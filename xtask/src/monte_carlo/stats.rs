@@ -193,6 +193,53 @@ pub struct Exclusion {
     pub reason: String,
 }
 
+/// One kept run in brief (robust statistics and the worst runs; merged by concatenation).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Mode name.
+    pub mode: String,
+    /// Run index.
+    pub run_index: u64,
+    /// 3-D position error at the final time, m.
+    pub final_pos_3d_m: f64,
+    /// Largest 3-D position error over the 1 Hz records, m.
+    pub peak_pos_3d_m: f64,
+    /// When it occurred, s.
+    pub peak_t_s: f64,
+    /// Largest NEES over the SD epochs (filters only).
+    pub peak_nees: Option<f64>,
+}
+
+impl RunSummary {
+    /// Summarises one finite run.
+    pub fn of(mode: Mode, run_index: u64, samples: &[Sample]) -> Self {
+        let norm = |s: &Sample| {
+            let [n, e, d] = s.pos_err_ned_m;
+            (n * n + e * e + d * d).sqrt()
+        };
+        let (mut peak, mut peak_t) = (0.0, 0.0);
+        for s in samples {
+            let e = norm(s);
+            if e > peak {
+                peak = e;
+                peak_t = s.t_s;
+            }
+        }
+        let peak_nees = samples
+            .iter()
+            .filter_map(|s| s.nees)
+            .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
+        Self {
+            mode: mode.name().to_string(),
+            run_index,
+            final_pos_3d_m: samples.last().map_or(f64::NAN, norm),
+            peak_pos_3d_m: peak,
+            peak_t_s: peak_t,
+            peak_nees,
+        }
+    }
+}
+
 /// Which slice of the run indices a statistics file covers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ShardInfo {
@@ -228,6 +275,9 @@ pub struct Stats {
     pub modes: Vec<ModeStats>,
     /// Runs left out, sorted by mode then index.
     pub exclusions: Vec<Exclusion>,
+    /// Every kept run in brief, sorted by mode then index.
+    #[serde(default)]
+    pub runs: Vec<RunSummary>,
     /// Σ over shards of the wall time of the simulation phase, s.
     pub wall_s: f64,
     /// Σ over shards of thread count × wall time, core·s.
@@ -308,6 +358,7 @@ pub fn merge(mut parts: Vec<Stats>) -> anyhow::Result<Stats> {
         out.run_ranges.extend_from_slice(&p.run_ranges);
         out.shards.extend_from_slice(&p.shards);
         out.exclusions.extend_from_slice(&p.exclusions);
+        out.runs.extend_from_slice(&p.runs);
         out.wall_s += p.wall_s;
         out.core_s += p.core_s;
     }
@@ -324,10 +375,10 @@ pub fn merge(mut parts: Vec<Stats>) -> anyhow::Result<Stats> {
         }
     }
     out.shards.sort_by_key(|s| s.index);
-    out.exclusions.sort_by(|a, b| {
-        let rank = |m: &str| Mode::ALL.iter().position(|x| x.name() == m);
-        (rank(&a.mode), a.run_index).cmp(&(rank(&b.mode), b.run_index))
-    });
+    out.exclusions
+        .sort_by(|a, b| order_key(&a.mode, a.run_index).cmp(&order_key(&b.mode, b.run_index)));
+    out.runs
+        .sort_by(|a, b| order_key(&a.mode, a.run_index).cmp(&order_key(&b.mode, b.run_index)));
     Ok(out)
 }
 
@@ -353,4 +404,9 @@ pub fn missing_ranges(stats: &Stats) -> Vec<(u64, u64)> {
         missing.push((next, stats.runs_total));
     }
     missing
+}
+
+/// Sort key: mode in `Mode::ALL` order, then run index.
+pub fn order_key(mode: &str, run_index: u64) -> (Option<usize>, u64) {
+    (Mode::ALL.iter().position(|x| x.name() == mode), run_index)
 }

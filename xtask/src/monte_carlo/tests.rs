@@ -91,6 +91,12 @@ fn merge_of_two_shards_equals_one_run() {
     for (a, b) in merged.modes.iter().zip(&single.modes) {
         assert_bins_close(a, b, 1e-12);
     }
+    // The per-run briefs are the same runs with the same numbers.
+    assert_eq!(merged.runs.len(), single.runs.len());
+    for (a, b) in merged.runs.iter().zip(&single.runs) {
+        assert_eq!((&a.mode, a.run_index), (&b.mode, b.run_index));
+        assert!(close(a.final_pos_3d_m, b.final_pos_3d_m, 1e-12));
+    }
     // The headline numbers of the merged summary equal those of the single run.
     let js: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
@@ -284,6 +290,12 @@ fn non_finite_runs_are_excluded_and_counted() {
     };
     let mut st = build_stats(&r, (0, 5), sim);
     st.duration_s = 10.0;
+    let kept: Vec<u64> = st.runs.iter().map(|r| r.run_index).collect();
+    assert_eq!(kept, vec![0, 1, 4]);
+    // Final 3-D error of run i: √((10 i)² + 1 + 100); the median of runs 0, 1, 4 is run 1's.
+    assert!((report::median_final(&st, "kf") - 201f64.sqrt()).abs() < 1e-12);
+    let worst = report::worst_runs(&st, "kf", 1);
+    assert_eq!((worst[0].run_index, worst[0].peak_t_s), (4, 10.0));
     let md = report::summary_md(&st);
     assert!(md.contains("2 run(s) excluded"), "{md}");
     assert!(md.contains("kf run 2 at t = 7 s"), "{md}");
