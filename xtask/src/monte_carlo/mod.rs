@@ -351,13 +351,9 @@ pub fn simulate_stats(r: &Resolved, progress: bool) -> Result<Stats> {
 /// Wraps a driver result into [`Stats`].
 pub fn build_stats(r: &Resolved, range: (u64, u64), sim: driver::Simulated) -> Stats {
     let mut exclusions = sim.exclusions;
-    exclusions.sort_by(|a, b| {
-        stats::order_key(&a.mode, a.run_index).cmp(&stats::order_key(&b.mode, b.run_index))
-    });
+    exclusions.sort_by_key(|a| stats::order_key(&a.mode, a.run_index));
     let mut runs = sim.runs;
-    runs.sort_by(|a, b| {
-        stats::order_key(&a.mode, a.run_index).cmp(&stats::order_key(&b.mode, b.run_index))
-    });
+    runs.sort_by_key(|a| stats::order_key(&a.mode, a.run_index));
     Stats {
         format: FORMAT.to_string(),
         scenario_fingerprint: stats::fingerprint(&format!("{:?}", r.scenario)),

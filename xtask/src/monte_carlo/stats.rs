@@ -376,9 +376,8 @@ pub fn merge(mut parts: Vec<Stats>) -> anyhow::Result<Stats> {
     }
     out.shards.sort_by_key(|s| s.index);
     out.exclusions
-        .sort_by(|a, b| order_key(&a.mode, a.run_index).cmp(&order_key(&b.mode, b.run_index)));
-    out.runs
-        .sort_by(|a, b| order_key(&a.mode, a.run_index).cmp(&order_key(&b.mode, b.run_index)));
+        .sort_by_key(|a| order_key(&a.mode, a.run_index));
+    out.runs.sort_by_key(|a| order_key(&a.mode, a.run_index));
     Ok(out)
 }
 
