@@ -11,12 +11,15 @@
 //!    bindgen needs libclang). Missing ones are installed with apt-get when running as root
 //!    (fresh machine), or in CI (`CI` set) through passwordless `sudo`; otherwise the command
 //!    stops and says what to install.
-//! 2. Guest program: by default `bt848-capture`'s `grab` example, built with
-//!    `-C target-feature=+crt-static` for `x86_64-unknown-linux-gnu`; `--guest-bin PATH` runs
-//!    another static binary instead (e.g. `nav-app`), which must accept the same flags
-//!    (`--device --input-name --input-index --std --size --format --max-frames --timeout-ms
-//!    --json --ctrl NAME=VALUE@FRAME --ctrl-on-timeout NAME=VALUE`) and print the same JSON lines
-//!    (`{"type":"open"|"frame"|"ctrl"|"timeout"|"summary",…}`; see `grab.rs`).
+//! 2. Guest program: the real `nav-app` (lane tracker with its `capture` feature), built
+//!    `--release` with `-C target-feature=+crt-static` for `x86_64-unknown-linux-gnu`
+//!    (`target/x86_64-unknown-linux-gnu/release/nav-app`; the cold build compiles nav-app's whole
+//!    dependency tree for that target once). `--guest-bin PATH` runs another static build of
+//!    nav-app instead. The guest runs e.g. `nav-app --device /dev/video0 --input-name S-Video
+//!    --std ntsc --max-frames 60 --json` and prints one JSON object per tracked frame (with its
+//!    `"capture"` device fields) and a last `{"summary": {…}}` line, plus its hidden test flags
+//!    (`--format --timeout-ms --ctrl NAME=VALUE@FRAME --ctrl-on-timeout NAME=VALUE`) for the
+//!    fault cases; see `crates/nav-app/src/main.rs`.
 //! 3. Kernel: the package `linux-image-amd64` depends on, fetched with `apt-get download` and
 //!    unpacked with `dpkg -x` (not installed).
 //! 4. Initramfs (newc cpio written here): busybox, `/init`, the modules rc-core, cec, mc,
@@ -42,7 +45,7 @@ use serde_json::Value;
 /// Options of `cargo xtask vivid`.
 #[derive(clap::Args, Debug)]
 pub struct VividArgs {
-    /// Static guest binary to test instead of building bt848-capture's `grab` example.
+    /// Static nav-app binary to test instead of building it.
     #[arg(long)]
     guest_bin: Option<PathBuf>,
     /// Kill qemu after this many seconds.
@@ -88,6 +91,10 @@ const VIVID_PARAMS: &str = "n_devs=1 node_types=0x1 num_inputs=2 input_types=0x9
 /// Common guest arguments: vivid's S-Video input, NTSC, 320×240.
 const BASE: &str = "--device /dev/video0 --input-name S-Video --std ntsc --size 320x240 --json";
 
+/// nav-app's exit codes (see `crates/nav-app/src/main.rs`).
+const EXIT_ERROR: i64 = 1;
+const EXIT_DEVICE_GONE: i64 = 3;
+
 /// What a case requires of the guest's output.
 #[derive(Clone, Copy)]
 enum Expect {
@@ -102,7 +109,7 @@ enum Expect {
     Std { mask: u64, frames: u64 },
     /// Exit 0 on input `index`.
     Input { index: u64 },
-    /// A clean typed error mentioning `text`, exit 2.
+    /// A clean typed error mentioning `text`, exit 1.
     CleanError { text: &'static str },
     /// Injected `V4L2_BUF_FLAG_ERROR` buffers: errored_dropped ≥ 1, all frames delivered, exit 0.
     BufError { frames: u64 },
@@ -133,6 +140,17 @@ fn cases() -> Vec<Case> {
         },
     };
     vec![
+        // The issue's command verbatim: no --format, no --size (GREY and 320×240 are defaults).
+        Case {
+            name: "nav-app-default",
+            args: "--device /dev/video0 --input-name S-Video --std ntsc --max-frames 60 --json"
+                .into(),
+            expect: Expect::Stream {
+                fourcc: "GREY",
+                frames: 60,
+                optional: false,
+            },
+        },
         stream("stream-grey", "GREY", false),
         stream("stream-yuyv", "YUYV", false),
         stream("stream-yu12", "YU12", false),
@@ -210,7 +228,7 @@ pub fn run(args: VividArgs) -> Result<()> {
 
     let guest = match &args.guest_bin {
         Some(p) => p.clone(),
-        None => build_grab(&root)?,
+        None => build_nav_app(&root)?,
     };
     ensure!(
         is_static_elf(&guest)?,
@@ -388,30 +406,37 @@ fn cargo() -> String {
     std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned())
 }
 
-/// Build `grab` statically; returns its path.
-fn build_grab(root: &Path) -> Result<PathBuf> {
+/// Build `nav-app` (feature `capture`) statically in release; returns its path.
+fn build_nav_app(root: &Path) -> Result<PathBuf> {
     const TARGET: &str = "x86_64-unknown-linux-gnu";
-    eprintln!("vivid: building the static guest program (bt848-capture example `grab`)…");
+    eprintln!("vivid: building the static guest program (nav-app --features capture, release)…");
+    let started = Instant::now();
     let status = Command::new(cargo())
         .current_dir(root)
         .args([
             "build",
+            "--release",
             "-p",
-            "bt848-capture",
-            "--example",
-            "grab",
+            "nav-app",
+            "--bin",
+            "nav-app",
+            "--features",
+            "capture",
             "--target",
             TARGET,
         ])
         .env("RUSTFLAGS", "-C target-feature=+crt-static")
         .status()
         .context("starting cargo build for the guest program")?;
-    ensure!(status.success(), "building the static guest program failed");
+    ensure!(status.success(), "building the static nav-app failed");
+    eprintln!(
+        "vivid: guest build took {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
     Ok(target_dir(root)
         .join(TARGET)
-        .join("debug")
-        .join("examples")
-        .join("grab"))
+        .join("release")
+        .join("nav-app"))
 }
 
 /// An ELF64 executable without a PT_INTERP program header (i.e. not dynamically linked).
@@ -786,16 +811,29 @@ impl Verdict {
     }
 }
 
-/// One case's guest output.
+/// One case's guest output, from nav-app's JSON lines (frames flattened by [`flatten_frame`];
+/// `open` is the summary's `device` object).
 #[derive(Default)]
 struct CaseOutput {
     rc: Option<i64>,
     open: Option<Value>,
     frames: Vec<Value>,
-    ctrls: Vec<Value>,
+    /// nav-app's stderr warnings about frame timeouts.
     timeouts: usize,
     summary: Option<Value>,
     panicked: bool,
+}
+
+/// A nav-app `--json` frame object as the flat record the checks read: `seq`, `ts_us`, `w`, `h`,
+/// `fourcc`, `missed`, `signal_lost`, `mean` from its `"capture"` object, and `lanes`, the
+/// number of lane reports (2 when the tracker ran on the frame).
+fn flatten_frame(v: &Value) -> Value {
+    let c = &v["capture"];
+    serde_json::json!({
+        "seq": c["sequence"], "ts_us": c["timestamp_us"], "w": c["width_px"], "h": c["height_px"],
+        "fourcc": c["format"], "missed": c["missed"], "signal_lost": c["signal_lost"],
+        "mean": c["mean_grey"], "lanes": v["lanes"].as_array().map_or(0, Vec::len),
+    })
 }
 
 fn split_cases(log: &SerialLog) -> BTreeMap<String, CaseOutput> {
@@ -823,20 +861,21 @@ fn split_cases(log: &SerialLog) -> BTreeMap<String, CaseOutput> {
         if line.contains("panicked") {
             o.panicked = true;
         }
-        // Kernel messages may share the console: only parse lines that are JSON objects.
-        let Some(start) = line.find("{\"type\"") else {
+        if line.contains("nav-app: warning:") && line.contains("no frame within") {
+            o.timeouts += 1;
             continue;
+        }
+        // Kernel messages may share the console: only parse what starts like nav-app's JSON.
+        let parse = |key: &str| {
+            line.find(key)
+                .and_then(|start| serde_json::from_str::<Value>(&line[start..]).ok())
         };
-        let Ok(v) = serde_json::from_str::<Value>(&line[start..]) else {
-            continue;
-        };
-        match v.get("type").and_then(Value::as_str) {
-            Some("open") => o.open = Some(v),
-            Some("frame") => o.frames.push(v),
-            Some("ctrl") => o.ctrls.push(v),
-            Some("timeout") => o.timeouts += 1,
-            Some("summary") => o.summary = Some(v),
-            _ => {}
+        if let Some(v) = parse("{\"frame\"") {
+            o.frames.push(flatten_frame(&v));
+        } else if let Some(v) = parse("{\"summary\"") {
+            let s = v.get("summary").cloned().unwrap_or(Value::Null);
+            o.open = s.get("device").filter(|d| !d.is_null()).cloned();
+            o.summary = Some(s);
         }
     }
     out
@@ -854,13 +893,17 @@ fn text<'a>(v: Option<&'a Value>, key: &str) -> &'a str {
         .unwrap_or("")
 }
 
-/// Frames are 320×240 with strictly increasing sequence numbers and timestamps.
+/// Frames are 320×240, tracked (two lane reports each), with strictly increasing sequence
+/// numbers and timestamps.
 fn check_frames(o: &CaseOutput, fourcc: Option<&str>) -> Result<(), String> {
     let mut last: Option<(u64, i64)> = None;
     for f in &o.frames {
         let (w, h) = (num(Some(f), "w"), num(Some(f), "h"));
         if (w, h) != (320, 240) {
             return Err(format!("frame {w}x{h}, expected 320x240"));
+        }
+        if num(Some(f), "lanes") != 2 {
+            return Err(format!("frame without the tracker's two lane reports: {f}"));
         }
         if let Some(fc) = fourcc
             && text(Some(f), "fourcc") != fc
@@ -909,12 +952,18 @@ fn judge(cases: &[Case], log: &SerialLog) -> Vec<Verdict> {
             None => Verdict::Fail("case never started (VM died or timed out?)".into()),
             Some(o) if o.rc.is_none() => Verdict::Fail("case never finished".into()),
             Some(o) if o.panicked => Verdict::Fail("guest panicked".into()),
-            Some(o) => judge_one(c.expect, o, grey_mean),
+            Some(o) => judge_one(
+                c.expect,
+                o,
+                grey_mean,
+                c.args.matches("--ctrl").count() as u64,
+            ),
         })
         .collect()
 }
 
-fn judge_one(expect: Expect, o: &CaseOutput, grey_mean: Option<f64>) -> Verdict {
+/// `controls`: how many test-hook controls the case sets (`--ctrl` and `--ctrl-on-timeout`).
+fn judge_one(expect: Expect, o: &CaseOutput, grey_mean: Option<f64>, controls: u64) -> Verdict {
     let rc = o.rc.unwrap_or(-1);
     let s = o.summary.as_ref();
     let frames = num(s, "frames");
@@ -944,12 +993,11 @@ fn judge_one(expect: Expect, o: &CaseOutput, grey_mean: Option<f64>) -> Verdict 
                 o.frames.len()
             ));
         }
-        if let Some(bad) = o
-            .ctrls
-            .iter()
-            .find(|c| c.get("ok") != Some(&Value::Bool(true)))
-        {
-            return Err(format!("setting a control failed: {bad}"));
+        if num(s, "controls_set") != controls {
+            return Err(format!(
+                "{} of {controls} test controls set",
+                num(s, "controls_set")
+            ));
         }
         // After a stream restart the driver numbers frames from 0 again.
         if restarted {
@@ -1012,7 +1060,7 @@ fn judge_one(expect: Expect, o: &CaseOutput, grey_mean: Option<f64>) -> Verdict 
             }
         }),
         Expect::CleanError { text: needle } => {
-            if rc == 2 && exit == "error" && text(s, "error").contains(needle) {
+            if rc == EXIT_ERROR && exit == "error" && text(s, "error").contains(needle) {
                 Ok(format!("error: {}", text(s, "error")))
             } else {
                 Err(format!("expected a clean error containing {needle:?}"))
@@ -1059,7 +1107,11 @@ fn judge_one(expect: Expect, o: &CaseOutput, grey_mean: Option<f64>) -> Verdict 
             at_least,
             max_frames,
         } => {
-            if rc == 3 && exit == "device-gone" && frames >= at_least && frames < max_frames {
+            if rc == EXIT_DEVICE_GONE
+                && exit == "device-gone"
+                && frames >= at_least
+                && frames < max_frames
+            {
                 Ok(format!(
                     "ENODEV after {frames} frames: clean device-gone exit"
                 ))
@@ -1085,27 +1137,24 @@ mod tests {
         }
     }
 
+    /// A nav-app `--json` frame line (lanes abridged to what the checks read).
     fn frame(n: u64, seq: u64, ts: u64) -> String {
         format!(
-            r#"{{"type":"frame","n":{n},"seq":{seq},"ts_us":{ts},"w":320,"h":240,"fourcc":"GREY","missed":0,"signal_lost":false,"mean":65.0}}"#
+            r#"{{"frame":{n},"t_s":0.0,"lanes":[{{"side":"left","state":"lost"}},{{"side":"right","state":"lost"}}],"track_us":900.0,"capture":{{"sequence":{seq},"timestamp_us":{ts},"format":"GREY","width_px":320,"height_px":240,"missed":0,"signal_lost":false,"mean_grey":65.0}}}}"#
         )
     }
 
     fn stream_log(seqs: &[u64], rc: i32) -> SerialLog {
-        let mut lines = vec![
-            "VIVID-CASE-BEGIN s".to_owned(),
-            r#"{"type":"open","input_index":1,"std_id":4096,"width":320,"height":240,"fourcc":"GREY"}"#
-                .to_owned(),
-        ];
+        let mut lines = vec!["VIVID-CASE-BEGIN s".to_owned()];
         for (i, s) in seqs.iter().enumerate() {
             // Kernel noise on the console must not confuse the parser.
             lines.push(format!(
                 "[    1.0] some kernel line {}",
-                frame(i as u64 + 1, *s, 1000 + *s)
+                frame(i as u64, *s, 1000 + *s)
             ));
         }
         lines.push(format!(
-            r#"{{"type":"summary","frames":{},"errored_dropped":0,"sequence_gaps":0,"exit":"max-frames","error":null}}"#,
+            r#"{{"summary":{{"device":{{"device":"/dev/video0","input_index":1,"std_id":4096,"width_px":320,"height_px":240,"format":"GREY","stride_bytes":320,"buffers":4}},"frames":{},"errored_dropped":0,"sequence_gaps":0,"controls_set":0,"exit":"max-frames","exit_code":0,"error":null}}}}"#,
             seqs.len()
         ));
         lines.push(format!("VIVID-CASE-END s rc={rc}"));
@@ -1152,6 +1201,26 @@ mod tests {
     }
 
     #[test]
+    fn frames_must_be_tracked_and_test_controls_all_set() {
+        // A frame object without the tracker's two lane reports fails the case.
+        let mut log = stream_log(&[0, 1, 2], 0);
+        log.lines[2] = log.lines[2].replace(r#"{"side":"left","state":"lost"},"#, "");
+        assert!(matches!(verdict(&log, GREY3), Verdict::Fail(_)));
+        // A case that sets one control passes only if the summary counts it.
+        let cases = [Case {
+            name: "s",
+            args: "--ctrl 'Disconnect=1@1'".into(),
+            expect: GREY3,
+        }];
+        let log = stream_log(&[0, 1, 2], 0);
+        assert!(matches!(judge(&cases, &log)[0], Verdict::Fail(_)));
+        let mut log = stream_log(&[0, 1, 2], 0);
+        let n = log.lines.len();
+        log.lines[n - 2] = log.lines[n - 2].replace(r#""controls_set":0"#, r#""controls_set":1"#);
+        assert!(matches!(judge(&cases, &log)[0], Verdict::Pass(_)));
+    }
+
+    #[test]
     fn unfinished_or_missing_case_fails() {
         let mut log = stream_log(&[0, 1, 2], 0);
         log.lines.pop(); // no END marker: the guest hung or the VM died
@@ -1170,14 +1239,14 @@ mod tests {
         };
         let gone = log_of(&[
             "VIVID-CASE-BEGIN s",
-            r#"{"type":"summary","frames":10,"exit":"device-gone","error":"gone"}"#,
+            r#"{"summary":{"device":null,"frames":10,"controls_set":0,"exit":"device-gone","exit_code":3,"error":"gone"}}"#,
             "VIVID-CASE-END s rc=3",
         ]);
         assert!(matches!(verdict(&gone, expect), Verdict::Pass(_)));
         let panicked = log_of(&[
             "VIVID-CASE-BEGIN s",
             "thread 'main' panicked at src/x.rs:1:1",
-            r#"{"type":"summary","frames":10,"exit":"device-gone","error":"gone"}"#,
+            r#"{"summary":{"device":null,"frames":10,"controls_set":0,"exit":"device-gone","exit_code":3,"error":"gone"}}"#,
             "VIVID-CASE-END s rc=3",
         ]);
         assert!(matches!(verdict(&panicked, expect), Verdict::Fail(_)));

@@ -1,6 +1,7 @@
 //! `grab`: stream grey frames from a V4L2 capture device and print one JSON object per line.
 //!
-//! The in-VM test program of `cargo xtask vivid` (statically linked), and a hardware smoke test:
+//! A hardware smoke test without the tracker (`cargo xtask vivid` now runs `nav-app --device`,
+//! which takes the same capture flags); build it statically to try it on a bare system:
 //!
 //! ```text
 //! grab --device /dev/video0 --input-name S-Video --std ntsc --size 320x240 --max-frames 60 --json

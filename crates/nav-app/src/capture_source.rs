@@ -10,8 +10,8 @@
 //! * Opening ([`open`], [`CaptureSource::open`]): input by name or index, video standard (NTSC-M
 //!   by default), size (320×240 by default) and pixel format are negotiated by bt848-capture;
 //!   the size and format *the driver returns* are used. Any failure is [`NavError::Capture`]
-//!   (typed source: unknown input, unsupported standard or format, not a capture device…) or
-//!   [`NavError::DeviceGone`].
+//!   (holding the typed capture error: unknown input, unsupported standard or format, not a
+//!   capture device…) or [`NavError::DeviceGone`].
 //! * Each delivered frame is grey (converted from the driver's format, BT.601 luma), with a
 //!   [`FrameMeta`] whose `index` counts the driver's frames (it jumps by the number of frames the
 //!   driver dropped, see [`DeviceFrameInfo::missed`]) and whose `t_s` is the driver timestamp
@@ -342,9 +342,9 @@ pub fn capture_error(device: &str, e: CaptureError) -> NavError {
         CaptureError::DeviceGone { .. } => NavError::DeviceGone {
             device: device.to_owned(),
         },
-        source => NavError::Capture {
+        error => NavError::Capture {
             device: device.to_owned(),
-            source,
+            error,
         },
     }
 }
@@ -437,8 +437,8 @@ mod device {
         /// Open and start streaming from `path` with `opts`.
         ///
         /// # Errors
-        /// [`NavError::ConfigField`] for bad options; [`NavError::Capture`] (the capture
-        /// layer's typed error as the source) or [`NavError::DeviceGone`].
+        /// [`NavError::ConfigField`] for bad options; [`NavError::Capture`] (holding the capture
+        /// layer's typed error) or [`NavError::DeviceGone`].
         pub fn open(path: &Path, opts: &DeviceOptions) -> Result<Self, NavError> {
             opts.validate()?;
             let device = path.display().to_string();
@@ -725,7 +725,13 @@ mod tests {
                 && text.contains("Television"),
             "{text}"
         );
-        assert!(std::error::Error::source(&other).is_some());
+        assert!(matches!(
+            other,
+            NavError::Capture {
+                error: CaptureError::InputNotFound { .. },
+                ..
+            }
+        ));
     }
 
     #[test]

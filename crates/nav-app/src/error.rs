@@ -132,13 +132,14 @@ pub enum NavError {
     },
     /// The capture device could not be opened or configured, or failed while streaming (bad
     /// device node, unknown input, unsupported standard or format, ioctl failure). Fatal.
-    #[error("{device}: {source}")]
+    /// (The capture error is rendered in the message, so it is not repeated as a `source`.)
+    #[error("{device}: {error}")]
     Capture {
         /// The device path.
         device: String,
-        /// What the capture layer reported.
-        #[source]
-        source: bt848_capture::CaptureError,
+        /// What the capture layer reported (typed: match on it to tell an unknown input from a
+        /// missing format, etc.).
+        error: bt848_capture::CaptureError,
     },
     /// No frame arrived within the capture timeout; the stream has been restarted. Not fatal
     /// while `consecutive < limit` (the frame loop reports it and asks again); the

@@ -2,7 +2,6 @@
 //! (The real-driver behaviour is tested in a VM by `cargo xtask vivid`.)
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn nav_app(args: &[&str]) -> Output {
@@ -22,8 +21,9 @@ fn last_json_line(o: &Output) -> serde_json::Value {
     serde_json::from_str(line).unwrap()
 }
 
-fn scratch_file(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("nav-app-capture-cli");
+#[cfg(feature = "capture")]
+fn scratch_file(name: &str, bytes: &[u8]) -> std::path::PathBuf {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("nav-app-capture-cli");
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join(name);
     std::fs::write(&p, bytes).unwrap();
