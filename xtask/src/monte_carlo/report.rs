@@ -555,7 +555,7 @@ pub fn summary_md(stats: &Stats) -> String {
     let _ = writeln!(s, "## Throughput\n");
     let _ = writeln!(
         s,
-        "{epochs} filter epochs (100 Hz INS steps, all configurations) in {:.2} s of simulation wall time: **{:.0} epochs/s per core** (Σ epochs / Σ CPU time of the threads that ran them), {:.0} epochs/s aggregate over the wall time (lower than threads × per-core when the machine is shared). A run that fails is not counted. For comparison on this machine (docs/ins-sd.md): KF-GINS (C++, 21 states, text I/O) ≈ 40 000 epochs/s; pyins (Python, 0.01 s covariance step) ≈ 136 epochs/s.",
+        "{epochs} filter epochs (100 Hz INS steps, all configurations) in {:.2} s of simulation wall time (summed over shards if merged): **{:.0} epochs/s per core** (Σ epochs / Σ CPU time of the threads that ran them), {:.0} epochs/s aggregate over the wall time (lower than threads × per-core when the machine is shared). A run that fails is not counted. For comparison on this machine (docs/ins-sd.md): KF-GINS (C++, 21 states, text I/O) ≈ 40 000 epochs/s; pyins (Python, 0.01 s covariance step) ≈ 136 epochs/s.",
         stats.wall_s, per_core, per_wall
     );
     s
@@ -636,20 +636,22 @@ fn checks(s: &mut String, stats: &Stats) {
             if m.mode == "standalone" {
                 continue;
             }
-            let (s600, send) = (
-                at(m, 600)[qi::PSI_D].std_dev(),
-                at(m, end)[qi::PSI_D].std_dev(),
-            );
+            let s600 = at(m, 600)[qi::PSI_D].std_dev();
+            let send = at(m, end)[qi::PSI_D].std_dev();
+            let (t_max, s_max) = (600..=end.min(m.bins.len() - 1))
+                .map(|t| (t, m.bins[t][qi::PSI_D].std_dev()))
+                .fold((600, s600), |a, b| if b.1 > a.1 { b } else { a });
             let _ = writeln!(
                 s,
-                "- {}: azimuth misalignment σ {} mrad at 600 s, {} mrad at {end} s → {}.",
+                "- {}: azimuth misalignment σ {} mrad at 600 s (manoeuvres end), largest after it {} mrad at {t_max} s, {} mrad at {end} s → {}.",
                 m.mode,
                 f(1e3 * s600, 3),
+                f(1e3 * s_max, 3),
                 f(1e3 * send, 3),
-                if send <= 1.5 * s600 {
-                    "bounded after the manoeuvres end"
+                if s_max <= 2.0 * s600 {
+                    "bounded after the manoeuvres end (paper: limited azimuth misalignment after 600 s)"
                 } else {
-                    "**grows after 600 s**"
+                    "**not bounded: it grows after the manoeuvres end**"
                 }
             );
         }
