@@ -49,6 +49,18 @@ pub enum SightingError {
         /// Which input or result was not finite.
         what: &'static str,
     },
+    /// The paper's printed H (eqs. 16–18) is undefined: its β_x, β_y divide by the north
+    /// component x_L − x₀ of the line of sight, which is zero (landmark exactly due east or
+    /// west of the computed position).
+    #[error(
+        "landmark {landmark}: printed H (eq. 18) undefined, north offset x_L - x0 = {north_offset_m} m"
+    )]
+    PrintedJacobianSingular {
+        /// Landmark id (index in the configuration).
+        landmark: usize,
+        /// North component of the computed line of sight, metres (0).
+        north_offset_m: f64,
+    },
     /// The measurement-noise variance passed to the noise generator is negative or not finite.
     #[error("noise variance must be finite and >= 0 m², got {noise_var_m2}")]
     InvalidNoiseVariance {

@@ -11,6 +11,8 @@
 //! * its analytic Jacobian H with respect to the shared 15-state error vector, at the computed
 //!   state: [`sighting_jacobian`] (2×15) and [`sighting_jacobian3`] (6×15), checked against
 //!   central finite differences of the nonlinear model (`tests/jacobian_fd.rs`);
+//! * the paper's H **as printed** (eqs. 15–18 read literally, for comparison runs only):
+//!   [`paper_printed_jacobian`], [`paper_printed_jacobian3`], [`paper_printed_blocks`];
 //! * the `[sighting]` configuration section [`SightingConfig`] and geometry checks.
 //!
 //! # Frames and conventions (shared contract with `ins-errors`)
@@ -181,6 +183,7 @@ mod config;
 mod error;
 mod jacobian;
 mod model;
+mod paper_printed;
 
 pub use config::{LandmarkConfig, SightingConfig};
 pub use error::SightingError;
@@ -192,4 +195,8 @@ pub use model::{
     DEGENERATE_RANGE_M, Landmark, LineOfSight, NavPose, PAPER_LANDMARKS_DEG_M, PAPER_NOISE_VAR_M2,
     VERTICAL_LOS_FRACTION, add_sighting_noise, check_geometry, line_of_sight, paper_landmarks,
     sighting_offset_m, sighting_offsets3_m, true_pose_from_errors,
+};
+pub use paper_printed::{
+    PaperAlphaReading, PaperPrintedBlocks, paper_printed_blocks, paper_printed_jacobian,
+    paper_printed_jacobian3,
 };

@@ -4,23 +4,16 @@
 
 mod common;
 
-use common::{fd_jacobian, fd_jacobian_with, paper_pose, random_geometry};
+use common::{fd_jacobian, fd_jacobian_with, paper_pose, paper_start, random_geometry};
 use ins_errors::earth::{displace_by_ned_m, frame_tilt_rad, pos_err_ned_m, radii_of_curvature_m};
 use nalgebra::{Matrix2x3, Matrix3, Rotation3, SMatrix, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sighting_model::{
-    Geodetic, Landmark, NavPose, POS_ERR_COL, PSI_COL, STATE_DIM, line_of_sight, paper_landmarks,
-    sighting_jacobian, true_pose_from_errors,
+    Geodetic, Landmark, NavPose, POS_ERR_COL, PSI_COL, PaperAlphaReading as AlphaReading,
+    STATE_DIM, line_of_sight, paper_landmarks, paper_printed_blocks, paper_printed_jacobian,
+    paper_printed_jacobian3, sighting_jacobian, sighting_jacobian3, true_pose_from_errors,
 };
-
-#[derive(Clone, Copy)]
-enum AlphaReading {
-    /// α₀ = tan⁻¹((z_L − z₀)/d₀) as printed (z down in NED: the depression).
-    Literal,
-    /// α₀ = tan⁻¹((z₀ − z_L)/d₀): the elevation.
-    Elevation,
-}
 
 struct Printed {
     h2: Matrix2x3<f64>,
@@ -31,59 +24,18 @@ struct Printed {
     h4: Matrix2x3<f64>,
 }
 
-/// Eqs. 16–18 transcribed, with x, y, z = NED coordinates (vehicle at the origin, landmark at
-/// the computed line of sight r̃), latitude λ and altitude H of the computed position.
+/// Eqs. 16–18 as evaluated by the library (`paper_printed_blocks`), plus H₃ with the tan λ
+/// term's sign flipped: adds 2 d₁₃ tan λ/(R_E + H) to entry (1, 2), d₁₃ = H₄(1, 3).
 fn printed(pos: &Geodetic, landmark: &Landmark, reading: AlphaReading) -> Printed {
-    let r = line_of_sight(pos, landmark).unwrap().los_ned_m;
-    let (dx, dy, dz) = (r.x, r.y, r.z); // x_L − x₀, y_L − y₀, z_L − z₀
-    let d0 = dx.hypot(dy);
-    let beta0 = dy.atan2(dx);
-    let alpha0 = match reading {
-        AlphaReading::Literal => dz.atan2(d0),
-        AlphaReading::Elevation => (-dz).atan2(d0),
-    };
-    let (sb, cb) = beta0.sin_cos();
-    let (sa, ca) = alpha0.sin_cos();
-    let d11 = cb * dz;
-    let d12 = sb * dz;
-    let d13 = -(cb * dx + sb * dy);
-    let d21 = sb * sa * dz - ca * dy;
-    let d22 = ca * dx - cb * sa * dz;
-    let d_a2 = cb * ca * dx + sb * ca * dy - sa * dz;
-    let d_b1 = -cb * dx - sb * dy;
-    let alpha_x = (-dz) * dx * ca * ca / d0.powi(3);
-    let alpha_y = (-dz) * dy * ca * ca / d0.powi(3);
-    let alpha_z = ca * ca / d0;
-    let beta_x = (2.0 * beta0).sin() / (2.0 * dx);
-    let beta_y = -cb * cb / dx;
-    let (r_n, r_e) = radii_of_curvature_m(pos.lat_rad);
-    let (rn_h, re_h) = (r_n + pos.alt_m, r_e + pos.alt_m);
+    let b = paper_printed_blocks(pos, landmark, reading).unwrap();
+    let (_, r_e) = radii_of_curvature_m(pos.lat_rad);
+    let mut h3_tan_flipped = b.h3_tilt;
+    h3_tan_flipped[(0, 1)] += 2.0 * b.h4_att[(0, 2)] * pos.lat_rad.tan() / (r_e + pos.alt_m);
     Printed {
-        h2: Matrix2x3::new(
-            d_b1 * beta_x,
-            d_b1 * beta_y,
-            0.0,
-            d_a2 * alpha_x,
-            d_a2 * alpha_y,
-            d_a2 * alpha_z,
-        ),
-        h3: Matrix2x3::new(
-            d12 / rn_h,
-            -(d11 + d13 * pos.lat_rad.tan()) / re_h,
-            0.0,
-            d22 / rn_h,
-            -d21 / re_h,
-            0.0,
-        ),
-        h3_tan_flipped: Matrix2x3::new(
-            d12 / rn_h,
-            -(d11 - d13 * pos.lat_rad.tan()) / re_h,
-            0.0,
-            d22 / rn_h,
-            -d21 / re_h,
-            0.0,
-        ),
-        h4: Matrix2x3::new(d11, d12, d13, d21, d22, 0.0),
+        h2: b.h2_pos,
+        h3: b.h3_tilt,
+        h3_tan_flipped,
+        h4: b.h4_att,
     }
 }
 
@@ -137,7 +89,7 @@ fn printed_h2_and_h4_with_elevation_reading_equal_the_verified_h() {
 fn printed_alpha_read_literally_scales_the_h_row_by_cos_2alpha() {
     for (pose, l) in geometries() {
         let h = sighting_jacobian(&pose.position, &l).unwrap();
-        let p = printed(&pose.position, &l, AlphaReading::Literal);
+        let p = printed(&pose.position, &l, AlphaReading::AsPrinted);
         let eps = line_of_sight(&pose.position, &l).unwrap().depression_rad();
         let k = (2.0 * eps).cos();
         // w row unchanged (no sin α₀ in it)…
@@ -275,4 +227,75 @@ fn true_pose_from_errors_inverts_the_contract_definitions() {
     // First-order contract form C_t^c ≈ I − [δθ×].
     let dth = frame_tilt_rad(&dp, truth.position.lat_rad, truth.position.alt_m);
     assert!((c_t_c - (Matrix3::identity() - ins_errors::earth::skew(&dth))).amax() < 1e-7);
+}
+
+#[test]
+fn paper_printed_jacobian_is_the_verified_h_with_the_h_row_scaled_by_cos_2eps_plus_printed_h3() {
+    for (pose, l) in geometries() {
+        let pos = pose.position;
+        let h = sighting_jacobian(&pos, &l).unwrap();
+        let hp = paper_printed_jacobian(&pos, &l).unwrap();
+        let p = printed(&pos, &l, AlphaReading::AsPrinted);
+        let eps = line_of_sight(&pos, &l).unwrap().depression_rad();
+        let k = (2.0 * eps).cos();
+        let scale = h.amax();
+        // ψ block: w row as verified, h row × cos 2ε.
+        assert!(
+            (hp.fixed_view::<1, 3>(0, PSI_COL) - h.fixed_view::<1, 3>(0, PSI_COL)).amax()
+                < 1e-9 * scale
+        );
+        assert!(
+            (hp.fixed_view::<1, 3>(1, PSI_COL) - k * h.fixed_view::<1, 3>(1, PSI_COL)).amax()
+                < 1e-9 * scale
+        );
+        // δp block: the same scaling plus the printed H₃ (≈ ρ/R of the entries, but present).
+        let mut expected_pos = pos_block(&h);
+        for j in 0..3 {
+            expected_pos[(1, j)] *= k;
+        }
+        expected_pos += p.h3;
+        assert!(
+            (pos_block(&hp) - expected_pos).amax() < 1e-9,
+            "landmark {}",
+            l.id()
+        );
+        assert!(p.h3.amax() > 1e-5, "H3 included");
+        // Nothing outside the δp and ψ columns.
+        let mut rest = hp;
+        rest.fixed_view_mut::<2, 3>(0, POS_ERR_COL).fill(0.0);
+        rest.fixed_view_mut::<2, 3>(0, PSI_COL).fill(0.0);
+        assert_eq!(rest.amax(), 0.0);
+    }
+    // Three-landmark form stacks the single-landmark rows.
+    let pos = paper_pose().position;
+    let ls = paper_landmarks();
+    let h3 = paper_printed_jacobian3(&pos, &ls).unwrap();
+    for (i, l) in ls.iter().enumerate() {
+        assert_eq!(
+            h3.fixed_rows::<2>(2 * i),
+            paper_printed_jacobian(&pos, l).unwrap()
+        );
+    }
+    // And differs from the verified H where the printed α₀ bites (h rows at the start point).
+    let hv = sighting_jacobian3(&pos, &ls).unwrap();
+    assert!((h3 - hv).amax() > 0.5 * hv.amax());
+}
+
+#[test]
+fn paper_printed_jacobian_stays_finite_and_accurate_for_a_landmark_almost_due_east() {
+    // The printed β_x, β_y divide by x_L − x₀; their products with d_β₁ have a finite limit.
+    // (The exactly-zero case is a unit test in src/paper_printed.rs.)
+    let pos = paper_start();
+    for north_m in [1e-3, -0.5, 3.0] {
+        let target = displace_by_ned_m(&pos, &Vector3::new(north_m, 10_000.0, -500.0));
+        let l = Landmark::new(7, target).unwrap();
+        let north = line_of_sight(&pos, &l).unwrap().los_ned_m.x;
+        assert!(north.abs() < 20.0, "north offset {north}");
+        let h = paper_printed_jacobian(&pos, &l).unwrap();
+        let hv = sighting_jacobian(&pos, &l).unwrap();
+        let d =
+            (h.fixed_view::<1, 3>(0, POS_ERR_COL) - hv.fixed_view::<1, 3>(0, POS_ERR_COL)).amax();
+        // w row of the δp block: verified + H₃ row (≈ ρ/R ≈ 2e-3).
+        assert!(d < 5e-3, "north {north}: w row off by {d}");
+    }
 }
