@@ -53,8 +53,11 @@
 //! and σ of each component, 3-D RMS, distance, NEES/NIS averages and bands) and
 //! `fig1_standalone_mean`, `fig2_akf_mean`, `fig3_kf_mean`, `fig4_standalone_sigma`,
 //! `fig5_akf_sigma`, `fig6_kf_sigma` in `.svg` and `.png` (the paper's numbering; each figure has
-//! the position error N/E/D in m above the misalignment N/E/D in mrad). Text in the figures uses
-//! DejaVu Sans bundled under `xtask/assets/` (licence beside it).
+//! the position error N/E/D in m above the misalignment N/E/D in mrad), plus two of ours:
+//! `fig7_nees_nis` (run-averaged NEES and NIS of the filters vs time, log scale, with their 95 %
+//! bands dashed) and `fig8_position_rms` (RMS over runs of the 3-D position error, every
+//! configuration, log scale). Text in the figures uses DejaVu Sans bundled under
+//! `xtask/assets/` (licence beside it), so PNG and SVG carry the same labels.
 //!
 //! ## Beyond one machine: shards
 //!

@@ -1,5 +1,6 @@
 //! Figures equivalent to the paper's Figs. 1–6 (mean and σ over runs of the position and
-//! misalignment errors vs time, per configuration), as SVG and PNG, drawn with plotters.
+//! misalignment errors vs time, per configuration), and our Figs. 7 (NEES/NIS vs their bands)
+//! and 8 (3-D RMS position error of every configuration), as SVG and PNG, drawn with plotters.
 //!
 //! Text needs a font: plotters' `ab_glyph` feature with DejaVu Sans bundled in
 //! `xtask/assets/` (Bitstream Vera licence, `DejaVuSans-LICENSE.txt` beside it), so the PNGs
@@ -195,11 +196,205 @@ pub fn figure(m: &ModeStats, kind: Kind, runs: u64) -> Result<(String, Vec<u8>)>
         &title,
     )
     .map_err(|e| anyhow!("PNG figure for {}: {e}", m.mode))?;
+    Ok((svg, encode_png(rgb)?))
+}
+
+/// A log-scale panel of several named curves plus optional dashed horizontal band lines.
+fn log_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+    y_desc: &str,
+    t_end: f64,
+    data: &[(String, RGBColor, Vec<(f64, f64)>)],
+    bands: &[(f64, RGBColor)],
+) -> Result<(), Box<dyn Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (_, _, pts) in data {
+        for &(_, y) in pts {
+            lo = lo.min(y);
+            hi = hi.max(y);
+        }
+    }
+    for &(y, _) in bands {
+        lo = lo.min(y);
+        hi = hi.max(y);
+    }
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0) {
+        (lo, hi) = (0.1, 10.0);
+    }
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .margin_right(36)
+        .x_label_area_size(40)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..t_end.max(1.0), (0.8 * lo..1.25 * hi).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc(y_desc)
+        .label_style(("sans-serif", 14))
+        .draw()?;
+    for &(y, c) in bands {
+        chart.draw_series(DashedLineSeries::new(
+            [(0.0, y), (t_end, y)],
+            6,
+            4,
+            c.stroke_width(1),
+        ))?;
+    }
+    for (name, colour, pts) in data {
+        let c = *colour;
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))?
+            .label(name.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()?;
+    Ok(())
+}
+
+fn mode_colour(mode: &str) -> RGBColor {
+    match mode {
+        "standalone" => RGBColor(120, 120, 120),
+        "kf" => RGBColor(0, 90, 180),
+        _ => RGBColor(220, 80, 0),
+    }
+}
+
+/// Fig. 7 (ours): run-averaged NEES and NIS of the filters vs time with their 95 % bands
+/// (dashed) for the number of runs kept.
+fn draw_consistency<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    stats: &Stats,
+) -> Result<(), Box<dyn Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let t_end = stats
+        .modes
+        .first()
+        .map_or(1, |m| m.bins.len().saturating_sub(1)) as f64;
+    let (upper, lower) = root.split_vertically(H / 2);
+    for (area, name, q, dof) in [
+        (&upper, "NEES", qi::NEES, super::report::NEES_DOF),
+        (&lower, "NIS", qi::NIS, super::report::NIS_DOF),
+    ] {
+        let mut data = Vec::new();
+        let mut bands = Vec::new();
+        for m in stats.modes.iter().filter(|m| m.mode != "standalone") {
+            let pts: Vec<(f64, f64)> = m
+                .bins
+                .iter()
+                .enumerate()
+                .filter(|(_, b)| b[q].n > 0)
+                .map(|(t, b)| (t as f64, b[q].mean()))
+                .filter(|(_, v)| v.is_finite() && *v > 0.0)
+                .collect();
+            if let Some((lo, hi)) = super::report::band(dof, m.runs_used) {
+                bands.push((lo, mode_colour(&m.mode)));
+                bands.push((hi, mode_colour(&m.mode)));
+            }
+            data.push((
+                format!("{} ({} runs)", m.mode, m.runs_used),
+                mode_colour(&m.mode),
+                pts,
+            ));
+        }
+        log_panel(
+            area,
+            &format!("{name} averaged over runs, n = {dof}; dashed: 95 % band"),
+            name,
+            t_end,
+            &data,
+            &bands,
+        )?;
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// Fig. 8 (ours): RMS over runs of the 3-D position error vs time, every configuration.
+fn draw_rms<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    stats: &Stats,
+) -> Result<(), Box<dyn Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let t_end = stats
+        .modes
+        .first()
+        .map_or(1, |m| m.bins.len().saturating_sub(1)) as f64;
+    let data: Vec<_> = stats
+        .modes
+        .iter()
+        .map(|m| {
+            let pts = m
+                .bins
+                .iter()
+                .enumerate()
+                .map(|(t, b)| (t as f64, b[qi::POS_3D].rms()))
+                .filter(|(_, v)| v.is_finite() && *v > 0.0)
+                .collect();
+            (
+                format!("{} ({} runs)", m.mode, m.runs_used),
+                mode_colour(&m.mode),
+                pts,
+            )
+        })
+        .collect();
+    log_panel(
+        &root,
+        "3-D position error, RMS over runs",
+        "position error (m)",
+        t_end,
+        &data,
+        &[],
+    )?;
+    root.present()?;
+    Ok(())
+}
+
+/// Renders one whole-stats figure to (SVG text, PNG bytes).
+fn render_both(
+    stats: &Stats,
+    what: &str,
+    f_svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>, &Stats) -> Result<(), Box<dyn Error>>,
+    f_png: impl Fn(DrawingArea<BitMapBackend<'_>, Shift>, &Stats) -> Result<(), Box<dyn Error>>,
+) -> Result<(String, Vec<u8>)> {
+    let mut svg = String::new();
+    f_svg(
+        SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area(),
+        stats,
+    )
+    .map_err(|e| anyhow!("SVG {what}: {e}"))?;
+    let mut rgb = vec![0u8; (W * H * 3) as usize];
+    f_png(
+        BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area(),
+        stats,
+    )
+    .map_err(|e| anyhow!("PNG {what}: {e}"))?;
+    Ok((svg, encode_png(rgb)?))
+}
+
+fn encode_png(rgb: Vec<u8>) -> Result<Vec<u8>> {
     let img = image::RgbImage::from_raw(W, H, rgb)
         .ok_or_else(|| anyhow!("PNG buffer has the wrong size"))?;
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    Ok((svg, png))
+    Ok(png)
 }
 
 /// All figures: `(file name, bytes)`, e.g. `fig3_kf_mean.svg`.
@@ -217,5 +412,28 @@ pub fn figures(stats: &Stats) -> Result<Vec<(String, Vec<u8>)>> {
             out.push((format!("{stem}.png"), png));
         }
     }
+    register_font()?;
+    if stats
+        .modes
+        .iter()
+        .any(|m| m.bins.iter().any(|b| b[qi::NEES].n > 0))
+    {
+        let (svg, png) = render_both(
+            stats,
+            "NEES/NIS figure",
+            |a, s| draw_consistency(a, s),
+            |a, s| draw_consistency(a, s),
+        )?;
+        out.push(("fig7_nees_nis.svg".to_string(), svg.into_bytes()));
+        out.push(("fig7_nees_nis.png".to_string(), png));
+    }
+    let (svg, png) = render_both(
+        stats,
+        "RMS figure",
+        |a, s| draw_rms(a, s),
+        |a, s| draw_rms(a, s),
+    )?;
+    out.push(("fig8_position_rms.svg".to_string(), svg.into_bytes()));
+    out.push(("fig8_position_rms.png".to_string(), png));
     Ok(out)
 }

@@ -377,6 +377,8 @@ fn interrupted_output_leaves_no_file_under_its_final_name() {
         "timeseries_kf.csv",
         "fig1_standalone_mean.svg",
         "fig6_kf_sigma.png",
+        "fig7_nees_nis.svg",
+        "fig8_position_rms.png",
     ] {
         assert!(names.iter().any(|n| n == f), "{f} missing: {names:?}");
     }
