@@ -55,6 +55,8 @@ fn register_font() -> Result<()> {
 }
 
 type Series = (&'static str, RGBColor, Vec<(f64, f64)>);
+/// A curve with an owned label.
+type Labelled = (String, RGBColor, Vec<(f64, f64)>);
 
 fn series(m: &ModeStats, kind: Kind, qs: [usize; 3], scale: f64) -> Vec<Series> {
     let names = ["N", "E", "D"];
@@ -205,7 +207,7 @@ fn log_panel<DB: DrawingBackend>(
     caption: &str,
     y_desc: &str,
     t_end: f64,
-    data: &[(String, RGBColor, Vec<(f64, f64)>)],
+    data: &[Labelled],
     bands: &[(f64, RGBColor)],
 ) -> Result<(), Box<dyn Error>>
 where
@@ -398,6 +400,9 @@ fn encode_png(rgb: Vec<u8>) -> Result<Vec<u8>> {
 }
 
 /// All figures: `(file name, bytes)`, e.g. `fig3_kf_mean.svg`.
+// The closures passed to `render_both` are needed: the generic fn items are not general enough
+// over the backends' lifetime (higher-ranked bound), which clippy's suggestion ignores.
+#[allow(clippy::redundant_closure)]
 pub fn figures(stats: &Stats) -> Result<Vec<(String, Vec<u8>)>> {
     let mut out = Vec::new();
     for m in &stats.modes {
