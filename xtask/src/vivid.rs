@@ -94,6 +94,7 @@ const BASE: &str = "--device /dev/video0 --input-name S-Video --std ntsc --size 
 /// nav-app's exit codes (see `crates/nav-app/src/main.rs`).
 const EXIT_ERROR: i64 = 1;
 const EXIT_DEVICE_GONE: i64 = 3;
+const EXIT_TIMEOUTS: i64 = 4;
 
 /// What a case requires of the guest's output.
 #[derive(Clone, Copy)]
@@ -119,6 +120,12 @@ enum Expect {
     NoSignal { frames: u64 },
     /// All buffers dropped → timeout → restart → frames again, exit 0.
     TimeoutRestart { frames: u64 },
+    /// All buffers dropped and never restored → `timeouts` timeouts in a row → exit 4
+    /// (`timeout`), at least `at_least` frames before, no panic.
+    TimeoutLimit { at_least: u64, timeouts: u64 },
+    /// Without `--json`: exit 0 and nav-app's stderr device line reporting `frames` frames,
+    /// frames/s, errored and dropped frames.
+    Human { frames: u64 },
     /// vivid Disconnect → device-gone, exit 3, fewer frames than asked, no panic.
     Disconnect { at_least: u64, max_frames: u64 },
 }
@@ -208,10 +215,30 @@ fn cases() -> Vec<Case> {
             ),
             expect: Expect::TimeoutRestart { frames: 20 },
         },
+        Case {
+            name: "human-stderr",
+            args: "--device /dev/video0 --input-name S-Video --std ntsc --max-frames 10".into(),
+            expect: Expect::Human { frames: 10 },
+        },
+        // Leaves vivid dropping every buffer: the next case restores it first.
+        Case {
+            name: "fault-timeout-limit",
+            args: format!(
+                "{BASE} --max-frames 40 --timeout-ms 500 --max-timeouts 2 \
+                 --ctrl 'Percentage of Dropped Buffers=100@5'"
+            ),
+            expect: Expect::TimeoutLimit {
+                at_least: 5,
+                timeouts: 2,
+            },
+        },
         // Last: vivid stays disconnected until every handle is closed.
         Case {
             name: "fault-disconnect",
-            args: format!("{BASE} --max-frames 60 --ctrl 'Disconnect=1@10'"),
+            args: format!(
+                "{BASE} --max-frames 60 --ctrl 'Percentage of Dropped Buffers=0@0' \
+                 --ctrl 'Disconnect=1@10'"
+            ),
             expect: Expect::Disconnect { at_least: 10, max_frames: 60 },
         },
     ]
@@ -820,6 +847,8 @@ struct CaseOutput {
     frames: Vec<Value>,
     /// nav-app's stderr warnings about frame timeouts.
     timeouts: usize,
+    /// nav-app's human-mode device line (`nav-app: device …: N frames in …`).
+    human: Option<String>,
     summary: Option<Value>,
     panicked: bool,
 }
@@ -863,6 +892,10 @@ fn split_cases(log: &SerialLog) -> BTreeMap<String, CaseOutput> {
         }
         if line.contains("nav-app: warning:") && line.contains("no frame within") {
             o.timeouts += 1;
+            continue;
+        }
+        if line.contains("nav-app: device ") {
+            o.human = Some(line.clone());
             continue;
         }
         // Kernel messages may share the console: only parse what starts like nav-app's JSON.
@@ -1103,6 +1136,35 @@ fn judge_one(expect: Expect, o: &CaseOutput, grey_mean: Option<f64>, controls: u
                 Err("no timeout/restart seen".into())
             }
         }),
+        Expect::TimeoutLimit { at_least, timeouts } => {
+            if rc == EXIT_TIMEOUTS
+                && exit == "timeout"
+                && frames >= at_least
+                && num(s, "timeouts") == timeouts
+                && num(s, "restarts") >= timeouts - 1
+            {
+                Ok(format!(
+                    "{timeouts} timeouts in a row after {frames} frames: exit 4 (timeout)"
+                ))
+            } else {
+                Err(format!(
+                    "expected exit timeout rc={EXIT_TIMEOUTS} after {timeouts} timeouts"
+                ))
+            }
+        }
+        Expect::Human { frames: want } => {
+            let line = o.human.as_deref().unwrap_or("");
+            let ok = rc == 0
+                && line.contains(&format!(" {want} frames in "))
+                && line.contains("frames/s")
+                && line.contains("errored buffers")
+                && line.contains("sequence gaps");
+            if ok {
+                Ok(format!("stderr: {}", line.trim()))
+            } else {
+                Err(format!("rc={rc}, stderr device line {line:?}"))
+            }
+        }
         Expect::Disconnect {
             at_least,
             max_frames,
@@ -1250,6 +1312,24 @@ mod tests {
             "VIVID-CASE-END s rc=3",
         ]);
         assert!(matches!(verdict(&panicked, expect), Verdict::Fail(_)));
+    }
+
+    #[test]
+    fn timeout_limit_requires_exit_4_after_the_given_timeouts() {
+        let expect = Expect::TimeoutLimit {
+            at_least: 5,
+            timeouts: 2,
+        };
+        fn log(rc: i32, timeouts: u32) -> SerialLog {
+            let summary = format!(
+                r#"{{"summary":{{"frames":5,"timeouts":{timeouts},"restarts":{timeouts},"exit":"timeout","exit_code":{rc}}}}}"#
+            );
+            let end = format!("VIVID-CASE-END s rc={rc}");
+            log_of(&["VIVID-CASE-BEGIN s", &summary, &end])
+        }
+        assert!(matches!(verdict(&log(4, 2), expect), Verdict::Pass(_)));
+        assert!(matches!(verdict(&log(1, 2), expect), Verdict::Fail(_)));
+        assert!(matches!(verdict(&log(4, 1), expect), Verdict::Fail(_)));
     }
 
     #[test]
