@@ -81,6 +81,18 @@ const STEPS: &[Step] = &[
         run: Run::Cargo(&["test", "--workspace", "--all-targets", "--all-features"]),
     },
     Step {
+        // The build a user without libclang gets: `--device` must say capture is not built in.
+        name: "test-no-capture",
+        run: Run::Cargo(&[
+            "test",
+            "-p",
+            "nav-app",
+            "--no-default-features",
+            "--features",
+            "cli",
+        ]),
+    },
+    Step {
         name: "doctest",
         run: Run::Cargo(&["test", "--workspace", "--doc", "--all-features"]),
     },
