@@ -203,12 +203,28 @@ pub fn paper_printed_jacobian3(
     computed: &Geodetic,
     landmarks: &[Landmark; 3],
 ) -> Result<SMatrix<f64, 6, STATE_DIM>, SightingError> {
+    paper_eq15_jacobian3(computed, landmarks, PaperAlphaReading::AsPrinted)
+}
+
+/// Eq. 15 for three landmarks, [H₂ + H₃ | 0 | H₄ | 0 | 0] with H₃ as printed and α₀ read as
+/// `reading`: [`PaperAlphaReading::AsPrinted`] gives [`paper_printed_jacobian3`];
+/// [`PaperAlphaReading::Elevation`] gives the printed H with only α₀ repaired, i.e. the
+/// verified H plus the printed H₃ (the paper's other flaw in isolation). Fixed size, no
+/// allocation.
+///
+/// # Errors
+/// As [`paper_printed_blocks`], for the first landmark that fails.
+pub fn paper_eq15_jacobian3(
+    computed: &Geodetic,
+    landmarks: &[Landmark; 3],
+    reading: PaperAlphaReading,
+) -> Result<SMatrix<f64, 6, STATE_DIM>, SightingError> {
     let c_e_c = ned_from_ecef(computed.lat_rad, computed.lon_rad);
     let x_c: Vector3<f64> = geodetic_to_ecef(computed);
     let mut h = SMatrix::<f64, 6, STATE_DIM>::zeros();
     for (i, landmark) in landmarks.iter().enumerate() {
         let los = los_from_ecef(landmark, &c_e_c, &x_c)?;
-        let blocks = blocks_from_los(computed, landmark, &los, PaperAlphaReading::AsPrinted)?;
+        let blocks = blocks_from_los(computed, landmark, &los, reading)?;
         place(&blocks, &mut h, ROWS_PER_LANDMARK * i);
     }
     Ok(h)

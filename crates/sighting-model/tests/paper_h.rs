@@ -11,8 +11,9 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sighting_model::{
     Geodetic, Landmark, NavPose, POS_ERR_COL, PSI_COL, PaperAlphaReading as AlphaReading,
-    STATE_DIM, line_of_sight, paper_landmarks, paper_printed_blocks, paper_printed_jacobian,
-    paper_printed_jacobian3, sighting_jacobian, sighting_jacobian3, true_pose_from_errors,
+    STATE_DIM, line_of_sight, paper_eq15_jacobian3, paper_landmarks, paper_printed_blocks,
+    paper_printed_jacobian, paper_printed_jacobian3, sighting_jacobian, sighting_jacobian3,
+    true_pose_from_errors,
 };
 
 struct Printed {
@@ -279,6 +280,16 @@ fn paper_printed_jacobian_is_the_verified_h_with_the_h_row_scaled_by_cos_2eps_pl
     // And differs from the verified H where the printed α₀ bites (h rows at the start point).
     let hv = sighting_jacobian3(&pos, &ls).unwrap();
     assert!((h3 - hv).amax() > 0.5 * hv.amax());
+    // With α₀ repaired (elevation), eq. 15 is the verified H plus the printed H₃ only.
+    let he = paper_eq15_jacobian3(&pos, &ls, AlphaReading::Elevation).unwrap();
+    for (i, l) in ls.iter().enumerate() {
+        let p = printed(&pos, l, AlphaReading::Elevation);
+        let mut want = hv.fixed_rows::<2>(2 * i).into_owned();
+        let mut blk = want.fixed_view_mut::<2, 3>(0, POS_ERR_COL);
+        blk += p.h3;
+        assert!((he.fixed_rows::<2>(2 * i) - want).amax() < 1e-9 * hv.amax());
+    }
+    assert!((he - hv).amax() > 1e-5 && (he - hv).amax() < 1e-2);
 }
 
 #[test]
