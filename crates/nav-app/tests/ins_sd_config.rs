@@ -152,3 +152,40 @@ fn run_seeds_are_distinct_and_shared_across_modes() {
     }
     assert_ne!(run_seed(1, Mode::Kf, 0), run_seed(2, Mode::Kf, 0));
 }
+
+#[test]
+fn measurement_jacobian_option_parses_defaults_to_verified_and_rejects_unknown_values() {
+    use nav_app::ins_sd::MeasurementJacobian;
+    let base = paper_toml();
+    assert_eq!(
+        Scenario::from_toml_str(&base)
+            .unwrap()
+            .filter
+            .measurement_jacobian,
+        MeasurementJacobian::Verified
+    );
+    let printed = with_value(&base, "filter", "measurement_jacobian", "\"paper_printed\"");
+    let s = Scenario::from_toml_str(&printed).unwrap();
+    assert_eq!(
+        s.filter.measurement_jacobian,
+        MeasurementJacobian::PaperPrinted
+    );
+    assert!(s.assumptions().iter().any(|a| a.contains("AS PRINTED")));
+    // Absent key: the verified H.
+    let start = base.find("\nmeasurement_jacobian = ").unwrap() + 1;
+    let end = start + base[start..].find('\n').unwrap() + 1;
+    let absent = format!("{}{}", &base[..start], &base[end..]);
+    assert!(!absent.contains("\nmeasurement_jacobian"));
+    assert_eq!(
+        Scenario::from_toml_str(&absent)
+            .unwrap()
+            .filter
+            .measurement_jacobian,
+        MeasurementJacobian::Verified
+    );
+    // Unknown value: a parse error in [filter] naming the key's accepted values.
+    let bad = with_value(&base, "filter", "measurement_jacobian", "\"printed\"");
+    let e = Scenario::from_toml_str(&bad).unwrap_err();
+    assert_eq!(field_of(&e), "filter");
+    assert!(e.to_string().contains("paper_printed"), "{e}");
+}

@@ -41,6 +41,26 @@ impl ScenarioError {
     }
 }
 
+/// `[filter] measurement_jacobian`: which H the filter linearises the SD measurement with.
+/// The simulated measurement is always the true nonlinear model; only the filter's H changes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeasurementJacobian {
+    /// The verified H, `sighting_model::sighting_jacobian3` (checked against finite
+    /// differences of the nonlinear model). The default.
+    #[default]
+    Verified,
+    /// The paper's eqs. 15–18 as printed, `sighting_model::paper_printed_jacobian3` (α₀ read
+    /// as printed, i.e. the depression: h rows × cos 2ε; printed H₃ kept). For reproducing the
+    /// paper's filter only.
+    PaperPrinted,
+    /// The printed eqs. 15–18 with only α₀ repaired (read as the elevation):
+    /// `sighting_model::paper_eq15_jacobian3` with `PaperAlphaReading::Elevation` = the
+    /// verified H plus the printed H₃ (the tilt term, ≈ ρ/R of the δp entries, with its tan λ
+    /// sign as printed). Isolates the paper's other flaw.
+    PaperPrintedElevation,
+}
+
 /// `[filter]`: initial covariance, process-noise tuning, measurement noise, feedback switch
 /// and the discretisation / adaptive-Q parameters of the INS/SD error-state filter.
 ///
@@ -88,6 +108,11 @@ pub struct FilterConfig {
     pub akf_projection: QProjection,
     /// Floor of the projected Q̂ (eigenvalues or diagonal), state units² per SD interval (≥ 0).
     pub akf_min_variance: f64,
+    /// Measurement matrix of the filter: `"verified"` (default when the key is absent),
+    /// `"paper_printed"` (the printed eqs. 15–18) or `"paper_printed_elevation"` (printed, α₀
+    /// repaired); the last two for comparison with the paper.
+    #[serde(default)]
+    pub measurement_jacobian: MeasurementJacobian,
 }
 
 impl Default for FilterConfig {
@@ -115,6 +140,7 @@ impl FilterConfig {
             akf_window: 10,
             akf_projection: QProjection::EigenClip,
             akf_min_variance: 0.0,
+            measurement_jacobian: MeasurementJacobian::Verified,
         }
     }
 

@@ -10,6 +10,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sighting_model::{Landmark, NavPose};
 
+use super::MeasurementJacobian;
 use super::interval::IntervalModel;
 use super::{Mode, RunError, RunOutcome, Sample, Scenario};
 
@@ -63,6 +64,8 @@ pub(crate) struct Loop {
     pub(crate) rng_imu: ChaCha8Rng,
     pub(crate) rng_sd: ChaCha8Rng,
     pub(crate) open_loop_until_s: f64,
+    /// Which H the filter uses (`[filter] measurement_jacobian`).
+    pub(crate) jacobian: MeasurementJacobian,
     /// Diagnostic: how many SD updates used the AKF's Q̂ rather than the a-priori Q.
     pub(crate) adaptive_q_used: usize,
 }
@@ -161,6 +164,7 @@ impl Loop {
             rng_imu,
             rng_sd,
             open_loop_until_s: f.open_loop_until_s,
+            jacobian: f.measurement_jacobian,
             adaptive_q_used: 0,
         })
     }
@@ -219,8 +223,20 @@ impl Loop {
                 .map_err(|source| RunError::Sighting { t_s, source })?;
         sighting_model::add_sighting_noise(&mut z, self.sd_noise_var_m2, &mut self.rng_sd)
             .map_err(|source| RunError::Sighting { t_s, source })?;
-        let h = sighting_model::sighting_jacobian3(&computed.pos, &self.landmarks)
-            .map_err(|source| RunError::Sighting { t_s, source })?;
+        let h = match self.jacobian {
+            MeasurementJacobian::Verified => {
+                sighting_model::sighting_jacobian3(&computed.pos, &self.landmarks)
+            }
+            MeasurementJacobian::PaperPrinted => {
+                sighting_model::paper_printed_jacobian3(&computed.pos, &self.landmarks)
+            }
+            MeasurementJacobian::PaperPrintedElevation => sighting_model::paper_eq15_jacobian3(
+                &computed.pos,
+                &self.landmarks,
+                sighting_model::PaperAlphaReading::Elevation,
+            ),
+        }
+        .map_err(|source| RunError::Sighting { t_s, source })?;
         let nis = match &mut self.filter {
             Filter::None => return Ok(f64::NAN),
             Filter::Kf(f) => {

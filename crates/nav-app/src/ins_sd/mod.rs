@@ -27,7 +27,7 @@
 //! * Measurement (paper eqs. 15–18, verified in `sighting-model`): for each of the three
 //!   landmarks the camera is pointed with the INS's position and attitude; z = (w, h) ∈ ℝ⁶ is
 //!   simulated with the **nonlinear** model from the true and the computed states plus
-//!   N(0, σ²_SD) noise ([sighting] `noise_var_m2`), and the filter uses z = H x + v with H
+//!   N(0, σ²_SD) noise (`[sighting] noise_var_m2`), and the filter uses z = H x + v with H
 //!   (6×15, δp and ψ columns) evaluated at the computed position; R = `filter.r_var_m2` · I₆.
 //!   Innovation ν = z − H x̂⁻ (the predicted offset of the computed state is zero).
 //! * Filter (paper §5): discrete KF, Joseph update (`akf`). **Open loop** until
@@ -96,6 +96,29 @@
 //! in that direction, Q̂ clips it to zero and the filter stops correcting it. With
 //! `akf_projection = "diagonal"` the AKF stays bounded (RMS 17 / 13 / 16 m, NEES ≈ 6–7).
 //!
+//! **The paper's printed H** (`[filter] measurement_jacobian`, hypothesis: the paper's KF
+//! error of ≈ 0.1 km comes from running its filter with the printed, flawed eqs. 15–18). Same
+//! 30 seeded runs (common random numbers), KF, RMS over runs of δp N / E / D:
+//!
+//! | `measurement_jacobian` | 195 s | 600 s | 900 s | mean NEES / NIS at 900 s |
+//! |---|---|---|---|---|
+//! | `"verified"` | 2.4 / 2.2 / 2.1 m | 1.0 / 1.0 / 1.0 m | 0.79 / 0.96 / 0.85 m | 10.7 / 6.4 |
+//! | `"paper_printed_elevation"` (α₀ repaired, printed H₃) | 2.4 / 2.1 / 2.2 m | 1.0 / 1.0 / 1.0 m | 0.78 / 0.95 / 0.85 m | 10.7 / 6.4 |
+//! | `"paper_printed"` (literal) | 366 / 262 / 1876 m | 124 / 102 / 185 km (23 runs alive) | 16.0 / 3.9 / 2.1 km (11 alive) | 4.9·10⁸ / 4.1·10⁵ |
+//!
+//! Read literally (α₀ = depression), the h rows are multiplied by cos 2ε: at the start the
+//! steep landmark (ε ≈ 74°) has its h row sign-flipped and the 45° one has none. Already open
+//! loop the estimate is off by hundreds of metres to kilometres (the recorded error is
+//! INS − x̂, and the INS is the same in every setting until 195 s), the feedback then injects it
+//! and the loop diverges: 19 of 30 runs end between 514 and 882 s with a landmark behind the
+//! camera. The printed H₃ alone (with α₀ read as the elevation — which is also what the printed
+//! α₀ means if its z axis is the paper's "up" state axis) changes nothing measurable. So the
+//! printed H does **not** explain the paper's ≈ 0.1 km: literally it diverges, repaired it gives
+//! our metre level. Reproduce: `cargo run --release -p nav-app --example paper_h -- 30`, or
+//! `cargo xtask monte-carlo --config <copy of configs/paper.toml with measurement_jacobian =
+//! "paper_printed"> --runs 30` (same figures for the runs that finish; it excludes the failed
+//! runs entirely, the example counts them up to their failure).
+//!
 //! ## Randomness
 //!
 //! [`run_seed`] derives run i's seed from the master seed (SplitMix64, independent of threads
@@ -134,7 +157,7 @@ mod config;
 mod engine;
 pub mod interval;
 
-pub use config::{FilterConfig, MonteCarloConfig, ScenarioError};
+pub use config::{FilterConfig, MeasurementJacobian, MonteCarloConfig, ScenarioError};
 
 use ins_errors::InsError;
 use ins_errors::config::{ImuConfig, TrajectoryConfig};
@@ -365,14 +388,22 @@ impl Scenario {
                 self.sighting.update_period_s
             ),
             format!(
-                "Filter: P0 σ = {} m, {} m/s, {} mrad, {} mg, {} °/h; R = {} m²·I6; open loop until {} s, then feedback with reset (P kept).",
+                "Filter: P0 σ = {} m, {} m/s, {} mrad, {} mg, {} °/h; R = {} m²·I6; open loop until {} s, then feedback with reset (P kept); measurement matrix H: {}.",
                 f.p0_pos_sigma_m,
                 f.p0_vel_sigma_mps,
                 f.p0_psi_sigma_mrad,
                 f.p0_accel_bias_sigma_mg,
                 f.p0_gyro_drift_sigma_degph,
                 f.r_var_m2,
-                f.open_loop_until_s
+                f.open_loop_until_s,
+                match f.measurement_jacobian {
+                    MeasurementJacobian::Verified =>
+                        "verified (sighting-model, checked against finite differences)",
+                    MeasurementJacobian::PaperPrinted =>
+                        "the paper's eqs. 15–18 AS PRINTED (α₀ = depression, printed H₃; comparison run)",
+                    MeasurementJacobian::PaperPrintedElevation =>
+                        "the paper's eqs. 15–18 as printed but α₀ = elevation (verified H + printed H₃; comparison run)",
+                }
             ),
             format!(
                 "KF Q (continuous, per body axis): accelerometer white {} mg² per sample, gyro white {} (°/h)² per sample, bias random walk {} mg²/s, drift random walk {} (°/h)²/s.",
