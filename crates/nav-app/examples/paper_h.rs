@@ -4,8 +4,10 @@
 //! (and when). Runs that fail (e.g. a landmark ends up behind the camera) count up to their
 //! failure time only.
 //!
-//! `cargo run --release -p nav-app --example paper_h -- [runs]` (default 30; paper scenario of
-//! `configs/paper.toml`, master seed 2009, run seeds as `xtask monte-carlo`).
+//! `cargo run --release -p nav-app --example paper_h -- [runs] [open-loop]` (default 30; paper
+//! scenario of `configs/paper.toml`, master seed 2009, run seeds as `xtask monte-carlo`;
+//! `open-loop` sets `filter.open_loop_until_s` beyond the run: no feedback at all, the filter
+//! is linearised at the free INS throughout).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nav_app::ins_sd::{MeasurementJacobian, Mode, Sample, Scenario, run, run_seed};
@@ -20,7 +22,11 @@ fn main() {
         "/../../configs/paper.toml"
     ))
     .unwrap();
-    let base = Scenario::from_toml_str(&text).unwrap();
+    let mut base = Scenario::from_toml_str(&text).unwrap();
+    let open_loop = std::env::args().any(|a| a == "open-loop");
+    if open_loop {
+        base.filter.open_loop_until_s = 1e9;
+    }
     let times = [195usize, 600, 900];
     for jac in [
         MeasurementJacobian::Verified,
@@ -61,7 +67,14 @@ fn main() {
                 }
             }
         }
-        println!("\n== measurement_jacobian = {jac:?}, KF, {runs} runs ==");
+        println!(
+            "\n== measurement_jacobian = {jac:?}, KF, {runs} runs{} ==",
+            if open_loop {
+                ", open loop throughout"
+            } else {
+                ""
+            }
+        );
         println!("t (s) | runs alive | RMS δp N / E / D (m) | mean NEES (n=15) | mean NIS (n=6)");
         for (k, &t) in times.iter().enumerate() {
             let m = alive[k].max(1) as f64;
