@@ -126,6 +126,11 @@
 //!   ≈ ρ/(R + h) ≈ 2·10⁻³ of the δp entries — far below σ_SD in practice, but the finite
 //!   difference check rejects it.
 //!
+//! [`paper_printed_jacobian`] / [`paper_printed_jacobian3`] evaluate eq. 15 literally (α₀ as
+//! printed, H₃ as printed) and [`paper_eq15_jacobian3`] with α₀ read either way, for runs that
+//! reproduce the paper's filter (`nav-app`, `[filter] measurement_jacobian`): with the literal
+//! α₀ the paper's closed loop diverges; with the elevation reading it matches this crate's H.
+//!
 //! (The reading note's form δu^c = −C_n^c (δp + u × φ) matches this crate's
 //! S C_cam^cᵀ (δp + r̃ × ψ) up to its sign convention only with ψ in place of φ, for the same
 //! reason.)

@@ -182,6 +182,24 @@ fn place<const R: usize>(
 /// printed diag(1, −1, −1, 1, −1, −1) sign map is the identity for NED states; module doc).
 /// For comparison runs only: [`crate::sighting_jacobian`] is the verified H.
 ///
+/// ```
+/// use sighting_model::{
+///     Geodetic, PSI_COL, line_of_sight, paper_landmarks, paper_printed_jacobian,
+///     sighting_jacobian,
+/// };
+/// let pos = Geodetic::from_deg(-23.2, -45.8667, 6000.0);
+/// let landmark = paper_landmarks()[1]; // seen steeply, ≈ 74° below the horizon
+/// let printed = paper_printed_jacobian(&pos, &landmark)?;
+/// let verified = sighting_jacobian(&pos, &landmark)?;
+/// let eps = line_of_sight(&pos, &landmark)?.depression_rad();
+/// // The h row's attitude entries are the verified ones times cos 2ε (< 0 here: sign flipped).
+/// let k = (2.0 * eps).cos();
+/// assert!(k < -0.5);
+/// let d = printed[(1, PSI_COL)] - k * verified[(1, PSI_COL)];
+/// assert!(d.abs() < 1e-6 * verified.amax());
+/// # Ok::<(), sighting_model::SightingError>(())
+/// ```
+///
 /// # Errors
 /// As [`paper_printed_blocks`].
 pub fn paper_printed_jacobian(
