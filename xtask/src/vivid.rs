@@ -12,9 +12,10 @@
 //!    (fresh machine), or in CI (`CI` set) through passwordless `sudo`; otherwise the command
 //!    stops and says what to install.
 //! 2. Guest program: the real `nav-app` (lane tracker with its `capture` feature), built
-//!    `--release` with `-C target-feature=+crt-static` for `x86_64-unknown-linux-gnu`
-//!    (`target/x86_64-unknown-linux-gnu/release/nav-app`; the cold build compiles nav-app's whole
-//!    dependency tree for that target once). `--guest-bin PATH` runs another static build of
+//!    with `-C target-feature=+crt-static` for `x86_64-unknown-linux-gnu` in the cargo profile
+//!    `vivid-guest` (release settings at opt-level 1: the guest tracks 60-frame streams, so build
+//!    time matters more than speed; `target/x86_64-unknown-linux-gnu/vivid-guest/nav-app`; the
+//!    cold build compiles nav-app's whole dependency tree for that target once). `--guest-bin PATH` runs another static build of
 //!    nav-app instead. The guest runs e.g. `nav-app --device /dev/video0 --input-name S-Video
 //!    --std ntsc --max-frames 60 --json` and prints one JSON object per tracked frame (with its
 //!    `"capture"` device fields) and a last `{"summary": {…}}` line, plus its hidden test flags
@@ -433,16 +434,19 @@ fn cargo() -> String {
     std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned())
 }
 
-/// Build `nav-app` (feature `capture`) statically in release; returns its path.
+/// Build `nav-app` (feature `capture`) statically in the `vivid-guest` profile; returns its path.
 fn build_nav_app(root: &Path) -> Result<PathBuf> {
     const TARGET: &str = "x86_64-unknown-linux-gnu";
-    eprintln!("vivid: building the static guest program (nav-app --features capture, release)…");
+    eprintln!(
+        "vivid: building the static guest program (nav-app --features capture, profile vivid-guest)…"
+    );
     let started = Instant::now();
     let status = Command::new(cargo())
         .current_dir(root)
         .args([
             "build",
-            "--release",
+            "--profile",
+            "vivid-guest",
             "-p",
             "nav-app",
             "--bin",
@@ -462,7 +466,7 @@ fn build_nav_app(root: &Path) -> Result<PathBuf> {
     );
     Ok(target_dir(root)
         .join(TARGET)
-        .join("release")
+        .join("vivid-guest")
         .join("nav-app"))
 }
 
