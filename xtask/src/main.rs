@@ -24,6 +24,8 @@ enum Cmd {
     /// Every check CI runs: formatting, clippy with warnings denied, all tests and doc tests,
     /// the lane regression and the vivid V4L2 VM test.
     Test,
+    /// Install the system packages a full build needs (Debian `libclang-dev`, for V4L2 capture).
+    Setup,
     /// Boot Debian's kernel under qemu with the vivid V4L2 driver and run the capture cases.
     Vivid(vivid::VividArgs),
     /// Render the synthetic lane sequences with ground truth into fixtures/synthetic/.
@@ -37,6 +39,7 @@ enum Cmd {
 fn main() -> Result<()> {
     match Cli::parse().cmd {
         Cmd::Test => test(),
+        Cmd::Setup => vivid::ensure_libclang(),
         Cmd::Vivid(args) => vivid::run(args),
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
