@@ -1,4 +1,10 @@
-//! # nav-app — the lane tracker of Pimentel & Hemerly
+//! # nav-app — the lane tracker of Pimentel & Hemerly, and the INS/SD closed loop
+//!
+//! The one crate that composes the others (ARCHITECTURE.md). Two applications live here: the lane
+//! tracker below, and [`ins_sd`], the sighting-device-aided INS of Lustosa, Chagas & Waldmann
+//! (truth → IMU → strapdown INS → 15-state error KF or adaptive KF with landmark sightings every
+//! 1 s, open loop to 195 s then feedback), which `cargo xtask monte-carlo` runs; its module docs
+//! give the model, the tuning and the measured results.
 //!
 //! The application layer of the lane-mark tracker of Pimentel & Hemerly (ITA; English reading
 //! in `shared/docs/lanes.md`, paper Fig. 1): frame sources, the tracking loop composed of
