@@ -138,7 +138,7 @@ impl FilterConfig {
             open_loop_until_s: 195.0,
             phi_subintervals: 2,
             akf_window: 10,
-            akf_projection: QProjection::EigenClip,
+            akf_projection: QProjection::Diagonal,
             akf_min_variance: 0.0,
             measurement_jacobian: MeasurementJacobian::Verified,
         }
