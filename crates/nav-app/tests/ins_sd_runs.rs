@@ -241,11 +241,11 @@ fn akf_nees_and_nis_are_reported() {
     }
     let (nees, nis) = (nees / n as f64, nis / n as f64);
     println!("AKF over {runs} runs: mean NEES {nees:.2} (n = 15), mean NIS {nis:.2} (m = 6)");
-    // Documented behaviour of the Mohamed–Schwarz AKF here (module doc): before 600 s its Q̂
-    // over-estimates the process noise, so it is under-confident: NEES and NIS both below their
-    // dimensions (≈ 6 and ≈ 4 over 100 runs), yet not collapsed to zero.
+    // Documented behaviour of the Mohamed–Schwarz AKF here (module doc; default diagonal
+    // projection): its Q̂ over-estimates the process noise, so it is under-confident: NEES well
+    // below 15 (≈ 6.4 over 100 runs) and NIS at or below 6 (≈ 5.3), yet not collapsed to zero.
     assert!((3.0..12.0).contains(&nees), "AKF NEES {nees}");
-    assert!((2.5..5.5).contains(&nis), "AKF NIS {nis}");
+    assert!((3.5..6.5).contains(&nis), "AKF NIS {nis}");
 }
 
 #[test]
