@@ -94,13 +94,21 @@
 //! The alternative `akf_projection = "eigen_clip"` (floor 0) gives 102 m RMS at 900 s — the
 //! paper's order — but is not bounded: it is under-confident while
 //! manoeuvring (mean NEES ≈ 6, NIS ≈ 3.3–4.3) and becomes badly over-confident after 600 s
-//! (mean NEES ≈ 10³): with the three landmarks ~10 km away, a vehicle translation δp and a
-//! rotation ψ with δp ≈ ρ ψ × u are nearly indistinguishable, the window of Δx has no energy
-//! in that direction, Q̂ clips it to zero and the filter stops correcting it (worst runs
-//! 96 / 31 / 74 of seed 2009 peak at 6–7 km near 790–810 s, azimuth σ 22 mrad at 792 s, then
-//! recover). Clipping eigenvalues also mixes units (m, m/s, rad, m/s², rad/s) in one floor.
-//! The diagonal projection keeps each state's own Q̂ variance and drops the cross terms, so no
-//! mixed direction is zeroed; it stays bounded (test
+//! (mean NEES ≈ 10³). Why (instrumented on run 96 of seed 2009, Q̂ diagonal against the KF's
+//! a-priori Q_T): with N = 10 < 15 the sample term (1/N) Σ Δx Δxᵀ has rank ≤ 10, so Q̂ is
+//! dominated by the indefinite P⁺ − Φ P⁺ Φᵀ; its raw ψ_D variance is ≈ −10⁶ × the model's.
+//! Clipping 4–6 large negative eigenvalues to 0 adds their magnitude back as positive mass in
+//! mixed-unit directions (m, m/s, rad, m/s², rad/s): the projected Q̂ has σ ≈ 10⁴ × the model's
+//! on v and ψ already at 600 s. A larger Q̂ gives a larger P, a larger P⁺ − Φ P⁺ Φᵀ and larger
+//! clipped mass — a positive feedback. In straight flight after 600 s the level/azimuth
+//! direction (δp ≈ ρ ψ × u, landmarks ~10 km away) is weakly observable, P grows (position σ
+//! 10 → 118 m at 600 → 720 s), the corrections fed back into the INS grow, and at 790–800 s Q̂
+//! explodes (σ ≈ 1.5 km per interval on position, 10⁵–10⁶ × on v and ψ) while the updated P
+//! stays at ~50 m: the error peaks at 6.8 km (NEES 10⁶) and then recovers (runs 96 / 31 / 74
+//! peak at 6–7 km near 790–810 s, azimuth σ over runs 22 mrad at 792 s). The diagonal
+//! projection sets a negative diagonal entry to 0 (4–11 of 15 at a time) and drops the cross
+//! terms, adding no mass from the negative part: Q̂ stays at σ ≈ 10²–10³ × the model's (still
+//! over-estimated, hence NEES ≈ 6) and the loop stays bounded (test
 //! `default_akf_stays_bounded_where_eigen_clip_blows_up`).
 //!
 //! **The paper's printed H** (`[filter] measurement_jacobian`, hypothesis: the paper's KF
