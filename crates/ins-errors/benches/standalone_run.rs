@@ -15,15 +15,7 @@ fn run(tr: &Trajectory, params: &ImuErrorParams, seed: u64) -> NavState {
     let imu = ImuErrors::draw(params, &mut rng);
     let mut it = tr.samples();
     let s0 = it.next().unwrap();
-    let mut ins = Strapdown::new(
-        NavState {
-            pos: s0.pos,
-            vel_ned_mps: s0.vel_ned_mps,
-            att_b_to_n: s0.att_b_to_n,
-        },
-        tr.step_s(),
-    )
-    .unwrap();
+    let mut ins = Strapdown::new(s0.nav_state(), tr.step_s()).unwrap();
     let mut ideal = (s0.specific_force_body_mps2, s0.ang_rate_ib_body_radps);
     for s in it {
         let (f, w) = imu.measure(&ideal.0, &ideal.1, &mut rng);
@@ -65,15 +57,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("ins_only/900s", |b| {
         b.iter(|| {
             let s0 = &buf[0];
-            let mut ins = Strapdown::new(
-                NavState {
-                    pos: s0.pos,
-                    vel_ned_mps: s0.vel_ned_mps,
-                    att_b_to_n: s0.att_b_to_n,
-                },
-                tr.step_s(),
-            )
-            .unwrap();
+            let mut ins = Strapdown::new(s0.nav_state(), tr.step_s()).unwrap();
             for s in &buf[..buf.len() - 1] {
                 ins.step(&s.specific_force_body_mps2, &s.ang_rate_ib_body_radps);
             }

@@ -114,7 +114,7 @@
 //! let mut it = tr.samples();
 //! let s0 = it.next().unwrap();
 //! let mut ins = Strapdown::new(
-//!     NavState { pos: s0.pos, vel_ned_mps: s0.vel_ned_mps, att_b_to_n: s0.att_b_to_n },
+//!     s0.nav_state(),
 //!     tr.step_s(),
 //! )?;
 //! let mut p = Mat15::identity() * 1e-2;

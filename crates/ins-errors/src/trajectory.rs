@@ -37,6 +37,7 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use crate::config::TrajectoryConfig;
 use crate::earth::{Geodetic, LocalFrame};
 use crate::error::InsError;
+use crate::strapdown::NavState;
 
 /// True state at one sample time plus the ideal IMU output for the following interval.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,6 +54,18 @@ pub struct TruthSample {
     pub specific_force_body_mps2: Vector3<f64>,
     /// Ideal angular rate ω_ib^b for [t_k, t_k + T_s] (midpoint value), body, rad/s.
     pub ang_rate_ib_body_radps: Vector3<f64>,
+}
+
+impl TruthSample {
+    /// The true navigation state (position, velocity, attitude) at t_k — e.g. to start a
+    /// strapdown INS at the truth.
+    pub fn nav_state(&self) -> NavState {
+        NavState {
+            pos: self.pos,
+            vel_ned_mps: self.vel_ned_mps,
+            att_b_to_n: self.att_b_to_n,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug)]

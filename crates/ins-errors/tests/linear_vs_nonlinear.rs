@@ -3,7 +3,7 @@
 
 use ins_errors::config::TrajectoryConfig;
 use ins_errors::error_model::{Transition, error_state, inject_errors, system_matrix};
-use ins_errors::strapdown::{NavState, Strapdown};
+use ins_errors::strapdown::Strapdown;
 use ins_errors::trajectory::Trajectory;
 use nalgebra::{SVector, Vector3};
 
@@ -33,11 +33,7 @@ fn run(
     let n = (dur_s / ts).round() as usize;
     let mut it = tr.samples().skip(k0);
     let s0 = it.next().unwrap();
-    let truth0 = NavState {
-        pos: s0.pos,
-        vel_ned_mps: s0.vel_ned_mps,
-        att_b_to_n: s0.att_b_to_n,
-    };
+    let truth0 = s0.nav_state();
     let mut ins = Strapdown::new(inject_errors(&truth0, &dp, &dv, &psi), ts).unwrap();
     let mut x = SVector::<f64, 15>::zeros();
     x.fixed_rows_mut::<3>(0).copy_from(&dp);
@@ -55,11 +51,7 @@ fn run(
         x = phi * x;
         imu = (s.specific_force_body_mps2, s.ang_rate_ib_body_radps);
         if (k + 1) % (n / 4) == 0 {
-            let truth = NavState {
-                pos: s.pos,
-                vel_ned_mps: s.vel_ned_mps,
-                att_b_to_n: s.att_b_to_n,
-            };
+            let truth = s.nav_state();
             let e = error_state(&truth, ins.state());
             out.push((s.t_s, e, x.fixed_rows::<9>(0).into_owned()));
         }

@@ -3,7 +3,7 @@
 
 use ins_errors::config::TrajectoryConfig;
 use ins_errors::error_model::error_state;
-use ins_errors::strapdown::{NavState, Strapdown};
+use ins_errors::strapdown::Strapdown;
 use ins_errors::trajectory::Trajectory;
 
 /// Bound justification. The truth's IMU samples are interval-midpoint values and the
@@ -23,24 +23,12 @@ fn mechanization_follows_truth_for_900_s() {
     let tr = Trajectory::new(&TrajectoryConfig::paper()).unwrap();
     let mut it = tr.samples();
     let first = it.next().unwrap();
-    let mut ins = Strapdown::new(
-        NavState {
-            pos: first.pos,
-            vel_ned_mps: first.vel_ned_mps,
-            att_b_to_n: first.att_b_to_n,
-        },
-        tr.step_s(),
-    )
-    .unwrap();
+    let mut ins = Strapdown::new(first.nav_state(), tr.step_s()).unwrap();
     let (mut max_p, mut max_v, mut max_psi) = (0.0f64, 0.0f64, 0.0f64);
     let mut imu = (first.specific_force_body_mps2, first.ang_rate_ib_body_radps);
     for s in it {
         ins.step(&imu.0, &imu.1);
-        let truth = NavState {
-            pos: s.pos,
-            vel_ned_mps: s.vel_ned_mps,
-            att_b_to_n: s.att_b_to_n,
-        };
+        let truth = s.nav_state();
         let e = error_state(&truth, ins.state());
         max_p = max_p.max(e.fixed_rows::<3>(0).norm());
         max_v = max_v.max(e.fixed_rows::<3>(3).norm());

@@ -12,14 +12,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 fn truth_at(k: usize) -> (Trajectory, NavState) {
     let tr = Trajectory::new(&TrajectoryConfig::paper()).unwrap();
     let s = tr.samples().nth(k).unwrap();
-    (
-        tr,
-        NavState {
-            pos: s.pos,
-            vel_ned_mps: s.vel_ned_mps,
-            att_b_to_n: s.att_b_to_n,
-        },
-    )
+    (tr, s.nav_state())
 }
 
 /// Correcting by the exact errors (contract conventions) returns the truth up to second-order
@@ -65,15 +58,7 @@ fn sensor_corrections_are_subtracted_from_measurements() {
     let run = |corrected: bool| {
         let mut it = tr.samples().take(6001);
         let s0 = it.next().unwrap();
-        let mut ins = Strapdown::new(
-            NavState {
-                pos: s0.pos,
-                vel_ned_mps: s0.vel_ned_mps,
-                att_b_to_n: s0.att_b_to_n,
-            },
-            tr.step_s(),
-        )
-        .unwrap();
+        let mut ins = Strapdown::new(s0.nav_state(), tr.step_s()).unwrap();
         if corrected {
             // Split into set + add to exercise both entry points.
             ins.set_sensor_corrections(&(0.5 * bias), &(0.5 * drift));
@@ -84,11 +69,7 @@ fn sensor_corrections_are_subtracted_from_measurements() {
         for s in it {
             ins.step(&(imu.0 + bias), &(imu.1 + drift));
             imu = (s.specific_force_body_mps2, s.ang_rate_ib_body_radps);
-            last = Some(NavState {
-                pos: s.pos,
-                vel_ned_mps: s.vel_ned_mps,
-                att_b_to_n: s.att_b_to_n,
-            });
+            last = Some(s.nav_state());
         }
         error_state(&last.unwrap(), ins.state()).norm()
     };

@@ -5,7 +5,7 @@
 
 use ins_errors::error_model::{self, Mat15, Transition};
 use ins_errors::imu::{ImuErrorParams, ImuErrors};
-use ins_errors::strapdown::{LinearizationPoint, NavState, Strapdown};
+use ins_errors::strapdown::{LinearizationPoint, Strapdown};
 use ins_errors::trajectory::Trajectory;
 use nav_app::ins_sd::Scenario;
 use nav_app::ins_sd::interval::IntervalModel;
@@ -24,15 +24,7 @@ fn points(t0_s: f64) -> (Vec<LinearizationPoint>, f64) {
     let imu = ImuErrors::draw(&params, &mut rng);
     let mut it = tr.samples();
     let s0 = it.next().unwrap();
-    let mut ins = Strapdown::new(
-        NavState {
-            pos: s0.pos,
-            vel_ned_mps: s0.vel_ned_mps,
-            att_b_to_n: s0.att_b_to_n,
-        },
-        tr.step_s(),
-    )
-    .unwrap();
+    let mut ins = Strapdown::new(s0.nav_state(), tr.step_s()).unwrap();
     let mut ideal = s0;
     let mut out = Vec::new();
     let k0 = (t0_s / tr.step_s()).round() as usize;
@@ -203,15 +195,7 @@ fn propagated_covariance_matches_the_standalone_monte_carlo_spread() {
     };
     let mut it = tr.samples();
     let s0 = it.next().unwrap();
-    let mut ins = Strapdown::new(
-        NavState {
-            pos: s0.pos,
-            vel_ned_mps: s0.vel_ned_mps,
-            att_b_to_n: s0.att_b_to_n,
-        },
-        step_s,
-    )
-    .unwrap();
+    let mut ins = Strapdown::new(s0.nav_state(), step_s).unwrap();
     let mut p = Mat15::zeros();
     for i in 0..3 {
         p[(9 + i, 9 + i)] = params.accel_bias_sigma_mps2.powi(2);

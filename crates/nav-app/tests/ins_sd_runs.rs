@@ -6,7 +6,7 @@
 use ins_errors::config::BiasModel;
 use ins_errors::error_model;
 use ins_errors::imu::{ImuErrorParams, ImuErrors};
-use ins_errors::strapdown::{NavState, Strapdown};
+use ins_errors::strapdown::Strapdown;
 use ins_errors::trajectory::Trajectory;
 use nav_app::ins_sd::{Mode, RunError, Sample, Scenario, run, run_seed};
 use rand::SeedableRng;
@@ -32,11 +32,7 @@ fn reference_standalone(sc: &Scenario, seed: u64) -> Vec<[f64; 9]> {
     let imu = ImuErrors::draw(&ImuErrorParams::from_config(&sc.imu).unwrap(), &mut rng);
     let mut it = tr.samples();
     let s0 = it.next().unwrap();
-    let nav = |s: &ins_errors::trajectory::TruthSample| NavState {
-        pos: s.pos,
-        vel_ned_mps: s.vel_ned_mps,
-        att_b_to_n: s.att_b_to_n,
-    };
+    let nav = |s: &ins_errors::trajectory::TruthSample| s.nav_state();
     let mut ins = Strapdown::new(nav(&s0), tr.step_s()).unwrap();
     let mut ideal = s0;
     let e0 = error_model::error_state(&nav(&s0), ins.state());

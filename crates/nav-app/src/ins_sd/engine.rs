@@ -71,11 +71,7 @@ pub(crate) struct Loop {
 }
 
 pub(crate) fn nav_state(s: &TruthSample) -> NavState {
-    NavState {
-        pos: s.pos,
-        vel_ned_mps: s.vel_ned_mps,
-        att_b_to_n: s.att_b_to_n,
-    }
+    s.nav_state()
 }
 
 fn pose(s: &NavState) -> NavPose {
