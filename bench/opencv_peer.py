@@ -11,6 +11,12 @@ frame; median over the same frames.
 
 Setup (once):  python3 -m venv target/opencv-venv && target/opencv-venv/bin/pip install "opencv-python-headless<5"
 Run:           cargo build --release -p nav-app && target/opencv-venv/bin/python bench/opencv_peer.py [CLIP.y4m]
+
+Accuracy mode (`cargo xtask eval-lanes` runs it when the venv exists):
+               bench/opencv_peer.py --predict-set fixtures/real/SET --out PRED.json
+writes, for every frame of the labelled set in order, the peer's ego lanes as
+`{"frames": [{"index": i, "lanes": [[a1, a2, a3] | null, [a1, a2, a3] | null]}]}` (left, right;
+x = a1*y^2 + a2*y + a3 in the frame's pixels), which the xtask scores with the same rules as nav-app.
 """
 import json
 import os
@@ -65,7 +71,49 @@ def opencv_pipeline(grey, roi_mask):
     return fits
 
 
+def opencv_sides(grey, roi_mask):
+    """The pipeline above, keeping which side each fit is: [left, right], None where absent."""
+    blur = cv2.GaussianBlur(grey, (5, 5), 0)
+    edges = cv2.bitwise_and(cv2.Canny(blur, 50, 150), roi_mask)
+    lines = cv2.HoughLinesP(edges, 1, np.pi / 180, 20, minLineLength=20, maxLineGap=10)
+    out = [None, None]
+    if lines is not None:
+        seg = lines[:, 0, :].astype(np.float64)
+        dx = seg[:, 2] - seg[:, 0]
+        dy = seg[:, 3] - seg[:, 1]
+        slope = np.divide(dy, dx, out=np.zeros_like(dy), where=dx != 0)
+        for k, side in enumerate((slope < -0.3, slope > 0.3)):
+            s = seg[side]
+            if len(s) >= 2:
+                ys = np.concatenate([s[:, 1], s[:, 3]])
+                xs = np.concatenate([s[:, 0], s[:, 2]])
+                out[k] = [float(c) for c in np.polyfit(ys, xs, 2)]
+    return out
+
+
+def predict_set(set_dir, out_path):
+    with open(os.path.join(set_dir, "labels.json")) as f:
+        labels = json.load(f)
+    h, w = labels["height"], labels["width"]
+    roi = np.zeros((h, w), np.uint8)
+    roi[int(0.62 * h):, :] = 255
+    frames = []
+    for fr in labels["frames"]:
+        grey = cv2.imread(os.path.join(set_dir, fr["file"]), cv2.IMREAD_GRAYSCALE)
+        if grey is None or grey.shape != (h, w):
+            raise SystemExit(f"{fr['file']}: cannot read a {w}x{h} grey image")
+        frames.append({"index": fr["index"], "lanes": opencv_sides(grey, roi)})
+    with open(out_path, "w") as f:
+        json.dump({"frames": frames}, f)
+
+
 def main():
+    if len(sys.argv) >= 2 and sys.argv[1] == "--predict-set":
+        if len(sys.argv) != 5 or sys.argv[3] != "--out":
+            raise SystemExit("usage: opencv_peer.py --predict-set SET_DIR --out PRED.json")
+        cv2.setNumThreads(1)
+        predict_set(sys.argv[2], sys.argv[4])
+        return
     clip = sys.argv[1] if len(sys.argv) > 1 else DEFAULT_CLIP
     cv2.setNumThreads(1)
     frames = read_y4m_mono(clip)

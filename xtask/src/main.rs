@@ -7,6 +7,7 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
+mod eval_lanes;
 mod fixtures;
 mod monte_carlo;
 mod regress;
@@ -22,7 +23,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Every check CI runs: formatting, clippy with warnings denied, all tests and doc tests,
-    /// the lane regression and the vivid V4L2 VM test.
+    /// the lane regression, the real-data lane evaluation and the vivid V4L2 VM test.
     Test,
     /// Install the system packages a full build needs (Debian `libclang-dev`, for V4L2 capture).
     Setup,
@@ -32,6 +33,9 @@ enum Cmd {
     Fixtures(fixtures::FixturesArgs),
     /// Run the lane tracker over every fixture and compare with the recorded expectations.
     Regress(regress::RegressArgs),
+    /// Score the lane tracker on the real labelled sets (fixtures/real/), beside the presets and
+    /// the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
+    EvalLanes(eval_lanes::EvalLanesArgs),
     /// The paper's Monte Carlo experiment (stand-alone, KF, AKF): summaries, CSV, Figs. 1–6; `merge` combines shards.
     MonteCarlo(monte_carlo::MonteCarloArgs),
 }
@@ -43,6 +47,7 @@ fn main() -> Result<()> {
         Cmd::Vivid(args) => vivid::run(args),
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
+        Cmd::EvalLanes(args) => eval_lanes::run(args),
         Cmd::MonteCarlo(args) => monte_carlo::run(args),
     }
 }
@@ -102,6 +107,11 @@ const STEPS: &[Step] = &[
     Step {
         name: "regress",
         run: Run::Xtask(&["regress"]),
+    },
+    Step {
+        // The tracker's default on the real labelled sets, against the recorded floors.
+        name: "eval-lanes",
+        run: Run::Xtask(&["eval-lanes", "--check"]),
     },
     Step {
         name: "vivid",

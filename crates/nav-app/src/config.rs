@@ -9,6 +9,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::NavError;
 
+/// The default configuration (`nav-app` with no `--config`), as shipped in `configs/default.toml`.
+pub const DEFAULT_TOML: &str = include_str!("../../../configs/default.toml");
 /// The `outdoor` preset (highway, strong light/shadow contrast), as shipped in `configs/outdoor.toml`.
 pub const OUTDOOR_TOML: &str = include_str!("../../../configs/outdoor.toml");
 /// The `indoor` preset (corridor floor lines, low contrast), as shipped in `configs/indoor.toml`.
@@ -143,6 +145,12 @@ fn check(
 }
 
 impl TrackerConfig {
+    /// The default configuration (`configs/default.toml`): what `nav-app` runs with no
+    /// `--config`, meant to need no preset on roads and indoor floors alike.
+    pub fn default_preset() -> Result<Self, NavError> {
+        Self::from_toml_str("preset default", DEFAULT_TOML)
+    }
+
     /// The `outdoor` preset.
     pub fn outdoor() -> Result<Self, NavError> {
         Self::from_toml_str("preset outdoor", OUTDOOR_TOML)
@@ -163,9 +171,10 @@ impl TrackerConfig {
         Ok(cfg)
     }
 
-    /// `indoor` / `outdoor` name a preset; anything else is a TOML file path.
+    /// `default` / `indoor` / `outdoor` name a preset; anything else is a TOML file path.
     pub fn load(name_or_path: &str) -> Result<Self, NavError> {
         match name_or_path {
+            "default" => Self::default_preset(),
             "outdoor" => Self::outdoor(),
             "indoor" => Self::indoor(),
             path => {

@@ -40,6 +40,15 @@ pub enum NavError {
         /// The directory.
         path: String,
     },
+    /// A labelled set (`labels.json`, see [`crate::labelled`]) is malformed or does not match its
+    /// frames.
+    #[error("{path}: bad lane labels: {reason}")]
+    Labels {
+        /// The label file or frame concerned.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// An image or stream declares a zero width or height.
     #[error("{name}: zero-size frame ({width}×{height})")]
     ZeroSize {

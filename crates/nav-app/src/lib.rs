@@ -91,8 +91,8 @@ pub mod sources;
 pub mod y4m;
 
 pub use config::{
-    FilterConfig, GradientConfig, INDOOR_TOML, InitConfig, OUTDOOR_TOML, RoiConfig, TrackConfig,
-    TrackerConfig,
+    DEFAULT_TOML, FilterConfig, GradientConfig, INDOOR_TOML, InitConfig, OUTDOOR_TOML, RoiConfig,
+    TrackConfig, TrackerConfig,
 };
 pub use error::NavError;
 pub use frame::{FrameMeta, FrameSource, GreyFrame};
@@ -104,5 +104,6 @@ pub use tracker::{
 };
 pub mod eval;
 pub mod ins_sd;
+pub mod labelled;
 pub mod overlay;
 pub mod synth;

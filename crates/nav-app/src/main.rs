@@ -80,8 +80,8 @@ struct Args {
     /// Capture device (e.g. /dev/video0).
     #[arg(long, value_name = "PATH")]
     device: Option<PathBuf>,
-    /// Preset name (`outdoor`, `indoor`) or a TOML file.
-    #[arg(long, value_name = "NAME|FILE", default_value = "outdoor")]
+    /// Preset name (`default`, `outdoor`, `indoor`) or a TOML file.
+    #[arg(long, value_name = "NAME|FILE", default_value = "default")]
     config: String,
     /// Recursive estimator.
     #[arg(long, value_enum, default_value = "kif")]

@@ -1,0 +1,579 @@
+//! `cargo xtask eval-lanes`: the lane tracker on real labelled frames (`fixtures/real/*/`), scored
+//! with the TuSimple and Aly rules of `nav_app::labelled`, per set and overall, ego lanes.
+//!
+//! Every set is split once and for all: the first 70 % of its frames (in set order) are the
+//! **development** part, the rest the **held-out** part; the tracker's defaults may be tuned on the
+//! development part only, and the held-out figures are reported on their own. Scored: the default
+//! configuration (what `nav-app` runs with no `--config`), the presets, and the classic OpenCV
+//! pipeline (`bench/opencv_peer.py`) when `target/opencv-venv/bin/python` exists. Writes
+//! `summary.md`, `summary.json` and `worst_frames.png` (the worst frames of the default run:
+//! labels green, nav-app red, the OpenCV peer blue). `--check` compares the default's figures with
+//! the floors in `fixtures/expectations-lanes-real.json` and fails below them; `--record` writes
+//! them (measured accuracy − 3 points, measured false positives + 3 points).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, Result, bail};
+use nav_app::labelled::{
+    EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, ScoringRules,
+    score_frame, track_label_set,
+};
+use nav_app::{Estimator, TrackerConfig};
+use serde::{Deserialize, Serialize};
+
+use crate::fixtures::workspace_root;
+
+/// Arguments of `cargo xtask eval-lanes`.
+#[derive(clap::Args, Debug)]
+pub struct EvalLanesArgs {
+    /// Directory of labelled sets (one sub-directory per set with a `labels.json`).
+    #[arg(long, default_value = "fixtures/real")]
+    sets: PathBuf,
+    /// Configurations scored beside the default: preset names or TOML files.
+    #[arg(long = "config", default_values_t = ["outdoor".to_owned(), "indoor".to_owned()])]
+    configs: Vec<String>,
+    /// Output directory (relative paths are taken from the workspace root).
+    #[arg(long, default_value = "target/eval-lanes")]
+    out: PathBuf,
+    /// Fail if the default configuration falls below the recorded floors.
+    #[arg(long)]
+    check: bool,
+    /// Record the floors from this run (default configuration, all frames).
+    #[arg(long)]
+    record: bool,
+    /// Print and write the development part only (what tuning may look at).
+    #[arg(long)]
+    dev_only: bool,
+    /// Do not run the OpenCV peer even if its venv exists.
+    #[arg(long)]
+    no_peer: bool,
+}
+
+/// Format version of `summary.json`.
+const SUMMARY_SCHEMA: u32 = 1;
+/// Fraction of every set's frames (the first ones, in set order) in the development part.
+const DEV_FRACTION: f64 = 0.7;
+/// Floors: measured accuracy minus this, measured false positives plus this.
+const FLOOR_MARGIN: f64 = 0.03;
+/// Name of the default configuration in the reports.
+const DEFAULT_NAME: &str = "default";
+/// Name of the OpenCV peer in the reports.
+const PEER_NAME: &str = "opencv-peer";
+/// Tiles in the contact sheet.
+const SHEET_TILES: usize = 12;
+
+/// One configuration's figures on one set (or overall).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SplitRates {
+    /// Every frame.
+    pub all: LaneRates,
+    /// The development part.
+    pub dev: LaneRates,
+    /// The held-out part.
+    pub holdout: LaneRates,
+}
+
+/// One set in `summary.json`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SetSummary {
+    /// Set name.
+    pub set: String,
+    /// `road` or `indoor`.
+    pub kind: String,
+    /// Where it comes from.
+    pub source: String,
+    /// Its licence.
+    pub licence: String,
+    /// Frame size, px.
+    pub size_px: [usize; 2],
+    /// Labelled frames.
+    pub frames: usize,
+    /// Longest run of consecutive labelled frames.
+    pub longest_clip: usize,
+    /// Per configuration (`default`, presets, `opencv-peer`).
+    pub results: BTreeMap<String, SplitRates>,
+}
+
+/// `summary.json`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Summary {
+    /// Format version.
+    pub schema: u32,
+    /// The scoring rules.
+    pub rules: ScoringRules,
+    /// Fraction of each set in the development part.
+    pub dev_fraction: f64,
+    /// The configuration `default` stands for.
+    pub default_config: String,
+    /// Per set.
+    pub sets: Vec<SetSummary>,
+    /// Pooled over every set, per configuration.
+    pub overall: BTreeMap<String, SplitRates>,
+}
+
+/// Floors of one set (default configuration, every frame).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Floor {
+    tusimple_accuracy_min: f64,
+    tusimple_fp_max: f64,
+    aly_detection_rate_min: f64,
+}
+
+#[derive(Default, Clone, Copy)]
+struct SplitTotals {
+    all: LaneTotals,
+    dev: LaneTotals,
+    holdout: LaneTotals,
+}
+
+impl SplitTotals {
+    fn add(&mut self, t: &LaneTotals, dev: bool) {
+        self.all.add(t);
+        if dev {
+            self.dev.add(t);
+        } else {
+            self.holdout.add(t);
+        }
+    }
+    fn merge(&mut self, o: &SplitTotals) {
+        self.all.add(&o.all);
+        self.dev.add(&o.dev);
+        self.holdout.add(&o.holdout);
+    }
+    fn rates(&self) -> SplitRates {
+        SplitRates {
+            all: self.all.summary(),
+            dev: self.dev.summary(),
+            holdout: self.holdout.summary(),
+        }
+    }
+}
+
+/// Frames `0..dev_count(n)` of a set of `n` are the development part.
+fn dev_count(n: usize) -> usize {
+    (DEV_FRACTION * n as f64).ceil() as usize
+}
+
+/// A scored frame of the default run, for the contact sheet.
+struct FrameRank {
+    set: usize,
+    frame: usize,
+    accuracy: f64,
+    false_positives: u64,
+}
+
+/// The peer's predictions file.
+#[derive(Deserialize)]
+struct PeerFile {
+    frames: Vec<PeerFrame>,
+}
+#[derive(Deserialize)]
+struct PeerFrame {
+    index: u64,
+    lanes: [Option<[f64; 3]>; 2],
+}
+
+fn resolve(root: &Path, p: &Path) -> PathBuf {
+    if p.is_absolute() {
+        p.to_owned()
+    } else {
+        root.join(p)
+    }
+}
+
+/// The labelled sets under `dir`, sorted by name.
+fn find_sets(dir: &Path) -> Result<Vec<(PathBuf, LabelSet)>> {
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("labels.json").is_file())
+        .collect();
+    dirs.sort();
+    if dirs.is_empty() {
+        bail!("{}: no labelled set (no */labels.json)", dir.display());
+    }
+    dirs.into_iter()
+        .map(|d| {
+            let set = LabelSet::load(&d)?;
+            Ok((d, set))
+        })
+        .collect()
+}
+
+/// The peer's `(frame index, prediction)` per frame, `None` without its venv.
+fn run_peer(root: &Path, set_dir: &Path, out: &Path) -> Result<Option<Vec<(u64, EgoPrediction)>>> {
+    let python = root.join("target/opencv-venv/bin/python");
+    if !python.exists() {
+        return Ok(None);
+    }
+    let status = Command::new(&python)
+        .arg(root.join("bench/opencv_peer.py"))
+        .arg("--predict-set")
+        .arg(set_dir)
+        .arg("--out")
+        .arg(out)
+        .status()
+        .with_context(|| format!("cannot start {}", python.display()))?;
+    if !status.success() {
+        bail!("opencv peer failed on {} ({status})", set_dir.display());
+    }
+    let text =
+        std::fs::read_to_string(out).with_context(|| format!("cannot read {}", out.display()))?;
+    let file: PeerFile =
+        serde_json::from_str(&text).with_context(|| format!("{}: bad JSON", out.display()))?;
+    Ok(Some(
+        file.frames
+            .into_iter()
+            .map(|f| (f.index, f.lanes))
+            .collect(),
+    ))
+}
+
+/// Run `cargo xtask eval-lanes`.
+pub fn run(args: EvalLanesArgs) -> Result<()> {
+    let root = workspace_root();
+    let sets_dir = resolve(&root, &args.sets);
+    let out = resolve(&root, &args.out);
+    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    let sets = find_sets(&sets_dir)?;
+    let rules = ScoringRules::default();
+
+    let mut configs: Vec<(String, TrackerConfig)> =
+        vec![(DEFAULT_NAME.to_owned(), TrackerConfig::default_preset()?)];
+    for c in &args.configs {
+        configs.push((c.clone(), TrackerConfig::load(c)?));
+    }
+
+    let mut summaries = Vec::new();
+    let mut overall: BTreeMap<String, SplitTotals> = BTreeMap::new();
+    let mut ranks = Vec::new();
+    let mut drawn: Vec<(Vec<EgoPrediction>, Option<Vec<EgoPrediction>>)> = Vec::new();
+    for (si, (dir, set)) in sets.iter().enumerate() {
+        let n_dev = dev_count(set.frames.len());
+        let mut results = BTreeMap::new();
+        let mut runs: Vec<(String, Vec<EgoPrediction>)> = Vec::new();
+        for (name, cfg) in &configs {
+            let preds = track_label_set(dir, set, cfg, Estimator::Kif)
+                .with_context(|| format!("set {} with config {name}", set.set))?;
+            runs.push((name.clone(), preds));
+        }
+        let peer = if args.no_peer {
+            None
+        } else {
+            run_peer(&root, dir, &out.join(format!("peer-{}.json", set.set)))?
+        };
+        let peer: Option<Vec<EgoPrediction>> = match peer {
+            Some(p) => {
+                let same = p.len() == set.frames.len()
+                    && p.iter().zip(&set.frames).all(|((i, _), f)| *i == f.index);
+                if !same {
+                    bail!("opencv peer's frames do not match set {}", set.set);
+                }
+                let p: Vec<EgoPrediction> = p.into_iter().map(|(_, l)| l).collect();
+                runs.push((PEER_NAME.to_owned(), p.clone()));
+                Some(p)
+            }
+            None => None,
+        };
+        for (name, preds) in &runs {
+            let mut totals = SplitTotals::default();
+            for (i, (f, p)) in set.frames.iter().zip(preds).enumerate() {
+                let t = score_frame(f, set.width, set.height, p, &rules);
+                totals.add(&t, i < n_dev);
+                if name == DEFAULT_NAME && t.label_lanes + t.predicted_lanes > 0 {
+                    ranks.push(FrameRank {
+                        set: si,
+                        frame: i,
+                        accuracy: if t.label_lanes > 0 {
+                            t.tusimple_acc_sum / t.label_lanes as f64
+                        } else {
+                            1.0
+                        },
+                        false_positives: t.predicted_lanes - t.tusimple_matched,
+                    });
+                }
+            }
+            overall.entry(name.clone()).or_default().merge(&totals);
+            results.insert(name.clone(), totals.rates());
+        }
+        drawn.push((runs.swap_remove(0).1, peer));
+        summaries.push(SetSummary {
+            set: set.set.clone(),
+            kind: format!("{:?}", set.kind).to_lowercase(),
+            source: set.source.clone(),
+            licence: set.licence.clone(),
+            size_px: [set.width, set.height],
+            frames: set.frames.len(),
+            longest_clip: set.longest_clip(),
+            results,
+        });
+    }
+    let summary = Summary {
+        schema: SUMMARY_SCHEMA,
+        rules,
+        dev_fraction: DEV_FRACTION,
+        default_config: "configs/default.toml".to_owned(),
+        sets: summaries,
+        overall: overall
+            .iter()
+            .map(|(k, v)| (k.clone(), v.rates()))
+            .collect(),
+    };
+
+    let md = render_markdown(&summary, args.dev_only);
+    print!("{md}");
+    if !args.dev_only {
+        std::fs::write(out.join("summary.md"), &md)?;
+        std::fs::write(
+            out.join("summary.json"),
+            serde_json::to_string_pretty(&summary)? + "\n",
+        )?;
+        ranks.sort_by(|a, b| {
+            a.accuracy
+                .total_cmp(&b.accuracy)
+                .then(b.false_positives.cmp(&a.false_positives))
+        });
+        ranks.truncate(SHEET_TILES);
+        let sheet = out.join("worst_frames.png");
+        contact_sheet(&sets, &drawn, &ranks, &rules, &sheet)?;
+        let mut list =
+            String::from("\nWorst frames of the default run (worst_frames.png, row by row):\n");
+        for (k, r) in ranks.iter().enumerate() {
+            let (_, set) = &sets[r.set];
+            list += &format!(
+                "{k:2}. {} {} (TuSimple {:.0} %, {} false positive{})\n",
+                set.set,
+                set.frames[r.frame].file,
+                100.0 * r.accuracy,
+                r.false_positives,
+                if r.false_positives == 1 { "" } else { "s" }
+            );
+        }
+        print!("{list}");
+        std::fs::write(out.join("summary.md"), md + &list)?;
+        println!("eval-lanes: wrote {}", out.display());
+    }
+
+    let floors_path = root.join("fixtures/expectations-lanes-real.json");
+    if args.record {
+        let mut floors = BTreeMap::new();
+        for s in &summary.sets {
+            let r = &s.results[DEFAULT_NAME].all;
+            floors.insert(s.set.clone(), floor_of(r));
+        }
+        floors.insert(
+            "overall".to_owned(),
+            floor_of(&summary.overall[DEFAULT_NAME].all),
+        );
+        std::fs::write(&floors_path, serde_json::to_string_pretty(&floors)? + "\n")?;
+        println!("eval-lanes: recorded {}", floors_path.display());
+    }
+    if args.check {
+        let text = std::fs::read_to_string(&floors_path)
+            .with_context(|| format!("cannot read {}", floors_path.display()))?;
+        let floors: BTreeMap<String, Floor> = serde_json::from_str(&text)
+            .with_context(|| format!("{}: bad floors", floors_path.display()))?;
+        let mut failures = Vec::new();
+        for (name, floor) in &floors {
+            let rates = if name == "overall" {
+                summary.overall[DEFAULT_NAME].all
+            } else {
+                match summary.sets.iter().find(|s| &s.set == name) {
+                    Some(s) => s.results[DEFAULT_NAME].all,
+                    None => {
+                        failures.push(format!("{name}: set missing"));
+                        continue;
+                    }
+                }
+            };
+            if rates.tusimple_accuracy < floor.tusimple_accuracy_min {
+                failures.push(format!(
+                    "{name}: TuSimple accuracy {:.3} < floor {:.3}",
+                    rates.tusimple_accuracy, floor.tusimple_accuracy_min
+                ));
+            }
+            if rates.tusimple_fp > floor.tusimple_fp_max {
+                failures.push(format!(
+                    "{name}: false positives {:.3} > ceiling {:.3}",
+                    rates.tusimple_fp, floor.tusimple_fp_max
+                ));
+            }
+            if rates.aly_detection_rate < floor.aly_detection_rate_min {
+                failures.push(format!(
+                    "{name}: Aly detection rate {:.3} < floor {:.3}",
+                    rates.aly_detection_rate, floor.aly_detection_rate_min
+                ));
+            }
+        }
+        if !failures.is_empty() {
+            bail!("eval-lanes: below the floors:\n  {}", failures.join("\n  "));
+        }
+        println!("eval-lanes: {} floors held", floors.len());
+    }
+    Ok(())
+}
+
+fn floor_of(r: &LaneRates) -> Floor {
+    let round = |x: f64| (x * 1000.0).round() / 1000.0;
+    Floor {
+        tusimple_accuracy_min: round((r.tusimple_accuracy - FLOOR_MARGIN).max(0.0)),
+        tusimple_fp_max: round((r.tusimple_fp + FLOOR_MARGIN).min(1.0)),
+        aly_detection_rate_min: round((r.aly_detection_rate - FLOOR_MARGIN).max(0.0)),
+    }
+}
+
+fn pct(x: f64) -> String {
+    format!("{:.1}", 100.0 * x)
+}
+
+fn render_markdown(s: &Summary, dev_only: bool) -> String {
+    let mut md = String::new();
+    md += "# Lane tracker on real labelled frames (`cargo xtask eval-lanes`)\n\n";
+    md += &format!(
+        "Ego lanes; label points below {:.0} % of the height. TuSimple: point within {} px at 1280 px \
+         width (scaled, slope-corrected), lane matched at ≥ {:.0} % of its points; accuracy, FP and FN \
+         in %. Aly: median nearest-point distance ≤ {} px at 640 px width; detection rate and false \
+         detections per label lane in %. dev = first {:.0} % of each set's frames, hold-out = the rest \
+         (never used for tuning).\n\n",
+        100.0 * s.rules.eval_top_fraction,
+        s.rules.tusimple_px_at_1280,
+        100.0 * s.rules.tusimple_match_fraction,
+        s.rules.aly_px_at_640,
+        100.0 * s.dev_fraction
+    );
+    type Pick = fn(&SplitRates) -> &LaneRates;
+    let splits: &[(&str, Pick)] = if dev_only {
+        &[("dev", |r| &r.dev)]
+    } else {
+        &[
+            ("all", |r| &r.all),
+            ("dev", |r| &r.dev),
+            ("hold-out", |r| &r.holdout),
+        ]
+    };
+    md += "| set | kind | frames (longest clip) | config | split | lanes | TuSimple acc | FP | FN | Aly det. | Aly false/label | mean err px |\n";
+    md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    let row = |md: &mut String,
+               set: &str,
+               kind: &str,
+               frames: &str,
+               cfg: &str,
+               split: &str,
+               r: &LaneRates| {
+        *md += &format!(
+            "| {set} | {kind} | {frames} | {cfg} | {split} | {} | {} | {} | {} | {} | {} | {:.2} |\n",
+            r.label_lanes,
+            pct(r.tusimple_accuracy),
+            pct(r.tusimple_fp),
+            pct(r.tusimple_fn),
+            pct(r.aly_detection_rate),
+            pct(r.aly_false_per_label),
+            r.mean_abs_error_px
+        );
+    };
+    for set in &s.sets {
+        for (cfg, rates) in &set.results {
+            for (split, pick) in splits {
+                row(
+                    &mut md,
+                    &set.set,
+                    &set.kind,
+                    &format!("{} ({})", set.frames, set.longest_clip),
+                    cfg,
+                    split,
+                    pick(rates),
+                );
+            }
+        }
+    }
+    let frames: usize = s.sets.iter().map(|x| x.frames).sum();
+    for (cfg, rates) in &s.overall {
+        for (split, pick) in splits {
+            row(
+                &mut md,
+                "**overall**",
+                "",
+                &frames.to_string(),
+                cfg,
+                split,
+                pick(rates),
+            );
+        }
+    }
+    md
+}
+
+/// Draw `ranks` (worst first) as a 4-column grid of 320×240 tiles: label points (ego green,
+/// others dark green), nav-app's default lanes red, the peer's blue.
+fn contact_sheet(
+    sets: &[(PathBuf, LabelSet)],
+    drawn: &[(Vec<EgoPrediction>, Option<Vec<EgoPrediction>>)],
+    ranks: &[FrameRank],
+    rules: &ScoringRules,
+    path: &Path,
+) -> Result<()> {
+    const TW: u32 = 320;
+    const TH: u32 = 240;
+    const COLS: u32 = 4;
+    let rows = (ranks.len() as u32).div_ceil(COLS).max(1);
+    let mut sheet = image::RgbImage::new(TW * COLS, TH * rows);
+    for (k, r) in ranks.iter().enumerate() {
+        let (dir, set) = &sets[r.set];
+        let f: &LabelFrame = &set.frames[r.frame];
+        let grey = image::open(LabelSet::frame_path(dir, f))
+            .with_context(|| format!("cannot read {}", f.file))?
+            .to_luma8();
+        let (ox, oy) = ((k as u32 % COLS) * TW, (k as u32 / COLS) * TH);
+        let mut put = |x: f64, y: f64, c: [u8; 3]| {
+            if x >= 0.0 && y >= 0.0 && x < f64::from(TW) && y < f64::from(TH) {
+                sheet.put_pixel(ox + x as u32, oy + y as u32, image::Rgb(c));
+            }
+        };
+        for (x, y, p) in grey.enumerate_pixels() {
+            if x < TW && y < TH {
+                put(f64::from(x), f64::from(y), [p[0]; 3]);
+            }
+        }
+        let y_top = rules.eval_top_fraction * set.height as f64;
+        // A dotted line marks the top of the scored band.
+        for x in (0..set.width).step_by(4) {
+            put(x as f64, y_top, [255, 255, 0]);
+        }
+        for lane in &f.lanes {
+            let c = if lane.side == LabelSide::Other {
+                [0, 120, 0]
+            } else {
+                [0, 255, 0]
+            };
+            for &[x, y] in &lane.points {
+                for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+                    put(x + dx, y + dy, c);
+                }
+            }
+        }
+        let (ours, peer) = &drawn[r.set];
+        let mut curves: Vec<([f64; 3], [u8; 3])> = Vec::new();
+        for c in ours[r.frame].iter().flatten() {
+            curves.push((*c, [255, 40, 40]));
+        }
+        if let Some(p) = peer {
+            for c in p[r.frame].iter().flatten() {
+                curves.push((*c, [60, 120, 255]));
+            }
+        }
+        for ([a1, a2, a3], col) in curves {
+            let y0 = (0.4 * set.height as f64) as usize;
+            for y in y0..set.height {
+                let yf = y as f64;
+                put((a1 * yf + a2) * yf + a3, yf, col);
+            }
+        }
+    }
+    sheet
+        .save(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}
