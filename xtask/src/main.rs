@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 mod eval_lanes;
 mod fixtures;
 mod monte_carlo;
+mod python;
 mod regress;
 mod vivid;
 
@@ -36,6 +37,8 @@ enum Cmd {
     /// Score the lane tracker on the real labelled sets (fixtures/real/), beside the presets and
     /// the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
     EvalLanes(eval_lanes::EvalLanesArgs),
+    /// Build the `ita_nav` Python wheel into target/py-venv and run its pytest suite.
+    Python(python::PythonArgs),
     /// The paper's Monte Carlo experiment (stand-alone, KF, AKF): summaries, CSV, Figs. 1–6; `merge` combines shards.
     MonteCarlo(monte_carlo::MonteCarloArgs),
 }
@@ -48,6 +51,7 @@ fn main() -> Result<()> {
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
         Cmd::EvalLanes(args) => eval_lanes::run(args),
+        Cmd::Python(args) => python::run(args),
         Cmd::MonteCarlo(args) => monte_carlo::run(args),
     }
 }
@@ -112,6 +116,11 @@ const STEPS: &[Step] = &[
         // The tracker's default on the real labelled sets, against the recorded floors.
         name: "eval-lanes",
         run: Run::Xtask(&["eval-lanes", "--check"]),
+    },
+    Step {
+        // The Python package: wheel built by maturin, pytest against the nav-app binary.
+        name: "python",
+        run: Run::Xtask(&["python"]),
     },
     Step {
         name: "vivid",

@@ -351,7 +351,8 @@ fn workspace_root() -> Result<PathBuf> {
         .context("xtask manifest dir has no parent")
 }
 
-fn target_dir(root: &Path) -> PathBuf {
+/// The cargo target directory (`CARGO_TARGET_DIR` or `<root>/target`).
+pub fn target_dir(root: &Path) -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from)
 }
 

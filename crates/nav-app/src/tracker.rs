@@ -393,15 +393,29 @@ impl LaneTracker {
     /// Process one frame. Errors only for a frame of the wrong size or a component refusing
     /// its (validated) input; a lane that cannot be tracked is reported as such, not as an error.
     pub fn track(&mut self, frame: &GreyFrame) -> Result<TrackReport, NavError> {
-        if frame.width != self.width || frame.height != self.height {
+        self.track_pixels(&frame.data, frame.width, frame.height, frame.width)
+    }
+
+    /// [`LaneTracker::track`] on borrowed pixels: `width × height` grey pixels, row `y` starting at
+    /// `data[y * stride_px]` (`stride_px ≥ width`), so a caller's buffer (a numpy array, a capture
+    /// buffer with padded rows) is read in place without a copy. Errors for a size other than the
+    /// tracker's or a `data` too short for the stride.
+    pub fn track_pixels(
+        &mut self,
+        data: &[u8],
+        width: usize,
+        height: usize,
+        stride_px: usize,
+    ) -> Result<TrackReport, NavError> {
+        if width != self.width || height != self.height {
             return Err(NavError::FrameSize {
                 expected_w: self.width,
                 expected_h: self.height,
-                got_w: frame.width,
-                got_h: frame.height,
+                got_w: width,
+                got_h: height,
             });
         }
-        let image = GreyImage::new(&frame.data, self.width, self.height, self.width)
+        let image = GreyImage::new(data, self.width, self.height, stride_px)
             .map_err(|e| stage("gradient", e))?;
         self.counters.frames += 1;
         for i in 0..2 {

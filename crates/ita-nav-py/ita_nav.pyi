@@ -1,0 +1,63 @@
+"""Lane-mark tracking of Pimentel & Hemerly (directional gradient -> Hough + least squares -> Kalman
+information filter), from numpy. Built from the Rust crates of ita-nav (crates/ita-nav-py)."""
+
+from typing import Literal, Optional, Tuple, TypedDict
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+DEFAULT_CONFIG_TOML: str
+"""The default tracker configuration (configs/default.toml), every field with its unit."""
+
+class NavError(Exception):
+    """A configuration, frame or tracking error from the Rust library; the message names the field,
+    file or frame."""
+
+class Lane(TypedDict):
+    side: Literal["left", "right"]
+    state: Literal["initialising", "tracking", "coasting", "lost"]
+    coeffs: Optional[Tuple[float, float, float]]
+    """(a1, a2, a3) of x = a1*y**2 + a2*y + a3 (x column, y row, pixels of the frame), or None when
+    the lane is initialising or lost."""
+    rows: Tuple[float, float]
+    """(y_min, y_max), rows (px) of the points behind the estimate."""
+    points: int
+    """Points used this frame (filter update, or the least-squares fit of an initialisation)."""
+    initialised: bool
+    """True if Hough + least squares (re-)initialised the lane on this frame."""
+
+class Counters(TypedDict):
+    frames: int
+    initialisations: Tuple[int, int]
+    gated_jumps: Tuple[int, int]
+    gated_crossings: Tuple[int, int]
+
+class LaneTracker:
+    """One tracker per video stream; every frame must have the size of the first one."""
+
+    def __init__(
+        self, config: Optional[str] = None, estimator: Literal["kif", "wrls"] = "kif"
+    ) -> None:
+        """config: None (the default configuration), a preset name ("default", "outdoor",
+        "indoor") or a TOML file path. Raises NavError for a bad configuration (naming the field),
+        ValueError for an unknown estimator."""
+    def track(self, frame: npt.NDArray[np.uint8]) -> list[Lane]:
+        """Track one frame: uint8 H x W (grey, read in place when C-contiguous) or H x W x 3 (RGB,
+        converted with BT.601 luma). Returns [left, right]. Raises TypeError for another dtype or
+        shape, ValueError for a non-contiguous array or a frame of another size, NavError for a
+        frame the tracker refuses."""
+    def reset(self) -> None:
+        """Forget both lanes: the next frame initialises again."""
+    @property
+    def frame_shape(self) -> Optional[Tuple[int, int]]:
+        """(height, width) of the frames this tracker takes, None before the first frame."""
+    @property
+    def last_track_us(self) -> float:
+        """Wall time of the Rust tracker alone on the last frame, microseconds (NaN before any)."""
+    @property
+    def counters(self) -> Counters: ...
+
+def read_frames(path: str) -> list[npt.NDArray[np.uint8]]:
+    """Every frame of an input, read as `nav-app --input PATH` reads it: a YUV4MPEG2 file, a
+    directory of images or a still image; H x W uint8 arrays. Raises NavError."""

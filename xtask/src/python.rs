@@ -1,0 +1,141 @@
+//! `cargo xtask python`: build the `ita_nav` wheel (crates/ita-nav-py, maturin) into the virtual
+//! environment `target/py-venv` and run its pytest suite against the `nav-app` binary.
+//!
+//! Everything it needs comes from PyPI into the venv on first use (maturin, pytest, numpy): a
+//! fresh machine needs only `python3` with its `venv` module (Debian `python3-venv`, installed with
+//! apt-get when missing and running as root or under CI with passwordless sudo).
+
+use std::path::{Path, PathBuf};
+
+use std::process::Command;
+
+use anyhow::{Context, Result, bail};
+
+use crate::fixtures::workspace_root;
+
+/// Requirements installed into the venv.
+const REQUIREMENTS: &[&str] = &["maturin>=1.9,<2", "pytest>=7", "numpy>=1.21"];
+
+/// Arguments of `cargo xtask python`.
+#[derive(clap::Args, Debug)]
+pub struct PythonArgs {
+    /// Extra arguments for pytest (e.g. `-k rgb`).
+    #[arg(trailing_var_arg = true)]
+    pytest_args: Vec<String>,
+}
+
+fn run_checked(cmd: &mut Command, what: &str) -> Result<()> {
+    eprintln!("xtask python: {what}");
+    let status = cmd
+        .status()
+        .with_context(|| format!("could not start: {what}"))?;
+    if !status.success() {
+        bail!("{what}: {status}");
+    }
+    Ok(())
+}
+
+/// Make `target/py-venv` with the requirements; returns its python.
+fn ensure_venv(root: &Path) -> Result<PathBuf> {
+    let venv = root.join("target/py-venv");
+    let python = venv.join("bin/python");
+    if !python.exists() {
+        let made = Command::new("python3")
+            .args(["-m", "venv"])
+            .arg(&venv)
+            .status()
+            .context("python3 is needed for the Python package (cannot start python3)")?;
+        if !made.success() {
+            // Debian splits the venv module out (python3-venv).
+            crate::vivid::ensure_host_packages(&["python3-venv"])?;
+            let _ = std::fs::remove_dir_all(&venv);
+            run_checked(
+                Command::new("python3").args(["-m", "venv"]).arg(&venv),
+                "python3 -m venv target/py-venv",
+            )?;
+        }
+    }
+    let have = Command::new(&python)
+        .args(["-c", "import numpy, pytest"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false)
+        && venv.join("bin/maturin").exists();
+    if !have {
+        run_checked(
+            Command::new(&python)
+                .args([
+                    "-m",
+                    "pip",
+                    "install",
+                    "--quiet",
+                    "--disable-pip-version-check",
+                ])
+                .args(REQUIREMENTS),
+            &format!("pip install {}", REQUIREMENTS.join(" ")),
+        )?;
+    }
+    Ok(python)
+}
+
+/// Run `cargo xtask python`.
+pub fn run(args: PythonArgs) -> Result<()> {
+    let root = workspace_root();
+    let python = ensure_venv(&root)?;
+    let venv_bin = python
+        .parent()
+        .map(Path::to_owned)
+        .context("venv without bin/")?;
+    let wheels = root.join("target/py-wheels");
+    let _ = std::fs::remove_dir_all(&wheels);
+    run_checked(
+        Command::new(venv_bin.join("maturin"))
+            .args(["build", "--release", "--quiet", "--manifest-path"])
+            .arg(root.join("crates/ita-nav-py/Cargo.toml"))
+            .arg("--interpreter")
+            .arg(&python)
+            .arg("--out")
+            .arg(&wheels),
+        "maturin build --release (crates/ita-nav-py)",
+    )?;
+    let wheel = std::fs::read_dir(&wheels)
+        .with_context(|| format!("cannot read {}", wheels.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.extension().is_some_and(|x| x == "whl"))
+        .context("maturin wrote no wheel")?;
+    run_checked(
+        Command::new(&python)
+            .args([
+                "-m",
+                "pip",
+                "install",
+                "--quiet",
+                "--disable-pip-version-check",
+                "--force-reinstall",
+                "--no-deps",
+            ])
+            .arg(&wheel),
+        &format!("pip install {}", wheel.display()),
+    )?;
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    run_checked(
+        Command::new(&cargo).current_dir(&root).args([
+            "build",
+            "-p",
+            "nav-app",
+            "--no-default-features",
+            "--features",
+            "cli",
+        ]),
+        "cargo build -p nav-app (the binary the Python results are compared with)",
+    )?;
+    let nav_app = crate::vivid::target_dir(&root).join("debug/nav-app");
+    run_checked(
+        Command::new(&python)
+            .current_dir(&root)
+            .env("NAV_APP_BIN", &nav_app)
+            .args(["-m", "pytest", "-q", "crates/ita-nav-py/tests"])
+            .args(&args.pytest_args),
+        "pytest crates/ita-nav-py/tests",
+    )
+}
