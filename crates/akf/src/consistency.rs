@@ -5,6 +5,7 @@
 //! average at confidence 1−α is [χ²_{α/2}(runs·dof), χ²_{1−α/2}(runs·dof)] / runs.
 
 use nalgebra::{SMatrix, SVector};
+use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
 use crate::AkfError;
 use crate::linalg::{check_finite, cholesky_lower, mahalanobis_squared};
@@ -22,65 +23,29 @@ pub fn nees<const N: usize>(
     Ok(mahalanobis_squared(&l, error))
 }
 
-/// Standard normal quantile Φ⁻¹(p), 0 < p < 1 (Acklam's rational approximation, relative
-/// error < 1.2·10⁻⁹).
-pub fn normal_quantile(p: f64) -> Result<f64, AkfError> {
-    if !(p > 0.0 && p < 1.0) {
-        return Err(AkfError::InvalidParameter {
+fn check_probability(p: f64) -> Result<(), AkfError> {
+    if p > 0.0 && p < 1.0 {
+        Ok(())
+    } else {
+        Err(AkfError::InvalidParameter {
             field: "p",
             reason: format!("{p} is outside (0, 1)"),
-        });
+        })
     }
-    const A: [f64; 6] = [
-        -3.969_683_028_665_376e1,
-        2.209_460_984_245_205e2,
-        -2.759_285_104_469_687e2,
-        1.383_577_518_672_69e2,
-        -3.066_479_806_614_716e1,
-        2.506_628_277_459_239,
-    ];
-    const B: [f64; 5] = [
-        -5.447_609_879_822_406e1,
-        1.615_858_368_580_409e2,
-        -1.556_989_798_598_866e2,
-        6.680_131_188_771_972e1,
-        -1.328_068_155_288_572e1,
-    ];
-    const C: [f64; 6] = [
-        -7.784_894_002_430_293e-3,
-        -3.223_964_580_411_365e-1,
-        -2.400_758_277_161_838,
-        -2.549_732_539_343_734,
-        4.374_664_141_464_968,
-        2.938_163_982_698_783,
-    ];
-    const D: [f64; 4] = [
-        7.784_695_709_041_462e-3,
-        3.224_671_290_700_398e-1,
-        2.445_134_137_142_996,
-        3.754_408_661_907_416,
-    ];
-    const P_LOW: f64 = 0.02425;
-    let tail = |q: f64| {
-        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
-            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
-    };
-    let x = if p < P_LOW {
-        tail((-2.0 * p.ln()).sqrt())
-    } else if p <= 1.0 - P_LOW {
-        let q = p - 0.5;
-        let r = q * q;
-        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
-            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
-    } else {
-        -tail((-2.0 * (1.0 - p).ln()).sqrt())
-    };
-    Ok(x)
 }
 
-/// χ² quantile with `dof` degrees of freedom by the Wilson–Hilferty approximation
-/// k·(1 − 2/(9k) + z_p·√(2/(9k)))³. Relative error ≈ 2·10⁻³ at k = 10, < 10⁻⁴ for k ≥ 100 (the
-/// Monte Carlo bands use k = runs·dof, in the hundreds).
+/// Standard normal quantile Φ⁻¹(p), 0 < p < 1 (`statrs`: Φ⁻¹(p) = −√2·erfc⁻¹(2p), to round-off).
+pub fn normal_quantile(p: f64) -> Result<f64, AkfError> {
+    check_probability(p)?;
+    let n = Normal::new(0.0, 1.0).map_err(|e| AkfError::InvalidParameter {
+        field: "normal",
+        reason: e.to_string(),
+    })?;
+    Ok(n.inverse_cdf(p))
+}
+
+/// χ² quantile with `dof` (> 0, not necessarily integer) degrees of freedom, the exact inverse of
+/// the regularised lower incomplete gamma function (`statrs`), 0 < p < 1.
 pub fn chi_square_quantile(p: f64, dof: f64) -> Result<f64, AkfError> {
     if !(dof.is_finite() && dof > 0.0) {
         return Err(AkfError::InvalidParameter {
@@ -88,10 +53,12 @@ pub fn chi_square_quantile(p: f64, dof: f64) -> Result<f64, AkfError> {
             reason: format!("{dof} must be finite and > 0"),
         });
     }
-    let z = normal_quantile(p)?;
-    let c = 2.0 / (9.0 * dof);
-    let base = (1.0 - c + z * c.sqrt()).max(0.0);
-    Ok(dof * base * base * base)
+    check_probability(p)?;
+    let d = ChiSquared::new(dof).map_err(|e| AkfError::InvalidParameter {
+        field: "dof",
+        reason: e.to_string(),
+    })?;
+    Ok(d.inverse_cdf(p))
 }
 
 /// Two-sided acceptance band for the average of `runs` independent χ²(`dof`) statistics at
@@ -139,19 +106,32 @@ mod tests {
 
     #[test]
     fn chi_square_quantile_matches_tables() {
-        // Tabulated χ² quantiles (NIST/SEMATECH e-Handbook, table 1.3.6.7.4).
+        // Tabulated χ² quantiles (NIST/SEMATECH e-Handbook, table 1.3.6.7.4, 3 decimals).
         let cases = [
             (0.95, 10.0, 18.307),
             (0.05, 10.0, 3.940),
             (0.975, 100.0, 129.561),
+            (0.95, 2.0, 5.991),
+            (0.99, 1.0, 6.635),
         ];
         for (p, k, expected) in cases {
             let q = chi_square_quantile(p, k).unwrap();
             assert!(
-                (q - expected).abs() < 3e-3 * expected,
+                (q - expected).abs() < 6e-4,
                 "p={p} k={k}: {q} vs {expected}"
             );
         }
+        // χ²(2) has the closed form F(x) = 1 − e^{−x/2}: the quantile is −2 ln(1 − p).
+        for p in [0.001, 0.1, 0.5, 0.9, 0.999] {
+            let q = chi_square_quantile(p, 2.0).unwrap();
+            let exact = -2.0 * (1.0 - p).ln();
+            assert!(
+                (q - exact).abs() < 1e-9 * exact.max(1.0),
+                "p={p}: {q} vs {exact}"
+            );
+        }
+        assert!(chi_square_quantile(0.5, 0.0).is_err());
+        assert!(chi_square_quantile(1.0, 3.0).is_err());
     }
 
     #[test]

@@ -30,8 +30,8 @@
 //! # Discretisation
 //!
 //! * Exact: [`van_loan`] — Φ = e^{A T}, Q_d = ∫₀ᵀ e^{As} G Q_c Gᵀ e^{Aᵀs} ds from the 30×30
-//!   exponential of [[−A, GQ_cGᵀ], [0, Aᵀ]]·T ([`expm`]: scaling and squaring with the (6,6)
-//!   Padé approximant, Golub & Van Loan alg. 11.3.1).
+//!   exponential of [[−A, GQ_cGᵀ], [0, Aᵀ]]·T ([`expm`]: nalgebra's scaling-and-squaring Padé
+//!   exponential; the tests check it against an independent Taylor series and Rodrigues' formula).
 //! * Fast (hot path, T = 0.01 s): [`Transition::series`] — third-order Taylor series exploiting the
 //!   zero bias rows of A (Φ = [[Φ₁₁, Φ₁₂], [0, I]]); [`discretize_fast`] — Φ by that series and
 //!   Q_d by Simpson's rule on [0, T] (nodes 0, T/2, T). Measured accuracy against Van Loan is in
@@ -136,9 +136,13 @@ pub fn continuous_noise_psd(
     q
 }
 
-/// Matrix exponential e^M of a fixed-size square matrix: scaling and squaring with the (6,6)
-/// Padé approximant (relative accuracy ≈ 1e-15 for ‖M/2^s‖∞ ≤ 1/2).
-pub fn expm<const N: usize>(m: &SMatrix<f64, N, N>) -> Result<SMatrix<f64, N, N>, InsError> {
+/// Matrix exponential e^M of a fixed-size square matrix (nalgebra's `exp`: scaling and squaring
+/// with Padé approximants of degree chosen from ‖M‖₁, Higham 2005 / Al-Mohy & Higham 2009). Errors
+/// for a non-finite entry.
+pub fn expm<const N: usize>(m: &SMatrix<f64, N, N>) -> Result<SMatrix<f64, N, N>, InsError>
+where
+    nalgebra::Const<N>: nalgebra::DimMin<nalgebra::Const<N>, Output = nalgebra::Const<N>>,
+{
     if !m.iter().all(|x| x.is_finite()) {
         return Err(InsError::InvalidArgument {
             func: "expm",
@@ -147,82 +151,7 @@ pub fn expm<const N: usize>(m: &SMatrix<f64, N, N>) -> Result<SMatrix<f64, N, N>
             value: "non-finite entry".to_string(),
         });
     }
-    let norm = (0..N)
-        .map(|i| m.row(i).iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    let s = if norm > 0.5 {
-        (norm / 0.5).log2().ceil() as i32
-    } else {
-        0
-    };
-    let x = m * 2f64.powi(-s);
-    let q = 6;
-    let mut c = 1.0;
-    let mut num = SMatrix::<f64, N, N>::identity();
-    let mut den = SMatrix::<f64, N, N>::identity();
-    let mut xk = SMatrix::<f64, N, N>::identity();
-    for k in 1..=q {
-        c *= (q - k + 1) as f64 / ((k * (2 * q - k + 1)) as f64);
-        xk = x * xk;
-        num += c * xk;
-        if k % 2 == 0 {
-            den += c * xk;
-        } else {
-            den -= c * xk;
-        }
-    }
-    let mut e = solve_in_place(den, num).ok_or(InsError::InvalidArgument {
-        func: "expm",
-        arg: "m",
-        requirement: "Padé denominator must be invertible",
-        value: format!("inf-norm {norm:e}"),
-    })?;
-    for _ in 0..s {
-        e = e * e;
-    }
-    Ok(e)
-}
-
-/// Solves D X = B by Gaussian elimination with partial pivoting (fixed size, no allocation).
-fn solve_in_place<const N: usize>(
-    mut d: SMatrix<f64, N, N>,
-    mut b: SMatrix<f64, N, N>,
-) -> Option<SMatrix<f64, N, N>> {
-    for k in 0..N {
-        let (piv, pmax) = (k..N)
-            .map(|i| (i, d[(i, k)].abs()))
-            .fold((k, -1.0), |a, c| if c.1 > a.1 { c } else { a });
-        if pmax.is_nan() || pmax <= 0.0 {
-            return None;
-        }
-        if piv != k {
-            d.swap_rows(piv, k);
-            b.swap_rows(piv, k);
-        }
-        let inv = 1.0 / d[(k, k)];
-        for i in k + 1..N {
-            let l = d[(i, k)] * inv;
-            if l != 0.0 {
-                for j in k..N {
-                    d[(i, j)] -= l * d[(k, j)];
-                }
-                for j in 0..N {
-                    b[(i, j)] -= l * b[(k, j)];
-                }
-            }
-        }
-    }
-    for k in (0..N).rev() {
-        let inv = 1.0 / d[(k, k)];
-        for j in 0..N {
-            let mut v = b[(k, j)];
-            for i in k + 1..N {
-                v -= d[(k, i)] * b[(i, j)];
-            }
-            b[(k, j)] = v * inv;
-        }
-    }
-    Some(b)
+    Ok(m.exp())
 }
 
 /// Exact discretisation by Van Loan's method: returns (Φ = e^{A T}, Q_d) for the continuous

@@ -32,7 +32,7 @@
 //!   `final_horizontal_error_m` likewise with √(δN² + δE²).
 //! * NEES (n = 15) and NIS (m = 6) are recorded at SD epochs. For M runs kept, M·(average) ~
 //!   χ²(M·n) if the filter is consistent, so the two-sided 95 % band for the run average is
-//!   [χ²_{0.025}(Mn), χ²_{0.975}(Mn)]/M, computed by `akf::average_band` (Wilson–Hilferty;
+//!   [χ²_{0.025}(Mn), χ²_{0.975}(Mn)]/M, computed by `akf::average_band` (exact χ² quantiles, statrs;
 //!   M = 100, n = 15 → [13.95, 16.09], matching docs/ins-sd.md, tested). `summary.md` reports the
 //!   overall average and the fraction of epochs whose run average lies inside, above (the filter
 //!   is over-confident) or below (under-confident) its band.

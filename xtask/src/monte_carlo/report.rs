@@ -48,7 +48,7 @@ pub const PAPER: [PaperFigure; 3] = [
     },
 ];
 
-/// Two-sided 95 % band for the average of `runs` χ²(`dof`) values (Wilson–Hilferty, `akf`).
+/// Two-sided 95 % band for the average of `runs` χ²(`dof`) values (exact quantiles, `akf`).
 pub fn band(dof: usize, runs: u64) -> Option<(f64, f64)> {
     akf::average_band(dof, runs as usize, CONFIDENCE).ok()
 }
