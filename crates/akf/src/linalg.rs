@@ -1,5 +1,5 @@
-//! Small allocation-free dense kernels on fixed-size nalgebra types: checks, Cholesky with pivot
-//! reporting, triangular solves, and a cyclic Jacobi symmetric eigensolver.
+//! Small allocation-free dense kernels on fixed-size nalgebra types: checks, adapters over the
+//! workspace's one Cholesky factorisation (`spd-linalg`), and a cyclic Jacobi symmetric eigensolver.
 //!
 //! Why not `nalgebra::SymmetricEigen`: for a generic `const N: usize` it needs
 //! `Const<N>: DimSub<U1>` plus an allocator bound on `DimDiff<Const<N>, U1>`, which would leak into
@@ -8,6 +8,7 @@
 //! at concrete sizes.
 
 use nalgebra::{SMatrix, SVector};
+use spd_linalg::Cholesky;
 
 use crate::AkfError;
 
@@ -64,103 +65,39 @@ pub(crate) fn check_symmetric<const N: usize>(
     Ok(())
 }
 
-/// `(A + Aᵀ)/2` in place; the result is exactly symmetric (floating-point addition commutes).
-pub(crate) fn symmetrise_in_place<const N: usize>(m: &mut SMatrix<f64, N, N>) {
-    for col in 0..N {
-        for row in (col + 1)..N {
-            let v = 0.5 * (m[(row, col)] + m[(col, row)]);
-            m[(row, col)] = v;
-            m[(col, row)] = v;
+/// `(A + Aᵀ)/2` in place; the result is exactly symmetric (the workspace's one, `spd-linalg`).
+pub(crate) use spd_linalg::symmetrise as symmetrise_in_place;
+
+impl From<spd_linalg::NotPositiveDefinite> for AkfError {
+    fn from(e: spd_linalg::NotPositiveDefinite) -> Self {
+        AkfError::NotPositiveDefinite {
+            what: e.matrix,
+            pivot: e.pivot,
+            pivot_value: e.value,
         }
     }
 }
 
-/// Lower Cholesky factor `L` with `A = L Lᵀ`, reading only the lower triangle of `A`.
-///
-/// Fails at the first pivot whose Schur complement is not strictly positive (or not finite) and
-/// names it.
+/// Cholesky factor of `a` (lower triangle read) by the workspace's one factorisation
+/// (`spd-linalg`); the error names `what` and the first pivot that is not finite and > 0.
 pub(crate) fn cholesky_lower<const M: usize>(
     what: &'static str,
     a: &SMatrix<f64, M, M>,
-) -> Result<SMatrix<f64, M, M>, AkfError> {
-    let mut l = SMatrix::<f64, M, M>::zeros();
-    for j in 0..M {
-        let mut d = a[(j, j)];
-        for k in 0..j {
-            d -= l[(j, k)] * l[(j, k)];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return Err(AkfError::NotPositiveDefinite {
-                what,
-                pivot: j,
-                pivot_value: d,
-            });
-        }
-        let ljj = d.sqrt();
-        l[(j, j)] = ljj;
-        for i in (j + 1)..M {
-            let mut s = a[(i, j)];
-            for k in 0..j {
-                s -= l[(i, k)] * l[(j, k)];
-            }
-            l[(i, j)] = s / ljj;
-        }
-    }
-    Ok(l)
-}
-
-/// Solves `L y = b` (forward substitution) for lower-triangular `L`.
-pub(crate) fn solve_lower<const M: usize>(
-    l: &SMatrix<f64, M, M>,
-    b: &SVector<f64, M>,
-) -> SVector<f64, M> {
-    let mut y = *b;
-    for i in 0..M {
-        let mut s = y[i];
-        for k in 0..i {
-            s -= l[(i, k)] * y[k];
-        }
-        y[i] = s / l[(i, i)];
-    }
-    y
-}
-
-/// Solves `Lᵀ x = y` (back substitution) for lower-triangular `L`.
-pub(crate) fn solve_lower_transpose<const M: usize>(
-    l: &SMatrix<f64, M, M>,
-    y: &SVector<f64, M>,
-) -> SVector<f64, M> {
-    let mut x = *y;
-    for i in (0..M).rev() {
-        let mut s = x[i];
-        for k in (i + 1)..M {
-            s -= l[(k, i)] * x[k];
-        }
-        x[i] = s / l[(i, i)];
-    }
-    x
+) -> Result<Cholesky<M>, AkfError> {
+    Ok(Cholesky::new(a, what)?)
 }
 
 /// Solves `(L Lᵀ) X = B` column by column.
 pub(crate) fn cholesky_solve_matrix<const M: usize, const C: usize>(
-    l: &SMatrix<f64, M, M>,
+    l: &Cholesky<M>,
     b: &SMatrix<f64, M, C>,
 ) -> SMatrix<f64, M, C> {
-    let mut x = SMatrix::<f64, M, C>::zeros();
-    for c in 0..C {
-        let col: SVector<f64, M> = b.column(c).into_owned();
-        let y = solve_lower(l, &col);
-        x.set_column(c, &solve_lower_transpose(l, &y));
-    }
-    x
+    l.solve_matrix(b)
 }
 
 /// `vᵀ (L Lᵀ)⁻¹ v = ‖L⁻¹ v‖²`.
-pub(crate) fn mahalanobis_squared<const M: usize>(
-    l: &SMatrix<f64, M, M>,
-    v: &SVector<f64, M>,
-) -> f64 {
-    solve_lower(l, v).norm_squared()
+pub(crate) fn mahalanobis_squared<const M: usize>(l: &Cholesky<M>, v: &SVector<f64, M>) -> f64 {
+    l.mahalanobis_squared(v)
 }
 
 /// Eigen-decomposition of a symmetric matrix by cyclic Jacobi rotations.
@@ -277,9 +214,9 @@ mod tests {
             5.0, 1.0, 0.5, 0.2, 1.0, 4.0, 0.3, 0.1, 0.5, 0.3, 3.0, 0.4, 0.2, 0.1, 0.4, 2.0,
         );
         let l = cholesky_lower("a", &a).unwrap();
-        assert!((l * l.transpose() - a).norm() < 1e-14 * a.norm());
+        assert!((l.l() * l.l().transpose() - a).norm() < 1e-14 * a.norm());
         let b = Vector4::new(1.0, -2.0, 0.5, 3.0);
-        let x = solve_lower_transpose(&l, &solve_lower(&l, &b));
+        let x = l.solve(&b);
         assert!((a * x - b).norm() < 1e-13);
         let m = cholesky_solve_matrix(&l, &Matrix4::identity());
         assert!((a * m - Matrix4::identity()).norm() < 1e-13);

@@ -210,51 +210,18 @@ where
     })
 }
 
-/// Solve `m·b = rhs` for a symmetric positive-definite 3×3 `m` by Cholesky `m = L·Lᵀ`.
-#[allow(clippy::needless_range_loop)] // index form mirrors the textbook recurrences
+/// Solve `m·b = rhs` for a symmetric positive-definite 3×3 `m` by the workspace's Cholesky
+/// (`spd-linalg`) with the relative pivot test [`MIN_RELATIVE_PIVOT`].
 fn solve_spd3(m: &[[f64; 3]; 3], rhs: &[f64; 3]) -> Result<[f64; 3], HoughError> {
-    let mut l = [[0.0f64; 3]; 3];
-    for j in 0..3 {
-        let mut d = m[j][j];
-        for k in 0..j {
-            d -= l[j][k] * l[j][k];
-        }
-        let threshold = MIN_RELATIVE_PIVOT * m[j][j];
-        if d.is_nan() || d <= threshold {
-            return Err(HoughError::RankDeficient {
-                pivot: j,
-                term: TERM_NAMES[j],
-                value: d,
-                threshold,
-            });
-        }
-        let ljj = d.sqrt();
-        l[j][j] = ljj;
-        for i in (j + 1)..3 {
-            let mut v = m[i][j];
-            for k in 0..j {
-                v -= l[i][k] * l[j][k];
-            }
-            l[i][j] = v / ljj;
-        }
-    }
-    // Forward substitution L·z = rhs.
-    let mut z = [0.0f64; 3];
-    for i in 0..3 {
-        let mut v = rhs[i];
-        for k in 0..i {
-            v -= l[i][k] * z[k];
-        }
-        z[i] = v / l[i][i];
-    }
-    // Back substitution Lᵀ·b = z.
-    let mut b = [0.0f64; 3];
-    for i in (0..3).rev() {
-        let mut v = z[i];
-        for k in (i + 1)..3 {
-            v -= l[k][i] * b[k];
-        }
-        b[i] = v / l[i][i];
-    }
-    Ok(b)
+    let mat = nalgebra::Matrix3::from_fn(|i, j| m[i][j]);
+    let chol =
+        spd_linalg::Cholesky::with_relative_floor(&mat, "normal equations", MIN_RELATIVE_PIVOT)
+            .map_err(|e| HoughError::RankDeficient {
+                pivot: e.pivot,
+                term: TERM_NAMES[e.pivot.min(2)],
+                value: e.value,
+                threshold: e.floor,
+            })?;
+    let b = chol.solve(&nalgebra::Vector3::new(rhs[0], rhs[1], rhs[2]));
+    Ok([b[0], b[1], b[2]])
 }

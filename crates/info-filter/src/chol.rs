@@ -1,122 +1,18 @@
-//! Fixed-size Cholesky factorisation `A = L Lᵀ` that reports which pivot failed.
-//!
-//! nalgebra's `Cholesky::new` only says "not positive definite"; the filters need the pivot for
-//! their error messages, and a factorisation that never allocates. Only the lower triangle of `A`
-//! is read.
+//! Checks of user matrices, and the workspace's one Cholesky factorisation (`spd-linalg`, which
+//! names the failing pivot and never allocates) with its error mapped into [`KifError`].
 
 use nalgebra::{SMatrix, SVector};
 
 use crate::KifError;
 
-/// Lower-triangular Cholesky factor `L` of a symmetric positive definite `N×N` matrix.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Cholesky<const N: usize> {
-    l: SMatrix<f64, N, N>,
-}
+pub use spd_linalg::{Cholesky, symmetrise};
 
-impl<const N: usize> Cholesky<N> {
-    /// Factorises `a` (lower triangle read). `matrix` names it in the error.
-    ///
-    /// # Errors
-    /// [`KifError::NotPositiveDefinite`] with the first pivot that is not finite and `> 0`.
-    #[inline]
-    pub fn new(a: &SMatrix<f64, N, N>, matrix: &'static str) -> Result<Self, KifError> {
-        let mut l = SMatrix::<f64, N, N>::zeros();
-        for j in 0..N {
-            let mut d = a[(j, j)];
-            for k in 0..j {
-                d -= l[(j, k)] * l[(j, k)];
-            }
-            // `!(d > 0)` also rejects NaN.
-            if !(d.is_finite() && d > 0.0) {
-                return Err(KifError::NotPositiveDefinite {
-                    matrix,
-                    pivot: j,
-                    value: d,
-                });
-            }
-            let ljj = d.sqrt();
-            l[(j, j)] = ljj;
-            let inv = 1.0 / ljj;
-            for i in (j + 1)..N {
-                let mut s = a[(i, j)];
-                for k in 0..j {
-                    s -= l[(i, k)] * l[(j, k)];
-                }
-                l[(i, j)] = s * inv;
-            }
-        }
-        Ok(Self { l })
-    }
-
-    /// The factor `L` (lower triangular, positive diagonal).
-    #[inline]
-    pub fn l(&self) -> &SMatrix<f64, N, N> {
-        &self.l
-    }
-
-    /// Solves `L z = b` (forward substitution).
-    #[inline]
-    pub fn solve_lower(&self, b: &SVector<f64, N>) -> SVector<f64, N> {
-        let mut z = *b;
-        for i in 0..N {
-            let mut s = z[i];
-            for k in 0..i {
-                s -= self.l[(i, k)] * z[k];
-            }
-            z[i] = s / self.l[(i, i)];
-        }
-        z
-    }
-
-    /// Solves `A x = b`.
-    #[inline]
-    pub fn solve(&self, b: &SVector<f64, N>) -> SVector<f64, N> {
-        let mut x = self.solve_lower(b);
-        for i in (0..N).rev() {
-            let mut s = x[i];
-            for k in (i + 1)..N {
-                s -= self.l[(k, i)] * x[k];
-            }
-            x[i] = s / self.l[(i, i)];
-        }
-        x
-    }
-
-    /// Solves `A X = B` column by column.
-    #[inline]
-    pub fn solve_matrix<const C: usize>(&self, b: &SMatrix<f64, N, C>) -> SMatrix<f64, N, C> {
-        let mut x = SMatrix::<f64, N, C>::zeros();
-        for c in 0..C {
-            let col = self.solve(&b.column(c).into_owned());
-            x.set_column(c, &col);
-        }
-        x
-    }
-
-    /// `A⁻¹`, exactly symmetric (the upper triangle is mirrored from the lower).
-    #[inline]
-    pub fn inverse(&self) -> SMatrix<f64, N, N> {
-        let mut inv = self.solve_matrix(&SMatrix::<f64, N, N>::identity());
-        symmetrise(&mut inv);
-        inv
-    }
-
-    /// `log det A = 2 Σ log L_ii`.
-    #[inline]
-    pub fn log_det(&self) -> f64 {
-        2.0 * (0..N).map(|i| self.l[(i, i)].ln()).sum::<f64>()
-    }
-}
-
-/// Replaces `a` by `(a + aᵀ)/2`.
-#[inline]
-pub fn symmetrise<const N: usize>(a: &mut SMatrix<f64, N, N>) {
-    for i in 0..N {
-        for j in (i + 1)..N {
-            let m = 0.5 * (a[(i, j)] + a[(j, i)]);
-            a[(i, j)] = m;
-            a[(j, i)] = m;
+impl From<spd_linalg::NotPositiveDefinite> for KifError {
+    fn from(e: spd_linalg::NotPositiveDefinite) -> Self {
+        KifError::NotPositiveDefinite {
+            matrix: e.matrix,
+            pivot: e.pivot,
+            value: e.value,
         }
     }
 }

@@ -1,6 +1,8 @@
 //! Fast WRLS: information form driven by power sums.
 
-use info_filter::{Cholesky, PixelPoint, PowerSums, RowNorm, ThetaCov, symmetrise, validate_spd};
+use info_filter::{
+    Cholesky, KifError, PixelPoint, PowerSums, RowNorm, ThetaCov, symmetrise, validate_spd,
+};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::WrlsError;
@@ -72,7 +74,7 @@ impl WrlsFast {
         let mut info = self.info * self.lambda + sums.normal_matrix();
         symmetrise(&mut info);
         let info_vec = self.info_vec * self.lambda + sums.normal_vector();
-        let chol = Cholesky::new(&info, "Y")?;
+        let chol = Cholesky::new(&info, "Y").map_err(KifError::from)?;
         self.theta = chol.solve(&info_vec);
         self.info = info;
         self.info_vec = info_vec;
@@ -95,7 +97,9 @@ impl WrlsFast {
     /// # Errors
     /// `Y` failing Cholesky (cannot happen after a successful update).
     pub fn covariance_normalised(&self) -> Result<Matrix3<f64>, WrlsError> {
-        Ok(Cholesky::new(&self.info, "Y")?.inverse())
+        Ok(Cholesky::new(&self.info, "Y")
+            .map_err(KifError::from)?
+            .inverse())
     }
 
     /// `P_px = T P_u Tᵀ`.

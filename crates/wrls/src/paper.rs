@@ -194,7 +194,7 @@ impl WrlsPaper {
         let i_kf = Matrix3::identity() - k_phi_t;
         let mut p_new = i_kf * p * i_kf.transpose() / lambda + k_k_t;
         symmetrise(&mut p_new);
-        Cholesky::new(&p_new, "P")?;
+        Cholesky::new(&p_new, "P").map_err(KifError::from)?;
         self.p = p_new;
         self.theta = theta;
         Ok(())
