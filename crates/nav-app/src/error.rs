@@ -177,15 +177,13 @@ pub enum NavError {
         /// The device path.
         device: String,
     },
-    /// A configuration file is not valid TOML or does not match the schema.
-    #[error("{path}: cannot parse configuration: {message}")]
-    ConfigParse {
-        /// Configuration file (or preset name).
-        path: String,
-        /// What the parser said (it names the line and the key).
-        message: String,
-    },
-    /// A configuration field holds a value outside its valid range.
+    /// A configuration file is not valid TOML, does not match the schema (unknown, missing or
+    /// mistyped key), or holds a field out of range: the error names the file, the line and the
+    /// column of the offending key or value (see the `toml-config` crate).
+    #[error("{0}")]
+    ConfigFile(toml_config::TomlError),
+    /// A configuration field holds a value outside its valid range (a configuration built in code,
+    /// or a capture option; from a file it is a [`NavError::ConfigFile`] naming the file and line).
     #[error("configuration field `{field}` = {value}: {reason}")]
     ConfigField {
         /// Dotted field name, e.g. `track.window_half_width_px`.

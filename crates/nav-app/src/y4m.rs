@@ -938,7 +938,11 @@ mod tests {
             matches!(err, NavError::ShortFrame { got: 1000, .. }),
             "{err}"
         );
-        assert!(frame.data.capacity() <= 1 << 21, "{}", frame.data.capacity());
+        assert!(
+            frame.data.capacity() <= 1 << 21,
+            "{}",
+            frame.data.capacity()
+        );
         assert_eq!((frame.width, frame.height, frame.data.len()), (0, 0, 0));
     }
 

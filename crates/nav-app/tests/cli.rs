@@ -223,7 +223,7 @@ fn a_short_last_frame_is_reported_skipped_and_counted_as_lost_exit_5() {
 }
 
 #[test]
-fn a_bad_config_exits_non_zero_naming_the_field() {
+fn a_bad_config_exits_1_naming_the_file_line_column_and_field_once() {
     let dir = scratch("config");
     let text = std::fs::read_to_string(format!(
         "{}/../../configs/outdoor.toml",
@@ -232,10 +232,31 @@ fn a_bad_config_exits_non_zero_naming_the_field() {
     .unwrap()
     .replace("r_sigma_px = 2.0", "r_sigma_px = -2.0");
     let path = dir.join("bad.toml");
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, &text).unwrap();
+    let line = 1 + text[..text.find("r_sigma_px = -2.0").unwrap()]
+        .matches('\n')
+        .count();
     let o = nav_app(&["--config", path.to_str().unwrap(), "--max-frames", "1"]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("filter.r_sigma_px"), "{}", stderr(&o));
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("filter.r_sigma_px"), "{e}");
+    let at = format!("{}:{line}:1: ", path.display());
+    assert!(e.contains(&at), "{e} lacks {at}");
+    assert_eq!(e.matches(path.to_str().unwrap()).count(), 1, "{e}");
+
+    // A misspelt key: located at the key, named once.
+    let text = text
+        .replace("r_sigma_px = -2.0", "r_sigma_px = 2.0")
+        .replace("wrls_lambda", "wrls_lamda");
+    let line = 1 + text[..text.find("wrls_lamda").unwrap()]
+        .matches('\n')
+        .count();
+    std::fs::write(&path, &text).unwrap();
+    let o = nav_app(&["--config", path.to_str().unwrap(), "--max-frames", "1"]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    let at = format!("{}:{line}:1: unknown field `wrls_lamda`", path.display());
+    assert!(e.contains(&at), "{e} lacks {at}");
 }
 
 #[test]
@@ -250,7 +271,10 @@ fn loop_repeats_a_file_up_to_max_frames() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let (frames, summary) = json_output(&o);
-    let frames: Vec<u64> = frames.iter().map(|v| v["frame"].as_u64().unwrap()).collect();
+    let frames: Vec<u64> = frames
+        .iter()
+        .map(|v| v["frame"].as_u64().unwrap())
+        .collect();
     assert_eq!(frames, (0..60).collect::<Vec<_>>());
     assert_eq!(summary["exit"], "max-frames");
 }
@@ -328,7 +352,10 @@ fn a_damaged_frame_header_loses_one_frame_and_the_stream_plays_to_its_end() {
     for (o, input) in [(&from_file, path.to_str().unwrap()), (&from_pipe, "stdin")] {
         assert_eq!(o.status.code(), Some(5), "{input}: {}", stderr(o));
         let (frames, summary) = json_output(o);
-        let indices: Vec<u64> = frames.iter().map(|v| v["frame"].as_u64().unwrap()).collect();
+        let indices: Vec<u64> = frames
+            .iter()
+            .map(|v| v["frame"].as_u64().unwrap())
+            .collect();
         let want: Vec<u64> = (0..24u64)
             .filter(|i| !damaged.contains(&(*i as usize)))
             .collect();
@@ -373,7 +400,10 @@ fn help_documents_the_exit_codes_and_the_summary() {
         "\"lost_frames\"",
         "\"skipped_bytes\"",
     ] {
-        assert!(help.contains(needle), "{needle} missing from --help:\n{help}");
+        assert!(
+            help.contains(needle),
+            "{needle} missing from --help:\n{help}"
+        );
     }
 }
 
