@@ -251,7 +251,7 @@ proptest! {
             prop_assert_eq!(*index, i as u64);
             prop_assert_eq!(data, &frames[i]);
         }
-        let partial = (at - header_len) % record != 0;
+        let partial = !(at - header_len).is_multiple_of(record);
         prop_assert_eq!(d.errors.len(), usize::from(partial), "{:?}", d.errors);
         prop_assert!(d.errors.iter().all(|e| !e.is_fatal() && e.lost_frames() == 1));
     }
