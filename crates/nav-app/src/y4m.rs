@@ -9,6 +9,11 @@
 //! A stream that repeats a `YUV4MPEG2` header where a `FRAME` is expected (two files
 //! concatenated) is accepted when the size is the same and rejected with
 //! [`NavError::SizeChanged`] otherwise.
+//!
+//! A stream damaged where a `FRAME` header is expected (a flipped byte, a frame cut short, junk)
+//! is resynchronised at the next `FRAME` marker: the frames lost are reported once as a
+//! non-fatal [`NavError::Y4mResync`] and totalled in [`Y4mSource::losses`]; see [`Y4mSource`]
+//! for how they are counted.
 
 use std::io::{self, BufRead, Read, Write};
 
