@@ -134,7 +134,8 @@ def main():
     ours = []
     for _ in range(3):
         out = subprocess.run([exe, "--input", clip, "--json"], check=True, capture_output=True, text=True).stdout
-        ours += [json.loads(line)["track_us"] for line in out.splitlines()]
+        rows = [json.loads(line) for line in out.splitlines()]
+        ours += [r["track_us"] for r in rows if "track_us" in r]  # the last line is the summary
     ours_us = statistics.median(ours)
     print(f"clip: {clip} ({len(frames)} frames, {w}x{h})")
     print(f"opencv {cv2.__version__} classic pipeline (1 thread): median {peer_us:8.1f} us/frame")

@@ -105,12 +105,16 @@ impl PixelFormat {
     }
 
     /// Bytes of source the conversion of a `width`×`height` frame with rows `stride_bytes` apart
-    /// reads: `stride·(height−1) + width·bytes_per_pixel` (for `YU12`, the Y plane only).
+    /// reads: `stride·(height−1) + width·bytes_per_pixel` (for `YU12`, the Y plane only),
+    /// saturating at `usize::MAX` (no buffer is that long, so an absurd stride is refused as
+    /// [`CaptureError::SourceTooShort`] instead of overflowing).
     pub const fn bytes_needed(self, width: usize, height: usize, stride_bytes: usize) -> usize {
         if width == 0 || height == 0 {
             return 0;
         }
-        stride_bytes * (height - 1) + width * self.bytes_per_pixel()
+        stride_bytes
+            .saturating_mul(height - 1)
+            .saturating_add(width.saturating_mul(self.bytes_per_pixel()))
     }
 }
 
@@ -155,7 +159,7 @@ pub fn to_grey(
     dst_grey: &mut [u8],
 ) -> Result<(), CaptureError> {
     let (w, h) = (width as usize, height as usize);
-    let expected = w * h;
+    let expected = w.saturating_mul(h);
     if dst_grey.len() != expected {
         return Err(CaptureError::OutputSize {
             expected,
@@ -167,7 +171,7 @@ pub fn to_grey(
     if expected == 0 {
         return Ok(());
     }
-    let row_bytes = w * format.bytes_per_pixel();
+    let row_bytes = w.saturating_mul(format.bytes_per_pixel());
     if stride_bytes < row_bytes {
         return Err(CaptureError::StrideTooSmall {
             format,

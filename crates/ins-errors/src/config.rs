@@ -253,24 +253,21 @@ impl Default for ImuConfig {
 }
 
 /// Parses section `section` (e.g. `"imu"`) of a TOML document into `T` and returns it
-/// unvalidated. Unknown keys are rejected (`deny_unknown_fields`) with the key named.
+/// unvalidated, through the workspace's one TOML loader (crate `toml-config`). Unknown keys are
+/// rejected (`deny_unknown_fields`) with the key named; the message gives the line and column
+/// (`line 12, column 1: unknown field …`).
 pub fn parse_section<T: DeserializeOwned>(toml_text: &str, section: &str) -> Result<T, InsError> {
-    let table: toml::Table = toml_text
-        .parse()
-        .map_err(|e: toml::de::Error| InsError::Toml {
-            section: section.to_string(),
-            message: e.to_string(),
-        })?;
-    let value = table.get(section).cloned().ok_or_else(|| InsError::Toml {
+    let toml_err = |e: toml_config::TomlError| InsError::Toml {
         section: section.to_string(),
-        message: "section missing".to_string(),
-    })?;
-    value
-        .try_into()
-        .map_err(|e: toml::de::Error| InsError::Toml {
-            section: section.to_string(),
-            message: e.to_string(),
-        })
+        message: match (e.line, e.column) {
+            (Some(l), Some(c)) => format!("line {l}, column {c}: {}", e.message),
+            _ => e.message,
+        },
+    };
+    toml_config::TomlDoc::parse("TOML text", toml_text)
+        .map_err(toml_err)?
+        .section(section)
+        .map_err(toml_err)
 }
 
 fn finite(prefix: &str, name: &str, v: f64) -> Result<(), InsError> {
@@ -399,7 +396,7 @@ mod tests {
         let e = parse_section::<ImuConfig>(text, "imu").unwrap_err();
         assert!(e.to_string().contains("gyro_noise_psd"), "{e}");
         let e = parse_section::<ImuConfig>("[trajectory]\n", "imu").unwrap_err();
-        assert!(e.to_string().contains("section missing"), "{e}");
+        assert!(e.to_string().contains("section [imu] missing"), "{e}");
     }
 
     #[test]

@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+use toml_config::TomlDoc;
 
 use crate::NavError;
 
@@ -161,13 +162,22 @@ impl TrackerConfig {
         Self::from_toml_str("preset indoor", INDOOR_TOML)
     }
 
-    /// Parse and validate TOML text; `name` is used in errors.
+    /// Parse and validate TOML text; `name` (the file path) is used in errors. Every error is a
+    /// [`NavError::ConfigFile`] naming `name`, the line and the column: syntax, unknown, missing
+    /// or mistyped keys, and fields out of range (located at their key).
     pub fn from_toml_str(name: &str, text: &str) -> Result<Self, NavError> {
-        let cfg: TrackerConfig = toml::from_str(text).map_err(|e| NavError::ConfigParse {
-            path: name.to_owned(),
-            message: e.to_string(),
+        let doc = TomlDoc::parse(name, text).map_err(NavError::ConfigFile)?;
+        let cfg: TrackerConfig = doc.deserialize().map_err(NavError::ConfigFile)?;
+        cfg.validate().map_err(|e| match e {
+            NavError::ConfigField {
+                field,
+                value,
+                reason,
+            } => {
+                NavError::ConfigFile(doc.error_at(field, format!("`{field}` = {value}: {reason}")))
+            }
+            other => other,
         })?;
-        cfg.validate()?;
         Ok(cfg)
     }
 
@@ -371,9 +381,20 @@ mod tests {
         let text = OUTDOOR_TOML.replace("[track]", "[track]\nwindow_width = 3");
         let err = TrackerConfig::from_toml_str("x.toml", &text).unwrap_err();
         let msg = err.to_string();
-        assert!(matches!(err, NavError::ConfigParse { .. }));
+        let line = 1 + text[..text.find("window_width").unwrap()]
+            .matches('\n')
+            .count();
+        match &err {
+            NavError::ConfigFile(e) => {
+                assert_eq!(
+                    (e.path.as_str(), e.line, e.column),
+                    ("x.toml", Some(line), Some(1))
+                );
+            }
+            other => panic!("{other:?}"),
+        }
         assert!(
-            msg.contains("window_width") && msg.contains("x.toml"),
+            msg.starts_with(&format!("x.toml:{line}:1: unknown field `window_width`")),
             "{msg}"
         );
     }
@@ -389,6 +410,21 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(msg.contains("r_sigma_px"), "{msg}");
+    }
+
+    #[test]
+    fn an_out_of_range_field_in_a_file_names_the_file_line_and_column() {
+        let text = OUTDOOR_TOML.replace("r_sigma_px = 2.0", "r_sigma_px = -2.0");
+        let line = 1 + text[..text.find("r_sigma_px = -2.0").unwrap()]
+            .matches('\n')
+            .count();
+        let msg = TrackerConfig::from_toml_str("cfg/bad.toml", &text)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            msg,
+            format!("cfg/bad.toml:{line}:1: `filter.r_sigma_px` = -2: must be finite and > 0 px")
+        );
     }
 
     #[test]

@@ -77,15 +77,26 @@ pub enum NavError {
         /// The `C` tag as found.
         chroma: String,
     },
-    /// A YUV4MPEG2 frame does not start with a `FRAME` header: the stream is corrupt from here on.
-    #[error("{name}: frame {frame}: expected a `FRAME` header, found {found:?}")]
-    Y4mFrameHeader {
+    /// A YUV4MPEG2 stream was damaged where a `FRAME` header was expected: the reader skipped
+    /// `skipped_bytes` bytes to the next `FRAME` marker (or to the end of the stream), losing
+    /// `lost_frames` frames (see [`crate::y4m::Y4mSource`] for how they are counted). Not fatal:
+    /// reported, counted, and the next `next_frame` delivers the frame after the marker.
+    #[error(
+        "{name}: frame {frame}: damaged stream, skipped {skipped_bytes} bytes ({lost_frames} \
+         frames lost) to {}",
+        if *end_of_stream { "the end of the stream" } else { "the next `FRAME` marker" }
+    )]
+    Y4mResync {
         /// File or `stdin`.
         name: String,
-        /// Zero-based index of the frame.
+        /// Zero-based index of the first frame lost.
         frame: u64,
-        /// The bytes found instead (at most 16, lossily decoded).
-        found: String,
+        /// Frames lost (not delivered).
+        lost_frames: u64,
+        /// Bytes skipped before the marker.
+        skipped_bytes: u64,
+        /// The scan reached the end of the stream instead of a marker.
+        end_of_stream: bool,
     },
     /// The stream changed frame size in the middle (a second YUV4MPEG2 header with another size).
     #[error(
@@ -106,7 +117,7 @@ pub enum NavError {
         to_h: usize,
     },
     /// The last frame of a stream is shorter than the header says (not fatal: reported, counted and
-    /// the stream ends there).
+    /// the stream ends there; one frame lost).
     #[error("{name}: frame {frame}: short frame, {got} of {expected} bytes before end of stream")]
     ShortFrame {
         /// File or `stdin`.
@@ -175,15 +186,13 @@ pub enum NavError {
         /// The device path.
         device: String,
     },
-    /// A configuration file is not valid TOML or does not match the schema.
-    #[error("{path}: cannot parse configuration: {message}")]
-    ConfigParse {
-        /// Configuration file (or preset name).
-        path: String,
-        /// What the parser said (it names the line and the key).
-        message: String,
-    },
-    /// A configuration field holds a value outside its valid range.
+    /// A configuration file is not valid TOML, does not match the schema (unknown, missing or
+    /// mistyped key), or holds a field out of range: the error names the file, the line and the
+    /// column of the offending key or value (see the `toml-config` crate).
+    #[error("{0}")]
+    ConfigFile(toml_config::TomlError),
+    /// A configuration field holds a value outside its valid range (a configuration built in code,
+    /// or a capture option; from a file it is a [`NavError::ConfigFile`] naming the file and line).
     #[error("configuration field `{field}` = {value}: {reason}")]
     ConfigField {
         /// Dotted field name, e.g. `track.window_half_width_px`.
@@ -224,17 +233,40 @@ pub enum NavError {
 }
 
 impl NavError {
-    /// `false` for errors that concern a single frame of a stream ([`NavError::BadFrame`],
-    /// [`NavError::ShortFrame`]) and for a capture timeout that is not yet the `limit`-th in a row
+    /// `false` for errors that concern frames of a stream ([`NavError::BadFrame`],
+    /// [`NavError::ShortFrame`], [`NavError::Y4mResync`]) and for a capture timeout that is not yet the `limit`-th in a row
     /// ([`NavError::CaptureTimeout`]): the caller reports and counts it and asks for the next frame.
     /// `true` for everything else: the run cannot go on.
     pub fn is_fatal(&self) -> bool {
         match self {
-            NavError::BadFrame { .. } | NavError::ShortFrame { .. } => false,
+            NavError::BadFrame { .. }
+            | NavError::ShortFrame { .. }
+            | NavError::Y4mResync { .. } => false,
             NavError::CaptureTimeout {
                 consecutive, limit, ..
             } => consecutive >= limit,
             _ => true,
+        }
+    }
+
+    /// Frames of the input this error stands for, lost (not delivered): 1 for
+    /// [`NavError::BadFrame`] and [`NavError::ShortFrame`], `lost_frames` for
+    /// [`NavError::Y4mResync`], 0 for everything else.
+    pub fn lost_frames(&self) -> u64 {
+        match self {
+            NavError::BadFrame { .. } | NavError::ShortFrame { .. } => 1,
+            NavError::Y4mResync { lost_frames, .. } => *lost_frames,
+            _ => 0,
+        }
+    }
+
+    /// Bytes of a stream this error skipped: `skipped_bytes` of [`NavError::Y4mResync`], the
+    /// bytes present of a [`NavError::ShortFrame`]; 0 for everything else.
+    pub fn skipped_bytes(&self) -> u64 {
+        match self {
+            NavError::Y4mResync { skipped_bytes, .. } => *skipped_bytes,
+            NavError::ShortFrame { got, .. } => *got as u64,
+            _ => 0,
         }
     }
 

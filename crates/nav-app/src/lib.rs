@@ -55,7 +55,9 @@
 //! ([`capture_source`]: `CaptureSource` over the `bt848-capture` crate, feature `capture`,
 //! default on; without it `--device` says capture is not in the build).
 //! Errors are [`NavError`]; [`NavError::is_fatal`] separates a fatal error from one bad frame
-//! (or one capture timeout) that is reported, counted and skipped.
+//! (or one capture timeout) that is reported, counted and skipped, and
+//! [`NavError::lost_frames`] says how many input frames a non-fatal error stands for (a damaged
+//! YUV4MPEG2 stream is resynchronised at the next `FRAME` marker: [`NavError::Y4mResync`]).
 //!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field

@@ -19,8 +19,8 @@
 //! "signal_lost", "mean_grey"}`, and the last line is always (also after an error)
 //! `{"summary": {"device": {…}|null, "frames", "errored_dropped", "sequence_gaps", "timeouts",
 //! "restarts", "signal_lost_frames", "controls_set", "elapsed_s", "fps", "tracked_frames",
-//! "exit", "exit_code", "error"}}` with `exit` one of `max-frames`, `end`, `device-gone`,
-//! `timeout`, `error`.
+//! "lost_frames", "skipped_bytes", "exit", "exit_code", "error"}}` with `exit` one of
+//! `max-frames`, `end`, `device-gone`, `timeout`, `error`.
 //!
 //! A frame timeout (no frame within the timeout, 1000 ms) restarts the stream and is reported;
 //! the `--max-timeouts`-th in a row (default 3) ends the run. Built without the `capture` feature,
@@ -31,9 +31,20 @@
 //! frames have been delivered; repeatable), `--ctrl-on-timeout NAME=VALUE` (set at the first
 //! timeout; repeatable).
 //!
+//! ## Damaged input and the summary
+//! A frame that cannot be used — an image of a directory that does not decode, a YUV4MPEG2 stream
+//! damaged where a `FRAME` header should be (the reader skips to the next `FRAME` marker, see
+//! `nav_app::y4m::Y4mSource`), a short last frame — is reported on stderr, counted and skipped;
+//! the run goes on. The last stderr line says `N frames tracked, L frames lost (B bytes
+//! skipped)`. With `--json` the last stdout line is always (every input, also after an error)
+//! `{"summary": {"input": …, "tracked_frames", "lost_frames", "skipped_bytes", "exit",
+//! "exit_code", "error"}}` (with `--device`: `"device"` and the capture counters in place of
+//! `"input"`, as above).
+//!
 //! ## Exit codes
 //! 0 success; 1 error (bad input, configuration, capture setup or streaming error); 2 bad
-//! command line; 3 capture device gone (`ENODEV`); 4 `--max-timeouts` frame timeouts in a row.
+//! command line; 3 capture device gone (`ENODEV`); 4 `--max-timeouts` frame timeouts in a row;
+//! 5 the run finished but frames of the input were lost (`lost_frames > 0`).
 
 use std::io::{BufWriter, Cursor, Write};
 use std::path::PathBuf;
@@ -59,6 +70,22 @@ use serde::Serialize;
 const SAMPLE_Y4M: &[u8] = include_bytes!("../../../fixtures/udacity/solidWhiteRight-first30.y4m");
 const SAMPLE_NAME: &str = "bundled sample (udacity solidWhiteRight, 30 frames, MIT)";
 
+/// Shown at the end of `--help`.
+const AFTER_HELP: &str = "\
+Damaged input: an undecodable image of a directory, a YUV4MPEG2 stream damaged where a FRAME
+header should be (the reader skips to the next FRAME marker) or a short last frame is reported,
+counted and skipped. The last stderr line says how many frames were tracked and lost and how many
+bytes were skipped; with --json the last stdout line is a {\"summary\": {...}} object with
+\"tracked_frames\", \"lost_frames\", \"skipped_bytes\", \"exit\", \"exit_code\" and \"error\".
+
+Exit codes:
+  0  success
+  1  error (bad input, configuration, capture setup or streaming error)
+  2  bad command line
+  3  capture device gone (ENODEV)
+  4  --max-timeouts frame timeouts in a row
+  5  finished, but frames of the input were lost (lost_frames > 0)";
+
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum EstimatorArg {
     /// Kalman information filter (paper eqs. 6–12, 24).
@@ -71,7 +98,8 @@ enum EstimatorArg {
 #[command(
     name = "nav-app",
     version,
-    about = "Lane-mark tracker (Pimentel & Hemerly): gradient → Hough+LS → KIF"
+    about = "Lane-mark tracker (Pimentel & Hemerly): gradient → Hough+LS → KIF",
+    after_help = AFTER_HELP
 )]
 struct Args {
     /// Image (PNG/JPEG/PGM), directory of images, .y4m file, or `-` for a YUV4MPEG2 stream on stdin.
@@ -196,7 +224,7 @@ struct FrameJson<'a> {
     capture: Option<DeviceFrameInfo>,
 }
 
-/// The last line of a `--device --json` run.
+/// The last line of a `--json` run.
 #[derive(Serialize)]
 struct SummaryJson<'a> {
     summary: SummaryBody<'a>,
@@ -204,14 +232,36 @@ struct SummaryJson<'a> {
 
 #[derive(Serialize)]
 struct SummaryBody<'a> {
-    device: Option<DeviceSetup>,
+    /// The `--input` (file, directory, `stdin` or the bundled sample); absent with `--device`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    input: Option<String>,
+    /// With `--device`: the device setup (`null` when it could not be opened).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    device: Option<Option<DeviceSetup>>,
+    /// With `--device`: the capture counters.
     #[serde(flatten)]
-    stats: DeviceStats,
+    stats: Option<DeviceStats>,
     tracked_frames: u64,
+    lost_frames: u64,
+    skipped_bytes: u64,
     exit: &'a str,
     exit_code: u8,
     error: Option<String>,
 }
+
+/// What a run did, filled as it goes (also when it fails).
+#[derive(Debug, Default)]
+struct RunStats {
+    /// Frames tracked.
+    frames: u64,
+    /// Frames of the input lost to damage (not delivered): see `NavError::lost_frames`.
+    lost_frames: u64,
+    /// Bytes of a stream skipped while resynchronising (and of short last frames).
+    skipped_bytes: u64,
+}
+
+/// Exit code of a run that finished but lost frames of its input to damage.
+const EXIT_FRAMES_LOST: u8 = 5;
 
 fn open_source(args: &Args) -> Result<Box<dyn FrameSource>> {
     match &args.input {
@@ -232,9 +282,9 @@ fn lane_text(r: &LaneReport) -> String {
     }
 }
 
-/// Run the tracker; returns the number of frames tracked. With `--device` the capture monitor is
-/// left in `monitor` (also when the run fails) for the summary.
-fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
+/// Run the tracker, counting frames in `stats`. With `--device` the capture monitor is left in
+/// `monitor` (also when the run fails) for the summary.
+fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) -> Result<()> {
     let cfg = TrackerConfig::load(&args.config)?;
     let estimator = match args.estimator {
         EstimatorArg::Kif => Estimator::Kif,
@@ -269,17 +319,17 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
     let mut tracker: Option<LaneTracker> = None;
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
-    let (mut frames, mut bad_frames, mut loop_base) = (0u64, 0u64, 0u64);
+    let mut loop_base = 0u64;
     let mut last_index = 0u64;
     let mut track_time = Duration::ZERO;
     let started = Instant::now();
     let mut last_states = [LaneState::Initialising; 2];
-    while args.max_frames.is_none_or(|m| frames < m) {
+    while args.max_frames.is_none_or(|m| stats.frames < m) {
         let meta = match source.next_frame(&mut frame) {
             Ok(Some(m)) => m,
             Ok(None) => {
                 if args.repeat
-                    && frames > 0
+                    && stats.frames > 0
                     && args.input.as_ref().is_some_and(|p| p.as_os_str() != "-")
                 {
                     loop_base += last_index + 1;
@@ -289,9 +339,8 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
                 break;
             }
             Err(e) if !e.is_fatal() => {
-                if !matches!(e, NavError::CaptureTimeout { .. }) {
-                    bad_frames += 1;
-                }
+                stats.lost_frames += e.lost_frames();
+                stats.skipped_bytes += e.skipped_bytes();
                 eprintln!("nav-app: warning: {e}");
                 continue;
             }
@@ -322,7 +371,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
         let report = t.track(&frame)?;
         let dt = t0.elapsed();
         track_time += dt;
-        frames += 1;
+        stats.frames += 1;
         let index = loop_base + meta.index;
         let capture = monitor.as_ref().and_then(CaptureMonitor::last_frame);
         if let Some(c) = capture
@@ -354,8 +403,8 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
             sink.write(index, &rgb, frame.width, frame.height)?;
         }
         let states = [report.lanes[0].state, report.lanes[1].state];
-        if !quiet && (states != last_states || frames % 100 == 1) {
-            let fps = frames as f64 / track_time.as_secs_f64().max(1e-9);
+        if !quiet && (states != last_states || stats.frames % 100 == 1) {
+            let fps = stats.frames as f64 / track_time.as_secs_f64().max(1e-9);
             eprintln!(
                 "frame {index:6}  t={:7.2}s  left: {:22}  right: {:22}  tracker {fps:8.0} frames/s",
                 meta.t_s,
@@ -369,12 +418,13 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
     if let Some(sink) = overlay {
         sink.finish()?;
     }
+    let (frames, lost, skipped) = (stats.frames, stats.lost_frames, stats.skipped_bytes);
     if !quiet {
         let wall = started.elapsed().as_secs_f64();
         let per_frame_us = 1e6 * track_time.as_secs_f64() / frames.max(1) as f64;
         eprintln!(
-            "nav-app: {frames} frames ({bad_frames} bad, skipped) in {wall:.2} s; tracking {per_frame_us:.1} µs/frame \
-             ({:.0} frames/s)",
+            "nav-app: {frames} frames tracked, {lost} frames lost ({skipped} bytes skipped) in \
+             {wall:.2} s; tracking {per_frame_us:.1} µs/frame ({:.0} frames/s)",
             1e6 / per_frame_us.max(1e-9)
         );
         if let Some(t) = &tracker {
@@ -384,13 +434,30 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
                 c.initialisations[0], c.initialisations[1], c.gated_jumps, c.gated_crossings
             );
         }
-    } else if bad_frames > 0 {
-        eprintln!("nav-app: {bad_frames} bad frames skipped");
+    } else if lost > 0 {
+        eprintln!("nav-app: {lost} frames lost ({skipped} bytes skipped)");
     }
     if frames == 0 {
         bail!("no frame could be read");
     }
-    Ok(frames)
+    Ok(())
+}
+
+/// The chain of an error as one line, each message once: a cause whose text its parent already
+/// shows (a `NavError::Io` renders its OS error and also returns it as its source) is left out.
+fn error_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
 }
 
 /// The documented exit code and `exit` name of a failed run.
@@ -405,54 +472,71 @@ fn failure_kind(e: &anyhow::Error) -> (u8, &'static str) {
 fn main() -> ExitCode {
     let args = Args::parse();
     let mut monitor = None;
-    let result = run(&args, &mut monitor);
+    let mut run_stats = RunStats::default();
+    let result = run(&args, &mut monitor, &mut run_stats);
+    let lost = run_stats.lost_frames > 0;
+    let ok_code = if lost { EXIT_FRAMES_LOST } else { 0 };
     let (code, exit, error) = match &result {
-        Ok(frames) if args.max_frames.is_some_and(|m| *frames >= m) => (0, "max-frames", None),
-        Ok(_) => (0, "end", None),
+        Ok(()) if args.max_frames.is_some_and(|m| run_stats.frames >= m) => {
+            (ok_code, "max-frames", None)
+        }
+        Ok(()) => (ok_code, "end", None),
         Err(e) => {
             let (code, exit) = failure_kind(e);
-            (code, exit, Some(format!("{e:#}")))
+            (code, exit, Some(error_line(e)))
         }
     };
     if let Some(e) = &error {
         eprintln!("nav-app: error: {e}");
     }
-    if let Some(dev) = &args.device {
-        let stats = monitor
+    let stats = args.device.as_ref().map(|_| {
+        monitor
             .as_ref()
             .map(CaptureMonitor::stats)
-            .unwrap_or_default();
-        if args.json {
-            let summary = SummaryJson {
-                summary: SummaryBody {
-                    device: monitor.as_ref().and_then(CaptureMonitor::setup),
-                    stats,
-                    tracked_frames: *result.as_ref().unwrap_or(&0),
-                    exit,
-                    exit_code: code,
-                    error,
-                },
-            };
-            match serde_json::to_string(&summary) {
-                Ok(line) => println!("{line}"),
-                Err(e) => eprintln!("nav-app: error: cannot write the JSON summary: {e}"),
-            }
-        } else if monitor.is_some() {
-            eprintln!(
-                "nav-app: device {}: {} frames in {:.2} s ({:.1} frames/s); dropped: {} errored \
-                 buffers, {} frames (sequence gaps); {} timeouts ({} restarts); {} frames without \
-                 signal",
-                dev.display(),
-                stats.frames,
-                stats.elapsed_s,
-                stats.fps,
-                stats.errored_dropped,
-                stats.sequence_gaps,
-                stats.timeouts,
-                stats.restarts,
-                stats.signal_lost_frames
-            );
+            .unwrap_or_default()
+    });
+    if args.json {
+        let input = match (&args.device, &args.input) {
+            (Some(_), _) => None,
+            (None, Some(p)) if p.as_os_str() == "-" => Some("stdin".to_owned()),
+            (None, Some(p)) => Some(p.display().to_string()),
+            (None, None) => Some(SAMPLE_NAME.to_owned()),
+        };
+        let summary = SummaryJson {
+            summary: SummaryBody {
+                input,
+                device: args
+                    .device
+                    .as_ref()
+                    .map(|_| monitor.as_ref().and_then(CaptureMonitor::setup)),
+                stats,
+                tracked_frames: run_stats.frames,
+                lost_frames: run_stats.lost_frames,
+                skipped_bytes: run_stats.skipped_bytes,
+                exit,
+                exit_code: code,
+                error,
+            },
+        };
+        match serde_json::to_string(&summary) {
+            Ok(line) => println!("{line}"),
+            Err(e) => eprintln!("nav-app: error: cannot write the JSON summary: {e}"),
         }
+    } else if let (Some(dev), Some(stats), Some(_)) = (&args.device, stats, &monitor) {
+        eprintln!(
+            "nav-app: device {}: {} frames in {:.2} s ({:.1} frames/s); dropped: {} errored \
+             buffers, {} frames (sequence gaps); {} timeouts ({} restarts); {} frames without \
+             signal",
+            dev.display(),
+            stats.frames,
+            stats.elapsed_s,
+            stats.fps,
+            stats.errored_dropped,
+            stats.sequence_gaps,
+            stats.timeouts,
+            stats.restarts,
+            stats.signal_lost_frames
+        );
     }
     ExitCode::from(code)
 }

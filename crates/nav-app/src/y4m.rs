@@ -9,6 +9,11 @@
 //! A stream that repeats a `YUV4MPEG2` header where a `FRAME` is expected (two files
 //! concatenated) is accepted when the size is the same and rejected with
 //! [`NavError::SizeChanged`] otherwise.
+//!
+//! A stream damaged where a `FRAME` header is expected (a flipped byte, a frame cut short, junk)
+//! is resynchronised at the next `FRAME` marker: the frames lost are reported once as a
+//! non-fatal [`NavError::Y4mResync`] and totalled in [`Y4mSource::losses`]; see [`Y4mSource`]
+//! for how they are counted.
 
 use std::io::{self, BufRead, Read, Write};
 
@@ -180,9 +185,51 @@ fn read_line<R: BufRead>(reader: &mut R, line: &mut Vec<u8>, name: &str) -> Resu
     }
 }
 
+/// What [`Y4mSource`] has lost to damage so far.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Y4mLosses {
+    /// Frames of the stream not delivered (skipped while resynchronising, or short at the end).
+    pub frames: u64,
+    /// Bytes skipped: damaged headers, the data they announced, and short last frames.
+    pub bytes: u64,
+    /// Resynchronisations (each one a [`NavError::Y4mResync`] returned by `next_frame`).
+    pub resyncs: u64,
+}
+
+/// The next marker found by [`Y4mSource::sync`].
+enum Marker {
+    /// `FRAME` followed by a space (parameters follow) or a newline (`line_done`).
+    Frame { line_done: bool },
+    /// `YUV4MPEG2 ` (a concatenated stream's header).
+    Header,
+    /// The end of the stream.
+    End,
+}
+
 /// A YUV4MPEG2 stream (file or stdin) as a [`FrameSource`]; only the Y plane is delivered.
 ///
-/// Reading a frame does not allocate once the caller's frame has the stream's size.
+/// Reading a frame does not allocate once the caller's frame has the stream's size. The frame
+/// buffer grows with the bytes actually read, so a header announcing a huge frame (up to the
+/// 2³⁰-pixel cap of [`Y4mHeader::parse`]) over a short stream does not allocate the whole frame.
+///
+/// ## Damaged streams
+/// Where a frame header is expected the reader scans forward to the next `FRAME` marker (`FRAME`
+/// followed by a space or a newline), so a damaged `FRAME` header (a flipped byte), a frame short
+/// of bytes in the middle of the stream, or garbage between frames costs the frames concerned, not
+/// the rest of the stream. This works on pipes (no seeking) with bounded memory: the scan looks at
+/// one byte at a time through the reader's buffer.
+///
+/// When `D > 0` bytes were skipped before the marker, `next_frame` returns one non-fatal
+/// [`NavError::Y4mResync`] before the frame after the marker. The frames lost are counted as
+/// `⌈D / L⌉`, with `L` the length of one frame record (its `FRAME` line and planes, as of the
+/// last good header): exact when damage replaces or drops bytes (bit flips, a frame cut short,
+/// lost packets) — the marker found is then the `⌈D/L⌉ + 1`-th after the last good frame, and
+/// the frame indices (and time stamps) after the damage are the true ones. Inserted bytes can make
+/// the count one too high. A frame that was cut short mid-stream swallows the next frame's header
+/// into its planes and is delivered (damaged), and the frame whose header it swallowed is lost:
+/// without reading ahead — which would delay every frame of a live pipe by one — the reader
+/// cannot tell a short frame from good pixels. A short **last** frame is a non-fatal
+/// [`NavError::ShortFrame`]. [`Y4mSource::losses`] keeps the totals.
 #[derive(Debug)]
 pub struct Y4mSource<R: BufRead> {
     reader: R,
@@ -190,6 +237,11 @@ pub struct Y4mSource<R: BufRead> {
     header: Y4mHeader,
     next_index: u64,
     line: Vec<u8>,
+    /// A `FRAME` line has been consumed: the reader is at the planes of frame `next_index`.
+    at_planes: bool,
+    /// Bytes of the last good `FRAME` line, its newline included.
+    frame_line_bytes: usize,
+    losses: Y4mLosses,
     finished: bool,
 }
 
@@ -211,6 +263,9 @@ impl<R: BufRead> Y4mSource<R> {
             header,
             next_index: 0,
             line,
+            at_planes: false,
+            frame_line_bytes: b"FRAME\n".len(),
+            losses: Y4mLosses::default(),
             finished: false,
         })
     }
@@ -219,6 +274,122 @@ impl<R: BufRead> Y4mSource<R> {
     pub fn header(&self) -> &Y4mHeader {
         &self.header
     }
+
+    /// Frames and bytes lost to damage so far.
+    pub fn losses(&self) -> Y4mLosses {
+        self.losses
+    }
+
+    /// Consume bytes up to and including the next marker; returns it and how many bytes came
+    /// before it (skipped).
+    fn sync(&mut self) -> Result<(Marker, u64), NavError> {
+        const FRAME_SP: &[u8] = b"FRAME ";
+        const FRAME_NL: &[u8] = b"FRAME\n";
+        const HEADER: &[u8] = b"YUV4MPEG2 ";
+        // The last bytes seen, newest last (HEADER is the longest marker).
+        let mut window = [0u8; 10];
+        let mut seen = 0u64;
+        loop {
+            let available = match self.reader.fill_buf() {
+                Ok(b) => b,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(NavError::io(self.name.clone(), e)),
+            };
+            if available.is_empty() {
+                return Ok((Marker::End, seen));
+            }
+            let mut found = None;
+            let mut used = 0;
+            for &b in available {
+                used += 1;
+                seen += 1;
+                window.copy_within(1.., 0);
+                window[9] = b;
+                if window.ends_with(FRAME_NL) {
+                    found = Some((Marker::Frame { line_done: true }, FRAME_NL.len()));
+                } else if window.ends_with(FRAME_SP) {
+                    found = Some((Marker::Frame { line_done: false }, FRAME_SP.len()));
+                } else if window.ends_with(HEADER) {
+                    found = Some((Marker::Header, HEADER.len()));
+                }
+                if found.is_some() {
+                    break;
+                }
+            }
+            self.reader.consume(used);
+            if let Some((marker, len)) = found {
+                return Ok((marker, seen - len as u64));
+            }
+        }
+    }
+
+    /// Find and consume the next `FRAME` line, taking in concatenated stream headers of the same
+    /// frame size on the way. Returns whether one was found (else the stream ended) and the bytes
+    /// skipped before it.
+    fn next_frame_line(&mut self) -> Result<(bool, u64), NavError> {
+        let mut skipped = 0u64;
+        loop {
+            let (marker, before) = self.sync()?;
+            skipped += before;
+            match marker {
+                Marker::End => return Ok((false, skipped)),
+                Marker::Frame { line_done } => {
+                    let mut len = b"FRAME\n".len();
+                    if !line_done {
+                        // Parameters: the rest of the line (bounded), ignored.
+                        read_line(&mut self.reader, &mut self.line, &self.name)?;
+                        len += self.line.len() + 1;
+                    }
+                    self.frame_line_bytes = len;
+                    return Ok((true, skipped));
+                }
+                Marker::Header => {
+                    read_line(&mut self.reader, &mut self.line, &self.name)?;
+                    let mut text = Vec::with_capacity(10 + self.line.len());
+                    text.extend_from_slice(b"YUV4MPEG2 ");
+                    text.extend_from_slice(&self.line);
+                    let new = Y4mHeader::parse(&self.name, &text)?;
+                    if new.width != self.header.width || new.height != self.header.height {
+                        self.finished = true;
+                        return Err(NavError::SizeChanged {
+                            name: self.name.clone(),
+                            frame: self.next_index,
+                            from_w: self.header.width,
+                            from_h: self.header.height,
+                            to_w: new.width,
+                            to_h: new.height,
+                        });
+                    }
+                    self.header = new;
+                }
+            }
+        }
+    }
+}
+
+/// Read `len` bytes into `data`, which ends up `len` bytes long when they were all there. The
+/// buffer grows only as bytes arrive (doubling from 1 MiB), so a header announcing a huge frame
+/// over a short stream costs at most twice the bytes actually present. Returns the bytes read.
+fn read_plane<R: Read>(reader: &mut R, data: &mut Vec<u8>, len: usize) -> io::Result<usize> {
+    const CHUNK: usize = 1 << 20;
+    data.truncate(len);
+    let mut got = 0;
+    while got < len {
+        let end = if data.len() >= len {
+            len
+        } else {
+            len.min((2 * got).max(CHUNK)).max(data.len())
+        };
+        if data.len() < end {
+            data.resize(end, 0);
+        }
+        let n = read_fully(reader, &mut data[got..end])?;
+        got += n;
+        if got < end {
+            break;
+        }
+    }
+    Ok(got)
 }
 
 impl<R: BufRead> FrameSource for Y4mSource<R> {
@@ -226,53 +397,57 @@ impl<R: BufRead> FrameSource for Y4mSource<R> {
         if self.finished {
             return Ok(None);
         }
-        let index = self.next_index;
-        loop {
-            if !read_line(&mut self.reader, &mut self.line, &self.name)? {
-                self.finished = true;
+        if !self.at_planes {
+            let first_lost = self.next_index;
+            let (found, skipped) = match self.next_frame_line() {
+                Ok(r) => r,
+                Err(e) => {
+                    self.finished = true;
+                    return Err(e);
+                }
+            };
+            self.at_planes = found;
+            self.finished = !found;
+            if skipped > 0 {
+                let record = (self.frame_line_bytes + self.header.frame_bytes()) as u64;
+                let lost = skipped.div_ceil(record);
+                self.next_index += lost;
+                self.losses.frames += lost;
+                self.losses.bytes += skipped;
+                self.losses.resyncs += 1;
+                return Err(NavError::Y4mResync {
+                    name: self.name.clone(),
+                    frame: first_lost,
+                    lost_frames: lost,
+                    skipped_bytes: skipped,
+                    end_of_stream: !found,
+                });
+            }
+            if !found {
                 return Ok(None);
             }
-            if self.line.starts_with(b"FRAME") && matches!(self.line.get(5), None | Some(b' ')) {
-                break;
-            }
-            if self.line.starts_with(b"YUV4MPEG2") {
-                let new = Y4mHeader::parse(&self.name, &self.line)?;
-                if new.width != self.header.width || new.height != self.header.height {
-                    self.finished = true;
-                    return Err(NavError::SizeChanged {
-                        name: self.name.clone(),
-                        frame: index,
-                        from_w: self.header.width,
-                        from_h: self.header.height,
-                        to_w: new.width,
-                        to_h: new.height,
-                    });
-                }
-                self.header = new;
-                continue;
-            }
-            self.finished = true;
-            return Err(NavError::Y4mFrameHeader {
-                name: self.name.clone(),
-                frame: index,
-                found: String::from_utf8_lossy(&self.line[..self.line.len().min(16)]).into_owned(),
-            });
         }
+        self.at_planes = false;
+        let index = self.next_index;
         self.next_index += 1;
         let (w, h) = (self.header.width, self.header.height);
-        frame.reshape(w, h);
         let expected = self.header.frame_bytes();
-        let got = read_fully(&mut self.reader, &mut frame.data)
+        let got = read_plane(&mut self.reader, &mut frame.data, w * h)
             .map_err(|e| NavError::io(self.name.clone(), e))?;
         let mut total = got;
         if got == w * h {
+            (frame.width, frame.height) = (w, h);
             let chroma = (expected - got) as u64;
             let skipped = io::copy(&mut (&mut self.reader).take(chroma), &mut io::sink())
                 .map_err(|e| NavError::io(self.name.clone(), e))?;
             total += skipped as usize;
         }
         if total < expected {
+            // Leave the caller a valid (empty) frame rather than a partial one.
+            frame.reshape(0, 0);
             self.finished = true;
+            self.losses.frames += 1;
+            self.losses.bytes += total as u64;
             return Err(NavError::ShortFrame {
                 name: self.name.clone(),
                 frame: index,
@@ -587,19 +762,193 @@ mod tests {
         );
     }
 
-    #[test]
-    fn garbage_instead_of_frame_header_is_fatal_and_names_the_frame() {
-        let mut s = stream("YUV4MPEG2 W2 H1 Cmono", &[&[1, 2]]);
-        s.extend_from_slice(b"GARBAGE\n\x00\x00");
-        let mut src = Y4mSource::new(&s[..], "g.y4m").unwrap();
+    /// Frames `0..n` of 4×3 mono, frame `i` filled with `i`.
+    fn numbered(n: u8) -> Vec<u8> {
+        let frames: Vec<Vec<u8>> = (0..n).map(|i| vec![i; 12]).collect();
+        let refs: Vec<&[u8]> = frames.iter().map(Vec::as_slice).collect();
+        stream("YUV4MPEG2 W4 H3 F25:1 Cmono", &refs)
+    }
+
+    /// Byte offset of frame `i`'s `FRAME` line in [`numbered`] (header 28 bytes, records 18).
+    fn record(i: usize) -> usize {
+        "YUV4MPEG2 W4 H3 F25:1 Cmono\n".len() + i * 18
+    }
+
+    /// Everything a source yields: delivered (index, first pixel), and the errors.
+    fn drain<R: BufRead>(src: &mut Y4mSource<R>) -> (Vec<(u64, u8)>, Vec<NavError>) {
+        let (mut frames, mut errors) = (Vec::new(), Vec::new());
         let mut frame = GreyFrame::default();
-        src.next_frame(&mut frame).unwrap().unwrap();
+        for _ in 0..1000 {
+            match src.next_frame(&mut frame) {
+                Ok(Some(m)) => {
+                    assert_eq!(frame.data.len(), frame.width * frame.height);
+                    frames.push((m.index, frame.data[0]));
+                }
+                Ok(None) => return (frames, errors),
+                Err(e) => {
+                    assert!(!e.is_fatal(), "{e}");
+                    errors.push(e);
+                }
+            }
+        }
+        panic!("source never ended");
+    }
+
+    #[test]
+    fn a_flipped_byte_in_a_frame_header_loses_that_frame_only() {
+        for offset in 0..6 {
+            let mut s = numbered(8);
+            s[record(3) + offset] ^= 0x20;
+            let mut src = Y4mSource::new(&s[..], "flip.y4m").unwrap();
+            let (frames, errors) = drain(&mut src);
+            let want: Vec<(u64, u8)> = [0u8, 1, 2, 4, 5, 6, 7]
+                .iter()
+                .map(|&i| (u64::from(i), i))
+                .collect();
+            assert_eq!(frames, want, "byte {offset} of the header flipped");
+            assert_eq!(errors.len(), 1);
+            assert!(
+                matches!(
+                    errors[0],
+                    NavError::Y4mResync {
+                        frame: 3,
+                        lost_frames: 1,
+                        skipped_bytes: 18,
+                        end_of_stream: false,
+                        ..
+                    }
+                ),
+                "{}",
+                errors[0]
+            );
+            let msg = errors[0].to_string();
+            assert!(msg.contains("flip.y4m") && msg.contains("frame 3"), "{msg}");
+            assert_eq!(
+                src.losses(),
+                Y4mLosses {
+                    frames: 1,
+                    bytes: 18,
+                    resyncs: 1
+                }
+            );
+            // Time stamps stay those of the true indices.
+            let mut src = Y4mSource::new(&s[..], "flip.y4m").unwrap();
+            let mut frame = GreyFrame::default();
+            let mut last = None;
+            loop {
+                match src.next_frame(&mut frame) {
+                    Ok(Some(m)) => last = Some(m),
+                    Ok(None) => break,
+                    Err(_) => {}
+                }
+            }
+            let last = last.unwrap();
+            assert_eq!(last.index, 7);
+            assert!((last.t_s - 7.0 / 25.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn garbage_of_several_frames_is_skipped_and_counted() {
+        let mut s = numbered(10);
+        // Frames 2, 3, 4 wholly overwritten with junk (no marker in it).
+        for b in &mut s[record(2)..record(5)] {
+            *b = b'x';
+        }
+        let mut src = Y4mSource::new(&s[..], "g.y4m").unwrap();
+        let (frames, errors) = drain(&mut src);
+        let idx: Vec<u64> = frames.iter().map(|f| f.0).collect();
+        assert_eq!(idx, vec![0, 1, 5, 6, 7, 8, 9]);
+        assert!(frames.iter().all(|&(i, v)| u64::from(v) == i));
+        assert!(
+            matches!(
+                errors[..],
+                [NavError::Y4mResync {
+                    frame: 2,
+                    lost_frames: 3,
+                    skipped_bytes: 54,
+                    ..
+                }]
+            ),
+            "{errors:?}"
+        );
+    }
+
+    #[test]
+    fn a_frame_cut_short_mid_stream_costs_the_next_frame_and_indices_stay_true() {
+        let mut s = numbered(8);
+        // Frame 2 loses 5 of its 12 bytes: it swallows frame 3's `FRAME` line.
+        s.drain(record(2) + 6..record(2) + 11);
+        let mut src = Y4mSource::new(&s[..], "cut.y4m").unwrap();
+        let (frames, errors) = drain(&mut src);
+        let idx: Vec<u64> = frames.iter().map(|f| f.0).collect();
+        assert_eq!(idx, vec![0, 1, 2, 4, 5, 6, 7]);
+        assert!(frames[3..].iter().all(|&(i, v)| u64::from(v) == i));
+        assert!(
+            matches!(
+                errors[..],
+                [NavError::Y4mResync {
+                    frame: 3,
+                    lost_frames: 1,
+                    ..
+                }]
+            ),
+            "{errors:?}"
+        );
+    }
+
+    #[test]
+    fn damage_at_the_start_and_at_the_end_is_counted() {
+        let mut s = numbered(5);
+        s[record(0)] = b'G';
+        s[record(4) + 2] = b'?';
+        let mut src = Y4mSource::new(&s[..], "e.y4m").unwrap();
+        let (frames, errors) = drain(&mut src);
+        assert_eq!(
+            frames.iter().map(|f| f.0).collect::<Vec<_>>(),
+            vec![1, 2, 3]
+        );
+        assert!(
+            matches!(
+                errors[..],
+                [
+                    NavError::Y4mResync {
+                        frame: 0,
+                        lost_frames: 1,
+                        end_of_stream: false,
+                        ..
+                    },
+                    NavError::Y4mResync {
+                        frame: 4,
+                        lost_frames: 1,
+                        skipped_bytes: 18,
+                        end_of_stream: true,
+                        ..
+                    }
+                ]
+            ),
+            "{errors:?}"
+        );
+        assert_eq!(src.losses().frames, 2);
+    }
+
+    #[test]
+    fn a_huge_declared_frame_over_a_short_stream_allocates_what_is_there() {
+        let mut s = b"YUV4MPEG2 W30000 H30000 Cmono\nFRAME\n".to_vec();
+        s.extend_from_slice(&[7; 1000]);
+        let mut src = Y4mSource::new(&s[..], "big.y4m").unwrap();
+        let mut frame = GreyFrame::default();
         let err = src.next_frame(&mut frame).unwrap_err();
         assert!(
-            matches!(err, NavError::Y4mFrameHeader { frame: 1, .. }),
+            matches!(err, NavError::ShortFrame { got: 1000, .. }),
             "{err}"
         );
-        assert!(err.is_fatal());
+        assert!(
+            frame.data.capacity() <= 1 << 21,
+            "{}",
+            frame.data.capacity()
+        );
+        assert_eq!((frame.width, frame.height, frame.data.len()), (0, 0, 0));
     }
 
     #[test]

@@ -28,6 +28,21 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// The `--json` output split into the frame objects and the closing summary (always last).
+fn json_output(o: &Output) -> (Vec<serde_json::Value>, serde_json::Value) {
+    let text = String::from_utf8(o.stdout.clone()).unwrap();
+    let mut values: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let summary = values.pop().expect("a summary line");
+    assert!(
+        values.iter().all(|v| v.get("summary").is_none()),
+        "only the last line is a summary"
+    );
+    (values, summary["summary"].clone())
+}
+
 #[test]
 fn with_no_input_it_runs_on_the_bundled_sample() {
     let o = nav_app(&["--max-frames", "5"]);
@@ -49,11 +64,21 @@ fn json_is_one_object_per_frame_with_the_documented_schema() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(o.stderr.is_empty(), "quiet under --json: {}", stderr(&o));
-    let text = String::from_utf8(o.stdout).unwrap();
-    let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines.len(), 24);
-    for (i, line) in lines.iter().enumerate() {
-        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+    let (frames, summary) = json_output(&o);
+    assert_eq!(frames.len(), 24);
+    assert_eq!(summary["tracked_frames"], 24);
+    assert_eq!(summary["lost_frames"], 0);
+    assert_eq!(summary["skipped_bytes"], 0);
+    assert_eq!(summary["exit"], "end");
+    assert_eq!(summary["exit_code"], 0);
+    assert!(summary["error"].is_null());
+    assert!(
+        summary["input"]
+            .as_str()
+            .unwrap()
+            .ends_with("straight_solid.y4m")
+    );
+    for (i, v) in frames.iter().enumerate() {
         assert_eq!(v["frame"].as_u64(), Some(i as u64));
         assert!((v["t_s"].as_f64().unwrap() - i as f64 / 25.0).abs() < 1e-9);
         let lanes = v["lanes"].as_array().unwrap();
@@ -78,9 +103,9 @@ fn a_still_image_is_one_frame() {
         .unwrap();
     let o = nav_app(&["--input", png.to_str().unwrap(), "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = String::from_utf8(o.stdout).unwrap();
-    assert_eq!(text.lines().count(), 1);
-    let v: serde_json::Value = serde_json::from_str(text.trim()).unwrap();
+    let (frames, _) = json_output(&o);
+    assert_eq!(frames.len(), 1);
+    let v = &frames[0];
     assert_eq!(v["lanes"][0]["state"], "initialising");
     assert!(
         v["lanes"][0]["coeffs"].is_null(),
@@ -175,7 +200,7 @@ fn fatal_bad_input_exits_non_zero_naming_the_file() {
 }
 
 #[test]
-fn a_short_last_frame_is_reported_and_skipped_and_the_run_succeeds() {
+fn a_short_last_frame_is_reported_skipped_and_counted_as_lost_exit_5() {
     let dir = scratch("short");
     let mut bytes = std::fs::read(fixture("synthetic/straight_solid.y4m")).unwrap();
     let frame_len = 6 + 320 * 240;
@@ -184,20 +209,21 @@ fn a_short_last_frame_is_reported_and_skipped_and_the_run_succeeds() {
     let path = dir.join("short.y4m");
     std::fs::write(&path, &bytes).unwrap();
     let o = nav_app(&["--input", path.to_str().unwrap(), "--json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(
-        String::from_utf8(o.stdout.clone()).unwrap().lines().count(),
-        3
-    );
+    assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
+    let (frames, summary) = json_output(&o);
+    assert_eq!(frames.len(), 3);
+    assert_eq!(summary["lost_frames"], 1);
+    assert_eq!(summary["skipped_bytes"], 1000 - 6);
+    assert_eq!(summary["exit_code"], 5);
     let e = stderr(&o);
     assert!(
-        e.contains("frame 3") && e.contains("short frame") && e.contains("1 bad frames"),
+        e.contains("frame 3") && e.contains("short frame") && e.contains("1 frames lost"),
         "{e}"
     );
 }
 
 #[test]
-fn a_bad_config_exits_non_zero_naming_the_field() {
+fn a_bad_config_exits_1_naming_the_file_line_column_and_field_once() {
     let dir = scratch("config");
     let text = std::fs::read_to_string(format!(
         "{}/../../configs/outdoor.toml",
@@ -206,10 +232,31 @@ fn a_bad_config_exits_non_zero_naming_the_field() {
     .unwrap()
     .replace("r_sigma_px = 2.0", "r_sigma_px = -2.0");
     let path = dir.join("bad.toml");
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, &text).unwrap();
+    let line = 1 + text[..text.find("r_sigma_px = -2.0").unwrap()]
+        .matches('\n')
+        .count();
     let o = nav_app(&["--config", path.to_str().unwrap(), "--max-frames", "1"]);
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("filter.r_sigma_px"), "{}", stderr(&o));
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("filter.r_sigma_px"), "{e}");
+    let at = format!("{}:{line}:1: ", path.display());
+    assert!(e.contains(&at), "{e} lacks {at}");
+    assert_eq!(e.matches(path.to_str().unwrap()).count(), 1, "{e}");
+
+    // A misspelt key: located at the key, named once.
+    let text = text
+        .replace("r_sigma_px = -2.0", "r_sigma_px = 2.0")
+        .replace("wrls_lambda", "wrls_lamda");
+    let line = 1 + text[..text.find("wrls_lamda").unwrap()]
+        .matches('\n')
+        .count();
+    std::fs::write(&path, &text).unwrap();
+    let o = nav_app(&["--config", path.to_str().unwrap(), "--max-frames", "1"]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    let at = format!("{}:{line}:1: unknown field `wrls_lamda`", path.display());
+    assert!(e.contains(&at), "{e} lacks {at}");
 }
 
 #[test]
@@ -223,16 +270,13 @@ fn loop_repeats_a_file_up_to_max_frames() {
         "--json",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = String::from_utf8(o.stdout).unwrap();
-    let frames: Vec<u64> = text
-        .lines()
-        .map(|l| {
-            serde_json::from_str::<serde_json::Value>(l).unwrap()["frame"]
-                .as_u64()
-                .unwrap()
-        })
+    let (frames, summary) = json_output(&o);
+    let frames: Vec<u64> = frames
+        .iter()
+        .map(|v| v["frame"].as_u64().unwrap())
         .collect();
     assert_eq!(frames, (0..60).collect::<Vec<_>>());
+    assert_eq!(summary["exit"], "max-frames");
 }
 
 #[test]
@@ -254,5 +298,124 @@ fn a_y4m_stream_on_stdin_is_read_with_input_dash() {
     let o = child.wait_with_output().unwrap();
     writer.join().unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(String::from_utf8(o.stdout).unwrap().lines().count(), 10);
+    let (frames, summary) = json_output(&o);
+    assert_eq!(frames.len(), 10);
+    assert_eq!(summary["input"], "stdin");
+}
+
+/// `straight_solid.y4m` (24 frames, 320×240 mono) with one flipped byte in the `FRAME` header of
+/// each frame in `damaged`.
+fn damaged_fixture(damaged: &[usize]) -> Vec<u8> {
+    let mut bytes = std::fs::read(fixture("synthetic/straight_solid.y4m")).unwrap();
+    let header_len = bytes.iter().position(|&b| b == b'\n').unwrap() + 1;
+    let record = 6 + 320 * 240;
+    for (k, &i) in damaged.iter().enumerate() {
+        let at = header_len + i * record + k % 6;
+        assert_eq!(&bytes[header_len + i * record..][..6], b"FRAME\n");
+        bytes[at] ^= 0x01;
+    }
+    bytes
+}
+
+fn run_on_stdin(args: &[&str], bytes: Vec<u8>) -> Output {
+    use std::io::Write;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nav-app"))
+        .args(args)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        // Small writes: the reader sees the stream as a pipe delivers it.
+        for chunk in bytes.chunks(4093) {
+            if stdin.write_all(chunk).is_err() {
+                break;
+            }
+        }
+    });
+    let o = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    o
+}
+
+#[test]
+fn a_damaged_frame_header_loses_one_frame_and_the_stream_plays_to_its_end() {
+    let damaged = [5usize, 17];
+    let bytes = damaged_fixture(&damaged);
+    let dir = scratch("damaged");
+    let path = dir.join("damaged.y4m");
+    std::fs::write(&path, &bytes).unwrap();
+    let from_file = nav_app(&["--input", path.to_str().unwrap(), "--json"]);
+    let from_pipe = run_on_stdin(&["--input", "-", "--json"], bytes);
+    for (o, input) in [(&from_file, path.to_str().unwrap()), (&from_pipe, "stdin")] {
+        assert_eq!(o.status.code(), Some(5), "{input}: {}", stderr(o));
+        let (frames, summary) = json_output(o);
+        let indices: Vec<u64> = frames
+            .iter()
+            .map(|v| v["frame"].as_u64().unwrap())
+            .collect();
+        let want: Vec<u64> = (0..24u64)
+            .filter(|i| !damaged.contains(&(*i as usize)))
+            .collect();
+        assert_eq!(indices, want, "{input}: every good frame after the damage");
+        for v in &frames {
+            for lane in v["lanes"].as_array().unwrap() {
+                assert_eq!(lane["state"], "tracking", "{input}: {v}");
+            }
+            let i = v["frame"].as_f64().unwrap();
+            assert!((v["t_s"].as_f64().unwrap() - i / 25.0).abs() < 1e-9);
+        }
+        assert_eq!(summary["input"], input);
+        assert_eq!(summary["tracked_frames"], 22);
+        assert_eq!(summary["lost_frames"], 2);
+        assert_eq!(summary["skipped_bytes"], 2 * (6 + 320 * 240));
+        assert_eq!(summary["exit"], "end");
+        assert_eq!(summary["exit_code"], 5);
+        let e = stderr(o);
+        assert!(
+            e.contains("frame 5: damaged stream") && e.contains("frame 17: damaged stream"),
+            "{e}"
+        );
+    }
+    // The human summary says it too.
+    let o = nav_app(&["--input", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(5));
+    let e = stderr(&o);
+    assert!(
+        e.contains("22 frames tracked, 2 frames lost (153612 bytes skipped)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn help_documents_the_exit_codes_and_the_summary() {
+    let o = nav_app(&["--help"]);
+    assert!(o.status.success());
+    let help = String::from_utf8(o.stdout).unwrap();
+    for needle in [
+        "Exit codes",
+        "5  finished, but frames of the input were lost",
+        "\"lost_frames\"",
+        "\"skipped_bytes\"",
+    ] {
+        assert!(
+            help.contains(needle),
+            "{needle} missing from --help:\n{help}"
+        );
+    }
+}
+
+#[test]
+fn a_missing_input_names_the_file_and_its_os_error_once() {
+    let o = nav_app(&["--input", "/nonexistent/clip.y4m"]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert_eq!(e.matches("/nonexistent/clip.y4m").count(), 1, "{e}");
+    assert_eq!(e.matches("No such file or directory").count(), 1, "{e}");
+    let o = nav_app(&["--config", "/nonexistent/tracker.toml"]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert_eq!(e.matches("No such file or directory").count(), 1, "{e}");
 }

@@ -24,6 +24,7 @@ fn field_of(e: &ScenarioError) -> String {
     match e {
         ScenarioError::Invalid { field, .. } => field.clone(),
         ScenarioError::Parse { section, .. } => section.clone(),
+        ScenarioError::InFile { field, .. } => field.clone(),
     }
 }
 
@@ -188,4 +189,51 @@ fn measurement_jacobian_option_parses_defaults_to_verified_and_rejects_unknown_v
     let e = Scenario::from_toml_str(&bad).unwrap_err();
     assert_eq!(field_of(&e), "filter");
     assert!(e.to_string().contains("paper_printed"), "{e}");
+}
+
+#[test]
+fn scenario_errors_name_the_file_line_and_column() {
+    let base = paper_toml();
+    let line_of =
+        |text: &str, needle: &str| 1 + text[..text.find(needle).unwrap()].matches('\n').count();
+    // Out of range: located at the key.
+    let text = with_value(&base, "filter", "r_var_m2", "-40.0");
+    let e = Scenario::from_toml_named("configs/mine.toml", &text).unwrap_err();
+    let line = line_of(&text, "r_var_m2 = -40.0");
+    assert_eq!(field_of(&e), "filter.r_var_m2");
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with(&format!("configs/mine.toml:{line}:1: filter.r_var_m2")),
+        "{msg}"
+    );
+    // Unknown key: located at the key; wrong type: at the value.
+    let text = base.replace("\n[filter]\n", "\n[filter]\nr_sigma_m = 6.0\n");
+    let e = Scenario::from_toml_named("m.toml", &text).unwrap_err();
+    let line = line_of(&text, "r_sigma_m = 6.0");
+    assert!(
+        e.to_string()
+            .starts_with(&format!("m.toml:{line}:1: unknown field `r_sigma_m`")),
+        "{e}"
+    );
+    let text = with_value(&base, "filter", "akf_window", "\"ten\"");
+    let e = Scenario::from_toml_named("m.toml", &text).unwrap_err();
+    let line = line_of(&text, "akf_window = \"ten\"");
+    assert!(
+        e.to_string().starts_with(&format!("m.toml:{line}:14: ")),
+        "{e}"
+    );
+    assert!(e.to_string().contains("filter.akf_window"), "{e}");
+    // Unknown section: at its header; syntax error: at the token.
+    let text = format!("{base}\n[camera]\nfov_deg = 3.0\n");
+    let e = Scenario::from_toml_named("m.toml", &text).unwrap_err();
+    let line = line_of(&text, "[camera]");
+    assert!(
+        e.to_string()
+            .starts_with(&format!("m.toml:{line}:2: unknown section `camera`")),
+        "{e}"
+    );
+    let e = Scenario::from_toml_named("m.toml", "[filter\n").unwrap_err();
+    assert!(e.to_string().starts_with("m.toml:1:"), "{e}");
+    // The path appears once.
+    assert_eq!(e.to_string().matches("m.toml").count(), 1);
 }

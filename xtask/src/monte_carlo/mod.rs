@@ -223,16 +223,15 @@ pub fn load_scenario(args: &RunArgs) -> Result<(Scenario, String)> {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read the scenario {}", path.display()))?;
-            let s = Scenario::from_toml_str(&text)
-                .with_context(|| format!("invalid scenario {}", path.display()))?;
+            // The error names the file, line and column itself.
+            let s = Scenario::from_toml_named(&path.display().to_string(), &text)?;
             (s, path.display().to_string())
         }
         None => {
             let path = workspace_root().join("configs/paper.toml");
             match std::fs::read_to_string(&path) {
                 Ok(text) => (
-                    Scenario::from_toml_str(&text)
-                        .with_context(|| format!("invalid scenario {}", path.display()))?,
+                    Scenario::from_toml_named(&path.display().to_string(), &text)?,
                     "configs/paper.toml".to_string(),
                 ),
                 Err(_) => (

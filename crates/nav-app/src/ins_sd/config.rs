@@ -11,13 +11,28 @@ use sighting_model::SightingConfig;
 /// field (`"filter.r_var_m2"`, `"imu.accel_bias_sigma_mg"`, `"sighting.landmarks[1].lat_deg"`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ScenarioError {
-    /// The text is not TOML, a section is missing or unknown, or a key is unknown or mistyped.
+    /// The text is not TOML, a section is missing or unknown, or a key is unknown or mistyped,
+    /// without a location. The loader ([`super::Scenario::from_toml_named`]) returns
+    /// [`ScenarioError::InFile`] instead; this variant remains for callers that parse
+    /// sections of their own.
     #[error("scenario TOML, section [{section}]: {message}")]
     Parse {
         /// Section concerned (`"(document)"` for top-level problems).
         section: String,
         /// Parser message (names the offending key).
         message: String,
+    },
+    /// An error in a scenario text, located by the one TOML loader (crate `toml-config`): `error`
+    /// names the file (or the name given to [`super::Scenario::from_toml_named`]), the line and
+    /// the column of the offending key or value, and says what is wrong. Every error of
+    /// [`super::Scenario::from_toml_str`] / [`super::Scenario::from_toml_named`] is one of these.
+    #[error("{error}")]
+    InFile {
+        /// What [`ScenarioError::Parse`] or [`ScenarioError::Invalid`] would name: the section
+        /// (`"(document)"` for a syntax error) or the dotted field.
+        field: String,
+        /// The located error.
+        error: toml_config::TomlError,
     },
     /// A field holds an invalid value.
     #[error("{field}: {requirement} (got {value})")]
@@ -278,44 +293,27 @@ pub(crate) struct ScenarioFile {
 
 const SECTIONS: [&str; 5] = ["trajectory", "imu", "sighting", "filter", "monte_carlo"];
 
-/// Parses the document section by section so that an error names its section.
-pub(crate) fn parse(text: &str) -> Result<ScenarioFile, ScenarioError> {
-    let table: toml::Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| ScenarioError::Parse {
-            section: "(document)".to_string(),
-            message: e.to_string(),
+/// Parses the document section by section (through the workspace's one TOML loader,
+/// `toml_config::TomlDoc`) so that an error names its section, file, line and column.
+pub(crate) fn parse(doc: &toml_config::TomlDoc<'_>) -> Result<ScenarioFile, ScenarioError> {
+    let located = |field: &str| {
+        let field = field.to_string();
+        move |error| ScenarioError::InFile { field, error }
+    };
+    doc.allow_only(&SECTIONS)
+        .map_err(|error| ScenarioError::InFile {
+            field: doc
+                .keys()
+                .find(|k| !SECTIONS.contains(k))
+                .unwrap_or("(document)")
+                .to_string(),
+            error,
         })?;
-    for key in table.keys() {
-        if !SECTIONS.contains(&key.as_str()) {
-            return Err(ScenarioError::Parse {
-                section: key.clone(),
-                message: format!("unknown section `{key}`, expected one of {SECTIONS:?}"),
-            });
-        }
-    }
-    fn section<T: serde::de::DeserializeOwned>(
-        table: &toml::Table,
-        name: &str,
-    ) -> Result<T, ScenarioError> {
-        let v = table
-            .get(name)
-            .cloned()
-            .ok_or_else(|| ScenarioError::Parse {
-                section: name.to_string(),
-                message: "section missing".to_string(),
-            })?;
-        v.try_into()
-            .map_err(|e: toml::de::Error| ScenarioError::Parse {
-                section: name.to_string(),
-                message: e.to_string().trim().to_string(),
-            })
-    }
     Ok(ScenarioFile {
-        trajectory: section(&table, "trajectory")?,
-        imu: section(&table, "imu")?,
-        sighting: section(&table, "sighting")?,
-        filter: section(&table, "filter")?,
-        monte_carlo: section(&table, "monte_carlo")?,
+        trajectory: doc.section("trajectory").map_err(located("trajectory"))?,
+        imu: doc.section("imu").map_err(located("imu"))?,
+        sighting: doc.section("sighting").map_err(located("sighting"))?,
+        filter: doc.section("filter").map_err(located("filter"))?,
+        monte_carlo: doc.section("monte_carlo").map_err(located("monte_carlo"))?,
     })
 }

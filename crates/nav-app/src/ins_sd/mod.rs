@@ -227,10 +227,23 @@ fn is_integer_multiple(x: f64, unit: f64) -> Option<usize> {
 }
 
 impl Scenario {
-    /// Parses and validates a scenario document. Unknown sections and keys are rejected; every
-    /// error names its section or its dotted field (`"filter.r_var_m2"`).
+    /// Parses and validates a scenario document: [`Scenario::from_toml_named`] with the name
+    /// `scenario`.
     pub fn from_toml_str(text: &str) -> Result<Scenario, ScenarioError> {
-        let f = config::parse(text)?;
+        Self::from_toml_named("scenario", text)
+    }
+
+    /// Parses and validates the scenario document `text`, read from the file `path`. Unknown
+    /// sections and keys are rejected. Every error is a [`ScenarioError::InFile`] naming `path`,
+    /// the line and the column of the offending key or value (a field out of range is located
+    /// at its key), and its section or dotted field (`"filter.r_var_m2"`).
+    pub fn from_toml_named(path: &str, text: &str) -> Result<Scenario, ScenarioError> {
+        let doc =
+            toml_config::TomlDoc::parse(path, text).map_err(|error| ScenarioError::InFile {
+                field: "(document)".to_string(),
+                error,
+            })?;
+        let f = config::parse(&doc)?;
         let s = Scenario {
             trajectory: f.trajectory,
             imu: f.imu,
@@ -238,7 +251,13 @@ impl Scenario {
             filter: f.filter,
             monte_carlo: f.monte_carlo,
         };
-        s.validate()?;
+        s.validate().map_err(|e| match e {
+            ScenarioError::Invalid { ref field, .. } => ScenarioError::InFile {
+                error: doc.error_at(field, e.to_string()),
+                field: field.clone(),
+            },
+            other => other,
+        })?;
         Ok(s)
     }
 
