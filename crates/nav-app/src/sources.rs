@@ -16,8 +16,10 @@ fn is_image_path(path: &Path) -> bool {
         .is_some_and(|e| IMAGE_EXTENSIONS.iter().any(|x| x.eq_ignore_ascii_case(e)))
 }
 
-/// Decode an image file (PNG, JPEG, PGM/PNM, by content) into a grey frame; colour is converted
-/// to grey with the `image` crate's luma weights (Rec. 709: 0.2126 R + 0.7152 G + 0.0722 B).
+/// Decode an image file (PNG, JPEG, PGM/PNM, by content) into a grey frame. A grey image is taken
+/// as it is; colour is converted with BT.601 luma, `Y' = 0.299 R' + 0.587 G' + 0.114 B'`
+/// ([`bt848_capture::convert::luma_bt601`]), the conversion of capture and of y4m (whose Y plane is
+/// BT.601), so one scene gives one grey whatever the input kind.
 ///
 /// Errors: [`NavError::Io`] when the file cannot be read, [`NavError::ImageDecode`] when it is
 /// truncated or corrupt, [`NavError::ZeroSize`].
@@ -44,9 +46,16 @@ pub fn decode_image_bytes(name: &str, bytes: &[u8], frame: &mut GreyFrame) -> Re
             height: h,
         });
     }
-    let grey = img.into_luma8();
     frame.reshape(w, h);
-    frame.data.copy_from_slice(grey.as_raw());
+    if img.color().has_color() {
+        let rgb = img.into_rgb8();
+        for (y, p) in frame.data.iter_mut().zip(rgb.as_raw().chunks_exact(3)) {
+            *y = bt848_capture::convert::luma_bt601(p[0], p[1], p[2]);
+        }
+    } else {
+        // Grey (with or without alpha, 8 or 16 bit): its luma as it is.
+        frame.data.copy_from_slice(img.into_luma8().as_raw());
+    }
     Ok(())
 }
 

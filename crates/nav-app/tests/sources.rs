@@ -64,7 +64,7 @@ fn still_png_pgm_and_jpeg_are_read_once_as_grey() {
 }
 
 #[test]
-fn colour_is_converted_to_grey_with_luma_weights() {
+fn colour_is_converted_to_grey_with_bt601_luma_like_capture_and_y4m() {
     let dir = scratch("colour");
     let path = dir.join("rgb.png");
     let img = image::RgbImage::from_fn(3, 1, |x, _| match x {
@@ -75,11 +75,15 @@ fn colour_is_converted_to_grey_with_luma_weights() {
     img.save(&path).unwrap();
     let (ok, _) = drain(&mut StillImage::new(&path));
     let g = &ok[0].1;
-    // Rec. 709 luma: 0.2126, 0.7152, 0.0722 of 255.
-    assert!(
-        g[0].abs_diff(54) <= 1 && g[1].abs_diff(182) <= 1 && g[2].abs_diff(18) <= 1,
-        "{g:?}"
-    );
+    // BT.601 luma: 0.299, 0.587, 0.114 of 255 → 76, 150, 29 (Rec. 709 would give 54, 182, 18),
+    // exactly what capture's conversion gives for the same pixels.
+    assert_eq!(g, &vec![76, 150, 29]);
+    for (x, rgb) in [[255u8, 0, 0], [0, 255, 0], [0, 0, 255]].iter().enumerate() {
+        assert_eq!(
+            g[x],
+            bt848_capture::convert::luma_bt601(rgb[0], rgb[1], rgb[2])
+        );
+    }
 }
 
 #[test]
