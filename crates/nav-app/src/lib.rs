@@ -83,6 +83,7 @@
 //! # Ok::<(), nav_app::NavError>(())
 //! ```
 
+pub mod birdseye;
 pub mod camera;
 pub mod capture_source;
 mod config;

@@ -43,6 +43,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use bt848_capture::{InputSelect, PixelFormat, VideoStd};
 use clap::{Parser, ValueEnum};
+use nav_app::birdseye::BirdseyeView;
+use nav_app::camera::{CameraConfig, CameraModel, EgoLaneReport};
 use nav_app::capture_source::{
     self, CaptureMonitor, DeviceFrameInfo, DeviceOptions, DeviceSetup, DeviceStats,
     parse_control_spec,
@@ -51,7 +53,8 @@ use nav_app::overlay::{OverlaySink, render_overlay};
 use nav_app::sources::open_input;
 use nav_app::y4m::Y4mSource;
 use nav_app::{
-    Estimator, FrameSource, GreyFrame, LaneReport, LaneState, LaneTracker, NavError, TrackerConfig,
+    Estimator, FrameSource, GreyFrame, LaneReport, LaneState, LaneTracker, NavError, Side,
+    TrackerConfig,
 };
 use serde::Serialize;
 
@@ -92,6 +95,14 @@ struct Args {
     /// Write annotated frames: a directory of PNGs, or a colour .y4m file.
     #[arg(long, value_name = "DIR|FILE.y4m")]
     overlay: Option<PathBuf>,
+    /// Camera model (TOML, or the presets `robot`, `highway`): adds the ego lane in metres
+    /// (`ego_lane`) and each lane's coefficient covariance (`lane_cov_px`) to the JSON.
+    #[arg(long, value_name = "robot|highway|FILE.toml")]
+    camera: Option<String>,
+    /// Write bird's-eye (inverse perspective) views of the ground with the lanes, one PNG per
+    /// frame, into this directory (needs --camera).
+    #[arg(long, value_name = "DIR", requires = "camera")]
+    birdseye: Option<PathBuf>,
     /// Stop after this many frames.
     #[arg(long, value_name = "N")]
     max_frames: Option<u64>,
@@ -191,6 +202,13 @@ struct FrameJson<'a> {
     lanes: &'a [LaneReport; 2],
     /// Wall time of `LaneTracker::track` on this frame, µs.
     track_us: f64,
+    /// The ego lane in metres with σ (with `--camera`; `null` unless both lanes are held).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ego_lane: Option<Option<EgoLaneReport>>,
+    /// Each lane's coefficient covariance in pixels (with `--camera`; `null` for a lane without
+    /// an estimate).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lane_cov_px: Option<[Option<[[f64; 3]; 3]>; 2]>,
     /// Device fields (with `--device` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     capture: Option<DeviceFrameInfo>,
@@ -236,6 +254,18 @@ fn lane_text(r: &LaneReport) -> String {
 /// left in `monitor` (also when the run fails) for the summary.
 fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
     let cfg = TrackerConfig::load(&args.config)?;
+    let camera: Option<CameraModel> = match &args.camera {
+        Some(c) => Some(CameraConfig::load(c)?.model()?),
+        None => None,
+    };
+    let mut birdseye = match (&args.birdseye, &camera) {
+        (Some(dir), Some(cam)) => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+            Some((dir.clone(), BirdseyeView::for_camera(cam)?, Vec::new()))
+        }
+        _ => None,
+    };
     let estimator = match args.estimator {
         EstimatorArg::Kif => Estimator::Kif,
         EstimatorArg::Wrls => Estimator::Wrls,
@@ -310,6 +340,9 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
                         frame.height
                     );
                 }
+                if let Some(cam) = &camera {
+                    cam.check_frame_size(frame.width, frame.height)?;
+                }
                 slot.insert(LaneTracker::new(
                     &cfg,
                     estimator,
@@ -324,6 +357,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
         track_time += dt;
         frames += 1;
         let index = loop_base + meta.index;
+        let ego = camera.as_ref().map(|c| c.ego_lane(t, &report));
         let capture = monitor.as_ref().and_then(CaptureMonitor::last_frame);
         if let Some(c) = capture
             && c.signal_lost != signal_lost
@@ -342,6 +376,11 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
                     t_s: meta.t_s,
                     lanes: &report.lanes,
                     track_us: dt.as_secs_f64() * 1e6,
+                    ego_lane: ego,
+                    lane_cov_px: camera.as_ref().map(|_| {
+                        [Side::Left, Side::Right]
+                            .map(|s| t.lane_covariance_px(s).map(|p| p.transpose().into()))
+                    }),
                     capture,
                 },
             )
@@ -352,6 +391,18 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>) -> Result<u64> {
         if let Some(sink) = overlay.as_mut() {
             render_overlay(&frame, t, &mut rgb);
             sink.write(index, &rgb, frame.width, frame.height)?;
+        }
+        if let Some((dir, view, rgb)) = birdseye.as_mut() {
+            view.render(&frame, t, &report, ego.flatten(), rgb);
+            let path = dir.join(format!("birdseye_{index:06}.png"));
+            image::save_buffer(
+                &path,
+                rgb,
+                view.width_px() as u32,
+                view.height_px() as u32,
+                image::ExtendedColorType::Rgb8,
+            )
+            .with_context(|| format!("cannot write {}", path.display()))?;
         }
         let states = [report.lanes[0].state, report.lanes[1].state];
         if !quiet && (states != last_states || frames % 100 == 1) {
