@@ -207,3 +207,59 @@ impl RoadRenderer {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_marks_are_drawn_where_the_camera_sees_the_true_road() {
+        // Noise-free: in each row the grey-weighted centre of each mark must sit on the
+        // projection of the true mark centre line (found by bisection along the road).
+        let spec = RoadSpec {
+            noise_sigma: 0.0,
+            curvature_per_m: (0.08, 0.08),
+            ..ROBOT_ROADS[0]
+        };
+        let cam = CameraConfig::load("robot").unwrap();
+        let mut r = RoadRenderer::new(spec, &cam).unwrap();
+        let hom = cam.model().unwrap().homography().to_owned();
+        let mut frame = GreyFrame::default();
+        for f in [0, 13] {
+            r.render(f, &mut frame);
+            let road = ArcRoad {
+                geometry: r.truth(f),
+            };
+            for n_m in [-0.2, 0.2] {
+                for s_m in [0.35, 0.6, 0.9] {
+                    let [u, v] = hom.ground_to_image(road.point(s_m, n_m)).unwrap();
+                    // The row through the point, and the mark's centre on it.
+                    let y = v.round() as usize;
+                    let (mut lo, mut hi) = (s_m - 0.2, s_m + 0.2);
+                    let row_of = |s: f64| hom.ground_to_image(road.point(s, n_m)).unwrap();
+                    for _ in 0..60 {
+                        let mid = 0.5 * (lo + hi);
+                        if row_of(mid)[1] > y as f64 {
+                            lo = mid
+                        } else {
+                            hi = mid
+                        }
+                    }
+                    let xt = row_of(0.5 * (lo + hi))[0];
+                    let (mut sw, mut sx) = (0.0, 0.0);
+                    for x in (u as usize).saturating_sub(10)..((u as usize) + 11).min(320) {
+                        let excess =
+                            (f64::from(frame.data[y * 320 + x]) - spec.ground_grey).max(0.0);
+                        sw += excess;
+                        sx += excess * x as f64;
+                    }
+                    let centre = sx / sw;
+                    assert!(
+                        (centre - xt).abs() < 0.15,
+                        "frame {f}, mark {n_m}, row {y}: drawn at {centre:.3}, truth {xt:.3}"
+                    );
+                }
+            }
+        }
+    }
+}
