@@ -2,8 +2,8 @@
 //! camera frame through the ground-plane homography, with the tracked lanes and the ego-lane
 //! model drawn on it.
 //!
-//! The view covers `X ∈ [0, 1.4·far]` forward (up the picture) and `Y ∈ [−0.7·far, 0.7·far]`
-//! across (right is right), `far` the camera file's `lookahead.far_m`, at 240×240 px. Grey:
+//! The view covers `X ∈ [0, 2·far]` forward (up the picture) and `Y ∈ [−far, far]` across
+//! (right is right), `far` the camera file's `lookahead.far_m`, at 320×320 px. Grey:
 //! the camera frame where the ground is visible, dark blue elsewhere. Red / blue dots: the left
 //! and right tracked parabolas mapped to the ground, row by row over the tracker's ROI. Green:
 //! the ego-lane model (centre line dashed, the two marks solid) over the look-ahead range,
@@ -13,7 +13,7 @@
 use crate::camera::{CameraModel, EgoLaneReport};
 use crate::{GreyFrame, LaneTracker, NavError, TrackReport};
 
-const SIZE_PX: usize = 240;
+const SIZE_PX: usize = 320;
 const OFF_GROUND_RGB: [u8; 3] = [20, 24, 48];
 const LANE_RGB: [[u8; 3]; 2] = [[255, 40, 40], [60, 110, 255]];
 const MODEL_RGB: [u8; 3] = [40, 230, 60];
@@ -37,7 +37,7 @@ impl BirdseyeView {
     /// None today; reserved for cameras whose view cannot be built.
     pub fn for_camera(camera: &CameraModel) -> Result<Self, NavError> {
         let far = camera.config().lookahead.far_m;
-        let (x_max_m, y_half_m) = (1.4 * far, 0.7 * far);
+        let (x_max_m, y_half_m) = (2.0 * far, far);
         let [w, h] = camera.config().image_size_px;
         let hom = camera.homography();
         let mut source = vec![u32::MAX; SIZE_PX * SIZE_PX];
@@ -103,18 +103,6 @@ impl BirdseyeView {
                 rgb[i..i + 3].copy_from_slice(&c);
             }
         };
-        let hom = self.camera.homography();
-        let (top, bottom) = tracker.roi_rows();
-        for (k, lane) in report.lanes.iter().enumerate() {
-            for row in top..bottom {
-                let Some(u) = lane.col_at_row(row as f64) else {
-                    break;
-                };
-                if let Ok([x, y]) = hom.image_to_ground([u, row as f64]) {
-                    put(self.to_view(x, y), LANE_RGB[k]);
-                }
-            }
-        }
         let la = self.camera.config().lookahead;
         for y in [-0.05, 0.0, 0.05].map(|f| f * self.y_half_m) {
             put(self.to_view(la.near_m, y), RANGE_RGB);
@@ -128,6 +116,7 @@ impl BirdseyeView {
             let c = 0.5 * e.curvature_per_m * s * s * s;
             let half_w = 0.5 * e.lane_width_m * s;
             let n = 4 * SIZE_PX;
+            let la = self.camera.config().lookahead;
             for i in 0..=n {
                 let x = la.near_m + (la.far_m - la.near_m) * i as f64 / n as f64;
                 let yc = y0 + (m + c * x) * x;
@@ -135,6 +124,18 @@ impl BirdseyeView {
                 put(self.to_view(x, yc + half_w), MODEL_RGB);
                 if (i / 12) % 2 == 0 {
                     put(self.to_view(x, yc), MODEL_RGB);
+                }
+            }
+        }
+        let hom = self.camera.homography();
+        let (top, bottom) = tracker.roi_rows();
+        for (k, lane) in report.lanes.iter().enumerate() {
+            for row in top..bottom {
+                let Some(u) = lane.col_at_row(row as f64) else {
+                    break;
+                };
+                if let Ok([x, y]) = hom.image_to_ground([u, row as f64]) {
+                    put(self.to_view(x, y), LANE_RGB[k]);
                 }
             }
         }

@@ -57,6 +57,13 @@
 //! Errors are [`NavError`]; [`NavError::is_fatal`] separates a fatal error from one bad frame
 //! (or one capture timeout) that is reported, counted and skipped.
 //!
+//! ## Lanes in metres
+//! [`camera`]: a camera file (pinhole intrinsics + mounting, or a measured ground-plane
+//! homography) turns the two lanes' parabolas and their KIF covariances
+//! ([`LaneTracker::lane_covariance_px`]) into the ego lane's lateral offset, heading, curvature
+//! and width with standard deviations (`lane-geometry` crate); [`birdseye`] draws the ground
+//! from above; [`synth::road`] renders a road from known 3-D geometry for the round-trip tests.
+//!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field
 //! carries its unit.

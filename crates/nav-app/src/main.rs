@@ -3,6 +3,7 @@
 //! ```text
 //! nav-app [--input PATH | --device PATH] [--config outdoor|indoor|FILE.toml] [--estimator kif|wrls]
 //!         [--json] [--overlay DIR|FILE.y4m] [--max-frames N] [--loop]
+//!         [--camera robot|highway|FILE.toml [--birdseye DIR]]
 //!         [--input-name NAME | --input-index N] [--std ntsc|pal|…] [--size WxH] [--max-timeouts N]
 //! ```
 //! With neither `--input` nor `--device` it runs on the bundled 30-frame sample (real highway
@@ -30,6 +31,14 @@
 //! pixel format), `--timeout-ms MS`, `--ctrl NAME=VALUE@FRAME` (set a V4L2 control once FRAME
 //! frames have been delivered; repeatable), `--ctrl-on-timeout NAME=VALUE` (set at the first
 //! timeout; repeatable).
+//!
+//! ## Lanes in metres (`--camera`)
+//! With a camera file (`nav_app::camera`) every `--json` frame object also carries `ego_lane`
+//! (`lateral_offset_m`, `heading_rad`, `curvature_per_m`, `lane_width_m` and each one's
+//! `*_sigma`; `null` unless both lanes are held) and `lane_cov_px` (each lane's 3×3 covariance
+//! of `[a1, a2, a3]`, rows, or `null`); `--birdseye DIR` writes `birdseye_NNNNNN.png`, the
+//! ground seen from above (`nav_app::birdseye`). The camera file must be for the input's frame
+//! size (`image_size_px`).
 //!
 //! ## Exit codes
 //! 0 success; 1 error (bad input, configuration, capture setup or streaming error); 2 bad
