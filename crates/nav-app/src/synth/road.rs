@@ -87,6 +87,24 @@ pub const ROBOT_ROADS: &[RoadSpec] = &[
     },
 ];
 
+/// A highway-scale sequence (the `highway` camera preset, 320×240): marks 0.15 m wide, 3.7 m
+/// apart, the car weaving by ±0.3 m and ±0.01 rad on a gentle curve.
+pub const HIGHWAY_ROADS: &[RoadSpec] = &[RoadSpec {
+    name: "highway_curve",
+    frames: 80,
+    lane_width_m: 3.7,
+    mark_width_m: 0.15,
+    offset_m: (0.0, 0.3),
+    heading_rad: (0.0, 0.01),
+    curvature_per_m: (0.0, 0.001),
+    period_frames: 80.0,
+    ground_grey: 90.0,
+    mark_grey: 210.0,
+    wall_grey: 180.0,
+    noise_sigma: 4.0,
+    seed: 21,
+}];
+
 /// Renders a [`RoadSpec`] through a camera.
 #[derive(Debug)]
 pub struct RoadRenderer {
