@@ -59,6 +59,13 @@
 //! [`NavError::lost_frames`] says how many input frames a non-fatal error stands for (a damaged
 //! YUV4MPEG2 stream is resynchronised at the next `FRAME` marker: [`NavError::Y4mResync`]).
 //!
+//! ## Lanes in metres
+//! [`camera`]: a camera file (pinhole intrinsics + mounting, or a measured ground-plane
+//! homography) turns the two lanes' parabolas and their KIF covariances
+//! ([`LaneTracker::lane_covariance_px`]) into the ego lane's lateral offset, heading, curvature
+//! and width with standard deviations (`lane-geometry` crate); [`birdseye`] draws the ground
+//! from above; [`synth::road`] renders a road from known 3-D geometry for the round-trip tests.
+//!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field
 //! carries its unit.
@@ -85,6 +92,8 @@
 //! # Ok::<(), nav_app::NavError>(())
 //! ```
 
+pub mod birdseye;
+pub mod camera;
 pub mod capture_source;
 mod config;
 mod error;

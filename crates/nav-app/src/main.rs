@@ -3,6 +3,7 @@
 //! ```text
 //! nav-app [--input PATH | --device PATH] [--config outdoor|indoor|FILE.toml] [--estimator kif|wrls]
 //!         [--json] [--overlay DIR|FILE.y4m] [--max-frames N] [--loop]
+//!         [--camera robot|highway|FILE.toml [--birdseye DIR]]
 //!         [--input-name NAME | --input-index N] [--std ntsc|pal|…] [--size WxH] [--max-timeouts N]
 //! ```
 //! With neither `--input` nor `--device` it runs on the bundled 30-frame sample (real highway
@@ -41,6 +42,14 @@
 //! "exit_code", "error"}}` (with `--device`: `"device"` and the capture counters in place of
 //! `"input"`, as above).
 //!
+//! ## Lanes in metres (`--camera`)
+//! With a camera file (`nav_app::camera`) every `--json` frame object also carries `ego_lane`
+//! (`lateral_offset_m`, `heading_rad`, `curvature_per_m`, `lane_width_m` and each one's
+//! `*_sigma`; `null` unless both lanes are held) and `lane_cov_px` (each lane's 3×3 covariance
+//! of `[a1, a2, a3]`, rows, or `null`); `--birdseye DIR` writes `birdseye_NNNNNN.png`, the
+//! ground seen from above (`nav_app::birdseye`). The camera file must be for the input's frame
+//! size (`image_size_px`).
+//!
 //! ## Exit codes
 //! 0 success; 1 error (bad input, configuration, capture setup or streaming error); 2 bad
 //! command line; 3 capture device gone (`ENODEV`); 4 `--max-timeouts` frame timeouts in a row;
@@ -54,6 +63,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use bt848_capture::{InputSelect, PixelFormat, VideoStd};
 use clap::{Parser, ValueEnum};
+use nav_app::birdseye::BirdseyeView;
+use nav_app::camera::{CameraConfig, CameraModel, EgoLaneReport};
 use nav_app::capture_source::{
     self, CaptureMonitor, DeviceFrameInfo, DeviceOptions, DeviceSetup, DeviceStats,
     parse_control_spec,
@@ -62,7 +73,8 @@ use nav_app::overlay::{OverlaySink, render_overlay};
 use nav_app::sources::open_input;
 use nav_app::y4m::Y4mSource;
 use nav_app::{
-    Estimator, FrameSource, GreyFrame, LaneReport, LaneState, LaneTracker, NavError, TrackerConfig,
+    Estimator, FrameSource, GreyFrame, LaneReport, LaneState, LaneTracker, NavError, Side,
+    TrackerConfig,
 };
 use serde::Serialize;
 
@@ -120,6 +132,14 @@ struct Args {
     /// Write annotated frames: a directory of PNGs, or a colour .y4m file.
     #[arg(long, value_name = "DIR|FILE.y4m")]
     overlay: Option<PathBuf>,
+    /// Camera model (TOML, or the presets `robot`, `highway`): adds the ego lane in metres
+    /// (`ego_lane`) and each lane's coefficient covariance (`lane_cov_px`) to the JSON.
+    #[arg(long, value_name = "robot|highway|FILE.toml")]
+    camera: Option<String>,
+    /// Write bird's-eye (inverse perspective) views of the ground with the lanes, one PNG per
+    /// frame, into this directory (needs --camera).
+    #[arg(long, value_name = "DIR", requires = "camera")]
+    birdseye: Option<PathBuf>,
     /// Stop after this many frames.
     #[arg(long, value_name = "N")]
     max_frames: Option<u64>,
@@ -219,6 +239,13 @@ struct FrameJson<'a> {
     lanes: &'a [LaneReport; 2],
     /// Wall time of `LaneTracker::track` on this frame, µs.
     track_us: f64,
+    /// The ego lane in metres with σ (with `--camera`; `null` unless both lanes are held).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ego_lane: Option<Option<EgoLaneReport>>,
+    /// Each lane's coefficient covariance in pixels (with `--camera`; `null` for a lane without
+    /// an estimate).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lane_cov_px: Option<[Option<[[f64; 3]; 3]>; 2]>,
     /// Device fields (with `--device` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     capture: Option<DeviceFrameInfo>,
@@ -286,6 +313,18 @@ fn lane_text(r: &LaneReport) -> String {
 /// `monitor` (also when the run fails) for the summary.
 fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) -> Result<()> {
     let cfg = TrackerConfig::load(&args.config)?;
+    let camera: Option<CameraModel> = match &args.camera {
+        Some(c) => Some(CameraConfig::load(c)?.model()?),
+        None => None,
+    };
+    let mut birdseye = match (&args.birdseye, &camera) {
+        (Some(dir), Some(cam)) => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+            Some((dir.clone(), BirdseyeView::for_camera(cam)?, Vec::new()))
+        }
+        _ => None,
+    };
     let estimator = match args.estimator {
         EstimatorArg::Kif => Estimator::Kif,
         EstimatorArg::Wrls => Estimator::Wrls,
@@ -359,6 +398,9 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                         frame.height
                     );
                 }
+                if let Some(cam) = &camera {
+                    cam.check_frame_size(frame.width, frame.height)?;
+                }
                 slot.insert(LaneTracker::new(
                     &cfg,
                     estimator,
@@ -373,6 +415,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         track_time += dt;
         stats.frames += 1;
         let index = loop_base + meta.index;
+        let ego = camera.as_ref().map(|c| c.ego_lane(t, &report));
         let capture = monitor.as_ref().and_then(CaptureMonitor::last_frame);
         if let Some(c) = capture
             && c.signal_lost != signal_lost
@@ -391,6 +434,11 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                     t_s: meta.t_s,
                     lanes: &report.lanes,
                     track_us: dt.as_secs_f64() * 1e6,
+                    ego_lane: ego,
+                    lane_cov_px: camera.as_ref().map(|_| {
+                        [Side::Left, Side::Right]
+                            .map(|s| t.lane_covariance_px(s).map(|p| p.transpose().into()))
+                    }),
                     capture,
                 },
             )
@@ -401,6 +449,18 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         if let Some(sink) = overlay.as_mut() {
             render_overlay(&frame, t, &mut rgb);
             sink.write(index, &rgb, frame.width, frame.height)?;
+        }
+        if let Some((dir, view, rgb)) = birdseye.as_mut() {
+            view.render(&frame, t, &report, ego.flatten(), rgb);
+            let path = dir.join(format!("birdseye_{index:06}.png"));
+            image::save_buffer(
+                &path,
+                rgb,
+                view.width_px() as u32,
+                view.height_px() as u32,
+                image::ExtendedColorType::Rgb8,
+            )
+            .with_context(|| format!("cannot write {}", path.display()))?;
         }
         let states = [report.lanes[0].state, report.lanes[1].state];
         if !quiet && (states != last_states || stats.frames % 100 == 1) {

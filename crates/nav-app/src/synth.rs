@@ -17,6 +17,8 @@
 //! wall (no lanes), Gaussian sensor noise (seeded ChaCha8), low contrast, and an indoor corridor
 //! whose "lanes" are the floor/wall boundaries.
 
+pub mod road;
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};

@@ -380,6 +380,29 @@ impl LaneTracker {
         self.counters = TrackerCounters::default();
     }
 
+    /// Covariance of one lane's reported coefficients `(a1, a2, a3)` in the pixel
+    /// parameterisation (entry `(i, j)` in units of `a_i·a_j`), `None` when the lane has no
+    /// estimate (initialising or lost) or its information matrix cannot be inverted.
+    ///
+    /// KIF: `P_px = T·Y_u⁻¹·Tᵀ`, the inverse of the information matrix the filter propagates in
+    /// the normalised rows `u = (y − y_c)/s`, mapped by the exact linear map `T` between the
+    /// normalised and the pixel coefficients (`info_filter::RowNorm`). WRLS: its `P` (a scaled
+    /// inverse normal matrix) times `filter.r_sigma_px²`, the least-squares covariance for that
+    /// pixel noise. No allocation.
+    pub fn lane_covariance_px(&self, side: Side) -> Option<Matrix3<f64>> {
+        let lane = &self.lanes[side as usize];
+        if !lane.has_estimate() {
+            return None;
+        }
+        match lane.filter.as_ref()? {
+            LaneFilter::Kif(k) => k.covariance().ok(),
+            LaneFilter::Wrls(w) => {
+                let r = self.cfg.filter.r_sigma_px;
+                w.covariance_px().map(|p| p * (r * r))
+            }
+        }
+    }
+
     /// Windows, points and report of one lane after the last frame (for overlays).
     pub fn lane_view(&self, side: Side) -> LaneView<'_> {
         let lane = &self.lanes[side as usize];

@@ -36,6 +36,11 @@ impl WrlsLane {
         self.inner.estimate()
     }
 
+    /// `P_px` of the WRLS recursion (a scaled inverse normal matrix, see `wrls`).
+    pub(crate) fn covariance_px(&self) -> Option<nalgebra::Matrix3<f64>> {
+        self.inner.covariance().ok()
+    }
+
     pub(crate) fn col_at_row_px(&self, row_px: f64) -> f64 {
         let t = self.inner.estimate();
         (t[0] * row_px + t[1]) * row_px + t[2]

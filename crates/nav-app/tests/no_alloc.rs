@@ -48,6 +48,37 @@ fn wrls_tracking_frames_do_not_allocate() {
 }
 
 #[test]
+fn the_metric_step_does_not_allocate() {
+    // Tracking plus the ego lane in metres (covariances from the tracker, lane-geometry's
+    // estimate) on every frame of a sequence with loss and re-initialisation.
+    let camera = nav_app::camera::CameraConfig::load("robot")
+        .unwrap()
+        .model()
+        .unwrap();
+    let spec = SCENES
+        .iter()
+        .find(|s| s.name == "wall_recovery")
+        .copied()
+        .unwrap();
+    let cfg = TrackerConfig::load(spec.config).unwrap();
+    let mut renderer = SceneRenderer::new(spec, 320, 240);
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
+    let mut frame = GreyFrame::default();
+    let (mut allocs, mut with_ego) = (0, 0);
+    for i in 0..spec.frames {
+        renderer.render(i, &mut frame);
+        let (ego, n) = allocations_in(|| {
+            let report = tracker.track(&frame).unwrap();
+            camera.ego_lane(&tracker, &report)
+        });
+        allocs += n;
+        with_ego += u32::from(ego.is_some());
+    }
+    assert!(with_ego > 15, "{with_ego}");
+    assert_eq!(allocs, 0, "{allocs} allocations");
+}
+
+#[test]
 fn the_counter_sees_an_allocation() {
     // Guards the guard: an allocation on the counting thread is counted.
     let (v, allocations) = allocations_in(|| Vec::<u8>::with_capacity(17));
