@@ -26,6 +26,21 @@ class Lane(TypedDict):
     """Points used this frame (filter update, or the least-squares fit of an initialisation)."""
     initialised: bool
     """True if Hough + least squares (re-)initialised the lane on this frame."""
+    covariance: Optional[npt.NDArray[np.float64]]
+    """3 x 3 covariance of coeffs (pixel parameterisation), from the Kalman information filter's
+    information matrix; None without an estimate."""
+
+class EgoLane(TypedDict):
+    """The ego lane on the ground plane (right/rightward positive), each with its standard deviation
+    propagated from both lanes' covariances."""
+    lateral_offset_m: float
+    lateral_offset_m_sigma: float
+    heading_rad: float
+    heading_rad_sigma: float
+    curvature_per_m: float
+    curvature_per_m_sigma: float
+    lane_width_m: float
+    lane_width_m_sigma: float
 
 class Counters(TypedDict):
     frames: int
@@ -37,10 +52,15 @@ class LaneTracker:
     """One tracker per video stream; every frame must have the size of the first one."""
 
     def __init__(
-        self, config: Optional[str] = None, estimator: Literal["kif", "wrls"] = "kif"
+        self,
+        config: Optional[str] = None,
+        estimator: Literal["kif", "wrls"] = "kif",
+        camera: Optional[str] = None,
     ) -> None:
         """config: None (the default configuration), a preset name ("default", "outdoor",
-        "indoor") or a TOML file path. Raises NavError for a bad configuration (naming the field),
+        "indoor") or a TOML file path. camera: None, a camera preset ("robot", "highway") or a
+        camera TOML file (as nav-app --camera); with it, ego_lane gives the lane in metres.
+        Raises NavError for a bad configuration or camera file (naming the file, line and field),
         ValueError for an unknown estimator."""
     def track(self, frame: npt.NDArray[np.uint8]) -> list[Lane]:
         """Track one frame: uint8 H x W (grey, read in place when C-contiguous) or H x W x 3 (RGB,
@@ -57,6 +77,10 @@ class LaneTracker:
         """Wall time of the Rust tracker alone on the last frame, microseconds (NaN before any)."""
     @property
     def counters(self) -> Counters: ...
+    @property
+    def ego_lane(self) -> Optional[EgoLane]:
+        """The ego lane in metres after the last frame (needs camera=); None unless both lanes
+        are held."""
 
 def read_frames(path: str) -> list[npt.NDArray[np.uint8]]:
     """Every frame of an input, read as `nav-app --input PATH` reads it: a YUV4MPEG2 file, a

@@ -24,7 +24,10 @@
 //! `track` returns `[left, right]`, each a dict: `side` (`"left"`/`"right"`), `state`
 //! (`"initialising"`, `"tracking"`, `"coasting"`, `"lost"`), `coeffs` (`(a1, a2, a3)` in the input's
 //! pixels, or `None`), `rows` (`(y_min, y_max)` px of the points behind the estimate), `points`
-//! (used this frame), `initialised` (Hough + LS ran for it on this frame).
+//! (used this frame), `initialised` (Hough + LS ran for it on this frame), `covariance` (3×3
+//! numpy array: covariance of `coeffs` in pixels, from the KIF's information matrix; `None`
+//! without an estimate). With a camera (`LaneTracker(camera="robot")`), `tracker.ego_lane` gives
+//! the lane in metres with σ after each frame (`lane-geometry`).
 
 use std::time::Instant;
 
@@ -33,7 +36,8 @@ use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use nav_app::{Estimator, LaneReport, LaneTracker as RustTracker, NavError as RustNavError};
+use nav_app::camera::{CameraConfig, CameraModel};
+use nav_app::{Estimator, LaneReport, LaneTracker as RustTracker, NavError as RustNavError, Side};
 
 pyo3::create_exception!(
     ita_nav,
@@ -51,9 +55,11 @@ fn nav_err(e: RustNavError) -> PyErr {
 struct LaneTracker {
     config: nav_app::TrackerConfig,
     estimator: Estimator,
+    camera: Option<CameraModel>,
     tracker: Option<RustTracker>,
     grey: Vec<u8>,
     last_track_us: f64,
+    last_ego: Option<nav_app::camera::EgoLaneReport>,
 }
 
 impl LaneTracker {
@@ -66,6 +72,9 @@ impl LaneTracker {
                      use a new LaneTracker for another frame size"
                 )));
             }
+        }
+        if let Some(c) = &self.camera {
+            c.check_frame_size(width, height).map_err(nav_err)?;
         }
         let slot = &mut self.tracker;
         match slot {
@@ -135,13 +144,23 @@ fn lane_dict<'py>(py: Python<'py>, l: &LaneReport) -> PyResult<Bound<'py, PyDict
 
 #[pymethods]
 impl LaneTracker {
-    /// `LaneTracker(config=None, estimator="kif")`: `config` is `None` (the default
+    /// `LaneTracker(config=None, estimator="kif", camera=None)`: `config` is `None` (the default
     /// configuration), a preset name (`"default"`, `"outdoor"`, `"indoor"`) or a TOML file path;
-    /// `estimator` is `"kif"` (Kalman information filter) or `"wrls"`.
+    /// `estimator` is `"kif"` (Kalman information filter) or `"wrls"`; `camera` a camera preset
+    /// (`"robot"`, `"highway"`) or file (`nav-app --camera`): with it, [`Self::ego_lane`] gives
+    /// the lane in metres after every frame.
     #[new]
-    #[pyo3(signature = (config=None, estimator="kif"))]
-    fn new(config: Option<&str>, estimator: &str) -> PyResult<Self> {
+    #[pyo3(signature = (config=None, estimator="kif", camera=None))]
+    fn new(config: Option<&str>, estimator: &str, camera: Option<&str>) -> PyResult<Self> {
         let config = nav_app::TrackerConfig::load(config.unwrap_or("default")).map_err(nav_err)?;
+        let camera = match camera {
+            Some(c) => Some(
+                CameraConfig::load(c)
+                    .and_then(|c| c.model())
+                    .map_err(nav_err)?,
+            ),
+            None => None,
+        };
         let estimator = match estimator {
             "kif" => Estimator::Kif,
             "wrls" => Estimator::Wrls,
@@ -154,9 +173,11 @@ impl LaneTracker {
         Ok(LaneTracker {
             config,
             estimator,
+            camera,
             tracker: None,
             grey: Vec::new(),
             last_track_us: f64::NAN,
+            last_ego: None,
         })
     }
 
@@ -197,7 +218,51 @@ impl LaneTracker {
                 "frame must be a numpy uint8 array H×W (grey) or H×W×3 (RGB), got dtype {dtype}, shape {shape}"
             )));
         };
-        report.lanes.iter().map(|l| lane_dict(py, l)).collect()
+        let t = self
+            .tracker
+            .as_ref()
+            .ok_or_else(|| PyValueError::new_err("no tracker"))?;
+        self.last_ego = self.camera.as_ref().and_then(|c| c.ego_lane(t, &report));
+        let mut out = Vec::with_capacity(2);
+        for (l, side) in report.lanes.iter().zip([Side::Left, Side::Right]) {
+            let d = lane_dict(py, l)?;
+            let cov = t.lane_covariance_px(side).map(|p| {
+                let rows: Vec<Vec<f64>> = (0..3)
+                    .map(|i| (0..3).map(|j| p[(i, j)]).collect())
+                    .collect();
+                rows
+            });
+            match cov {
+                Some(rows) => d.set_item("covariance", numpy::PyArray2::from_vec2(py, &rows)?)?,
+                None => d.set_item("covariance", py.None())?,
+            }
+            out.push(d);
+        }
+        Ok(out)
+    }
+
+    /// The ego lane in metres after the last frame (needs `camera=`), or `None` when the two lanes
+    /// are not both held: a dict of `lateral_offset_m`, `heading_rad`, `curvature_per_m`,
+    /// `lane_width_m` and each one's `*_sigma` (the per-frame JSON's `ego_lane`).
+    #[getter]
+    fn ego_lane<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(e) = self.last_ego else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        for (k, v) in [
+            ("lateral_offset_m", e.lateral_offset_m),
+            ("lateral_offset_m_sigma", e.lateral_offset_m_sigma),
+            ("heading_rad", e.heading_rad),
+            ("heading_rad_sigma", e.heading_rad_sigma),
+            ("curvature_per_m", e.curvature_per_m),
+            ("curvature_per_m_sigma", e.curvature_per_m_sigma),
+            ("lane_width_m", e.lane_width_m),
+            ("lane_width_m_sigma", e.lane_width_m_sigma),
+        ] {
+            d.set_item(k, v)?;
+        }
+        Ok(Some(d))
     }
 
     /// Forget both lanes: the next frame initialises again (Hough + least squares).
@@ -205,6 +270,7 @@ impl LaneTracker {
         if let Some(t) = &mut self.tracker {
             t.reset();
         }
+        self.last_ego = None;
     }
 
     /// `(height, width)` of the frames this tracker takes, or `None` before the first frame.

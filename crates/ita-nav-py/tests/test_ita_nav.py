@@ -64,12 +64,17 @@ def test_the_bundled_real_frames_have_both_lanes_on_every_frame():
     assert tracker.counters["frames"] == 30
 
 
+def plain(lanes):
+    """Lanes with the covariance arrays as nested lists (comparable with ==)."""
+    return [{k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in l.items()} for l in lanes]
+
+
 def test_an_rgb_frame_is_converted_with_bt601_luma():
     frame = ita_nav.read_frames(str(SAMPLE))[0]
     grey_lanes = ita_nav.LaneTracker().track(frame)
     # R = G = B = Y: BT.601 luma gives Y back, so the lanes are the grey frame's.
     rgb = np.repeat(frame[:, :, None], 3, axis=2)
-    assert ita_nav.LaneTracker().track(rgb) == grey_lanes
+    assert plain(ita_nav.LaneTracker().track(rgb)) == plain(grey_lanes)
     # A pure red frame is 0.299·255 ≈ 76 grey: no lanes, but no error.
     red = np.zeros((240, 320, 3), np.uint8)
     red[:, :, 0] = 255
@@ -138,3 +143,38 @@ def test_bad_configuration_and_estimator_are_named(tmp_path):
 def test_presets_load_by_name():
     for name in ("default", "outdoor", "indoor"):
         assert repr(ita_nav.LaneTracker(config=name)).startswith("LaneTracker(")
+
+
+def test_covariance_and_metric_ego_lane_equal_the_rust_binary():
+    frames = ita_nav.read_frames(str(SAMPLE))
+    rust = rust_run(SAMPLE, "--camera", "highway")
+    tracker = ita_nav.LaneTracker(camera="highway")
+    held = 0
+    for i, (frame, r) in enumerate(zip(frames, rust)):
+        lanes = tracker.track(frame)
+        for k, lane in enumerate(lanes):
+            cov_rust = r["lane_cov_px"][k]
+            assert (lane["covariance"] is None) == (cov_rust is None), i
+            if cov_rust is not None:
+                assert lane["covariance"].shape == (3, 3)
+                assert lane["covariance"].tolist() == cov_rust, i
+        ego = tracker.ego_lane
+        assert (ego is None) == (r["ego_lane"] is None), i
+        if ego is not None:
+            held += 1
+            assert ego == r["ego_lane"], i
+            assert ego["lane_width_m_sigma"] > 0
+    assert held == len(frames)
+    tracker.reset()
+    assert tracker.ego_lane is None
+
+
+def test_without_a_camera_there_is_no_ego_lane_and_a_wrong_camera_is_refused():
+    frame = ita_nav.read_frames(str(SAMPLE))[0]
+    t = ita_nav.LaneTracker()
+    t.track(frame)
+    assert t.ego_lane is None
+    with pytest.raises(ita_nav.NavError, match="image_size_px"):
+        ita_nav.LaneTracker(camera="highway").track(np.zeros((180, 320), np.uint8))
+    with pytest.raises(ita_nav.NavError):
+        ita_nav.LaneTracker(camera="no-such-camera.toml")
