@@ -41,25 +41,7 @@ impl ScenarioError {
     }
 }
 
-/// `[filter] measurement_jacobian`: which H the filter linearises the SD measurement with.
-/// The simulated measurement is always the true nonlinear model; only the filter's H changes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MeasurementJacobian {
-    /// The verified H, `sighting_model::sighting_jacobian3` (checked against finite
-    /// differences of the nonlinear model). The default.
-    #[default]
-    Verified,
-    /// The paper's eqs. 15–18 as printed, `sighting_model::paper_printed_jacobian3` (α₀ read
-    /// as printed, i.e. the depression: h rows × cos 2ε; printed H₃ kept). For reproducing the
-    /// paper's filter only.
-    PaperPrinted,
-    /// The printed eqs. 15–18 with only α₀ repaired (read as the elevation):
-    /// `sighting_model::paper_eq15_jacobian3` with `PaperAlphaReading::Elevation` = the
-    /// verified H plus the printed H₃ (the tilt term, ≈ ρ/R of the δp entries, with its tan λ
-    /// sign as printed). Isolates the paper's other flaw.
-    PaperPrintedElevation,
-}
+pub use ins_sd_filter::MeasurementJacobian;
 
 /// `[filter]`: initial covariance, process-noise tuning, measurement noise, feedback switch
 /// and the discretisation / adaptive-Q parameters of the INS/SD error-state filter.
@@ -204,14 +186,14 @@ impl FilterConfig {
         Ok(())
     }
 
-    /// Initial covariance diagonal in state units (m², (m/s)², rad², (m/s²)², (rad/s)²).
-    pub(crate) fn p0_diagonal(&self) -> [f64; 5] {
+    /// Initial σ in state units (m, m/s, rad, m/s², rad/s).
+    pub(crate) fn p0_sigmas(&self) -> [f64; 5] {
         [
-            self.p0_pos_sigma_m.powi(2),
-            self.p0_vel_sigma_mps.powi(2),
-            (self.p0_psi_sigma_mrad * 1e-3).powi(2),
-            (self.p0_accel_bias_sigma_mg * MG_TO_MPS2).powi(2),
-            (self.p0_gyro_drift_sigma_degph * DEGPH_TO_RADPS).powi(2),
+            self.p0_pos_sigma_m,
+            self.p0_vel_sigma_mps,
+            self.p0_psi_sigma_mrad * 1e-3,
+            self.p0_accel_bias_sigma_mg * MG_TO_MPS2,
+            self.p0_gyro_drift_sigma_degph * DEGPH_TO_RADPS,
         ]
     }
 

@@ -42,6 +42,10 @@ pub struct IntervalModel {
     sum_vel: Vector3<f64>,
     sum_f: Vector3<f64>,
     sum_c: Matrix3<f64>,
+    // Length of the current sub-interval, s, and whether every step in it had the nominal
+    // length (then τ = n·T_s exactly, as for a regular IMU).
+    sum_dt: f64,
+    all_nominal: bool,
     // Position in the interval.
     steps_done: usize,
     sub_done: usize,
@@ -74,6 +78,8 @@ impl IntervalModel {
             sum_vel: Vector3::zeros(),
             sum_f: Vector3::zeros(),
             sum_c: Matrix3::zeros(),
+            sum_dt: 0.0,
+            all_nominal: true,
             steps_done: 0,
             sub_done: 0,
             phi: Transition::from_dense(&Mat15::identity()),
@@ -86,10 +92,23 @@ impl IntervalModel {
         &self.w
     }
 
-    /// Adds the linearisation point after one INS step. Closes a sub-interval when due.
+    /// Adds the linearisation point after one INS step of the nominal length. Closes a
+    /// sub-interval when due.
     #[inline]
     pub fn push(&mut self, lp: &LinearizationPoint) {
+        self.push_dt(lp, self.step_s);
+    }
+
+    /// Adds the linearisation point after one INS step of `dt_s` seconds (irregular samples).
+    /// Sub-intervals still close after `steps_per_interval / subintervals` steps; the
+    /// sub-interval's length is the sum of its steps (n·T_s exactly when every step was
+    /// nominal), and the averages are plain means over the steps (for steps of unequal length
+    /// a first-order approximation of the time average).
+    #[inline]
+    pub fn push_dt(&mut self, lp: &LinearizationPoint, dt_s: f64) {
         self.n += 1;
+        self.sum_dt += dt_s;
+        self.all_nominal &= dt_s == self.step_s;
         self.sum_lat += lp.pos.lat_rad;
         self.sum_lon += lp.pos.lon_rad;
         self.sum_alt += lp.pos.alt_m;
@@ -119,7 +138,12 @@ impl IntervalModel {
             c_b_to_n: self.sum_c * inv,
         };
         let a = error_model::system_matrix(&lp);
-        let (phi_s, q_s) = error_model::discretize_fast(&a, &self.w, self.n as f64 * self.step_s);
+        let tau_s = if self.all_nominal {
+            self.n as f64 * self.step_s
+        } else {
+            self.sum_dt
+        };
+        let (phi_s, q_s) = error_model::discretize_fast(&a, &self.w, tau_s);
         let phi11: SMatrix<f64, 9, 9> = phi_s.phi11 * self.phi.phi11;
         let phi12: SMatrix<f64, 9, 6> = phi_s.phi11 * self.phi.phi12 + phi_s.phi12;
         self.phi = Transition { phi11, phi12 };
@@ -132,11 +156,20 @@ impl IntervalModel {
         self.sum_vel = Vector3::zeros();
         self.sum_f = Vector3::zeros();
         self.sum_c = Matrix3::zeros();
+        self.sum_dt = 0.0;
+        self.all_nominal = true;
     }
 
     /// Number of INS steps pushed since the last [`IntervalModel::take`].
     pub fn steps_done(&self) -> usize {
         self.steps_done
+    }
+
+    /// (Φ, Q) from the last [`IntervalModel::take`] to now, without starting a new interval
+    /// (works on a copy; for predictions between updates).
+    pub fn peek(&self) -> (Mat15, Mat15) {
+        let mut copy = self.clone();
+        copy.take()
     }
 
     /// Returns (Φ_T dense, Q_T) for the steps pushed since the last call (closing a partial
