@@ -105,6 +105,7 @@ pub struct InsSdFilter {
     last_epoch_s: f64,
     gate_threshold: Option<f64>,
     stats: FilterStatistics,
+    last_report: UpdateReport,
 }
 
 fn nav_finite(s: &NavState) -> bool {
@@ -210,6 +211,7 @@ impl InsSdFilter {
             t_s: t0_s,
             last_epoch_s: f64::NEG_INFINITY,
             stats: FilterStatistics::default(),
+            last_report: UpdateReport::default(),
         })
     }
 
@@ -466,6 +468,7 @@ impl InsSdFilter {
             self.feedback();
             report.fed_back = true;
         }
+        self.last_report = report;
         Ok(report)
     }
 
@@ -564,6 +567,11 @@ impl InsSdFilter {
     /// The adaptive Q̂ over one interval (`None` for the KF or before the window is full).
     pub fn q_estimate(&self) -> Option<&Mat15> {
         self.est.as_deref().and_then(Est::q_estimate)
+    }
+
+    /// What the last update with at least one sighting did.
+    pub fn last_report(&self) -> &UpdateReport {
+        &self.last_report
     }
 
     /// Totals since construction (sightings used and rejected, …).

@@ -99,6 +99,7 @@
 //! simulation's wall time is given beside it.
 
 pub mod driver;
+pub mod export;
 pub mod plot;
 pub mod report;
 pub mod stats;
@@ -157,6 +158,10 @@ pub struct RunArgs {
     /// Cut the flight to its first SECONDS (quick looks and tests).
     #[arg(long, value_name = "SECONDS")]
     pub duration: Option<f64>,
+    /// Also write run 0 of the KF and the AKF as IMU/sighting/truth logs into DIR/kf and
+    /// DIR/akf, for `nav-app ins` (formats: nav_app::ins_sd::logs).
+    #[arg(long, value_name = "DIR")]
+    pub export_logs: Option<PathBuf>,
 }
 
 /// Options of `merge`.
@@ -399,6 +404,9 @@ pub fn simulate(args: &RunArgs) -> Result<PathBuf> {
     let stats = simulate_stats(&r, true)?;
     write_outputs(&r.out, &stats, !r.sharded)?;
     print_done(&r.out, &stats, !r.sharded);
+    if let Some(dir) = &args.export_logs {
+        export::export_logs(&r, dir)?;
+    }
     Ok(r.out)
 }
 

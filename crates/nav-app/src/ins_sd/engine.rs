@@ -11,12 +11,37 @@ use ins_sd_filter::{
     ErrorSigmas, Estimator, FilterError, InsSdFilter, InsSdFilterConfig, LandmarkEntry,
     LandmarkTable, ProcessNoisePsd, Sighting, Vec15, nav_pose,
 };
-use nalgebra::{SVector, Vector2};
+use nalgebra::{SVector, Vector2, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sighting_model::Landmark;
 
 use super::{Mode, RunError, RunOutcome, Sample, Scenario};
+
+/// Sees what a run feeds its filter (for exporting a run as logs, [`super::logs`]). Every
+/// method defaults to nothing; the Monte Carlo uses [`NoObserver`] (compiled away).
+pub trait RunObserver {
+    /// The INS start: time 0 and the initial navigation state (the truth at t = 0).
+    fn start(&mut self, _initial: &NavState) {}
+    /// One IMU sample at `t_s` (mean specific force, body m/s², and angular rate, body rad/s,
+    /// over the interval ending at `t_s`).
+    fn imu(
+        &mut self,
+        _t_s: f64,
+        _specific_force_body_mps2: &Vector3<f64>,
+        _ang_rate_body_radps: &Vector3<f64>,
+    ) {
+    }
+    /// A sighting epoch: the sightings handed to the filter and the filter after its update.
+    fn epoch(&mut self, _t_s: f64, _sightings: &[Sighting], _filter: &InsSdFilter) {}
+    /// The truth at a 1 Hz record time (t = 0, 1, …).
+    fn truth(&mut self, _t_s: f64, _truth: &NavState) {}
+}
+
+/// The observer that observes nothing.
+pub struct NoObserver;
+
+impl RunObserver for NoObserver {}
 
 /// Everything a run carries from step to step (built once, no allocation in the loop).
 pub(crate) struct Loop {
@@ -163,7 +188,10 @@ impl Loop {
     /// One 100 Hz step: corrupt the ideal IMU sample of the interval just flown and hand it to
     /// the filter (time stamp k·T_s).
     #[inline]
-    pub(crate) fn step(&mut self, ideal: &TruthSample) -> Result<(), RunError> {
+    pub(crate) fn step(
+        &mut self,
+        ideal: &TruthSample,
+    ) -> Result<(Vector3<f64>, Vector3<f64>), RunError> {
         let (f, w) = self.imu.measure(
             &ideal.specific_force_body_mps2,
             &ideal.ang_rate_ib_body_radps,
@@ -172,7 +200,8 @@ impl Loop {
         self.k += 1;
         self.filter
             .propagate_rates(self.k as f64 * self.step_s, &f, &w)
-            .map_err(run_error)
+            .map_err(run_error)?;
+        Ok((f, w))
     }
 
     /// The full true error of the INS (15 states): δp, δv, ψ of the INS against `truth`,
@@ -273,6 +302,17 @@ pub(crate) fn run(
     seed: u64,
     out: &mut [Sample],
 ) -> Result<RunOutcome, RunError> {
+    run_observed(scenario, mode, seed, out, &mut NoObserver)
+}
+
+/// [`run`], showing `obs` every IMU sample, sighting epoch and 1 Hz truth.
+pub(crate) fn run_observed<O: RunObserver>(
+    scenario: &Scenario,
+    mode: Mode,
+    seed: u64,
+    out: &mut [Sample],
+    obs: &mut O,
+) -> Result<RunOutcome, RunError> {
     let plan = scenario.plan()?;
     if out.len() != plan.samples {
         return Err(RunError::OutputLength {
@@ -290,6 +330,8 @@ pub(crate) fn run(
     };
     let mut lp = Loop::new(scenario, mode, seed, &first)?;
     let truth0 = nav_state(&first);
+    obs.start(&truth0);
+    obs.truth(0.0, &truth0);
     out[0] = lp.sample(0.0, &truth0, 0.0, None)?;
     let mut ideal = first;
     let mut distance_m = 0.0;
@@ -299,7 +341,8 @@ pub(crate) fn run(
     let mut last_nis: Option<f64> = None;
     for k in 1..=plan.steps {
         let Some(s) = truth_it.next() else { break };
-        lp.step(&ideal)?;
+        let (f, w) = lp.step(&ideal)?;
+        obs.imu(k as f64 * plan.step_s, &f, &w);
         epochs += 1;
         let speed = s.vel_ned_mps.norm();
         distance_m += 0.5 * (speed + speed_prev) * plan.step_s;
@@ -314,6 +357,10 @@ pub(crate) fn run(
         let truth = nav_state(&s);
         if update_due {
             last_nis = Some(lp.sd_update(t_s, &truth)?);
+            obs.epoch(t_s, &lp.sightings, &lp.filter);
+        }
+        if sample_due {
+            obs.truth(t_s, &truth);
         }
         if sample_due && written < out.len() {
             out[written] = lp.sample(t_s, &truth, distance_m, last_nis.take())?;

@@ -187,10 +187,12 @@
 
 mod config;
 mod engine;
+pub mod logs;
 /// The interval discretisation (moved to `ins-sd-filter`; re-exported for existing users).
 pub use ins_sd_filter::interval;
 
 pub use config::{FilterConfig, MeasurementJacobian, MonteCarloConfig, ScenarioError};
+pub use engine::{NoObserver, RunObserver};
 
 use ins_errors::InsError;
 use ins_errors::config::{ImuConfig, TrajectoryConfig};
@@ -245,6 +247,25 @@ impl Scenario {
         };
         s.validate()?;
         Ok(s)
+    }
+
+    /// The scenario as a TOML document that [`Scenario::from_toml_str`] reads back unchanged.
+    ///
+    /// # Errors
+    /// The serializer's (not expected for a validated scenario).
+    pub fn to_toml_string(&self) -> Result<String, toml::ser::Error> {
+        toml::to_string(&config::ScenarioFile {
+            trajectory: self.trajectory.clone(),
+            imu: self.imu.clone(),
+            sighting: self.sighting.clone(),
+            filter: self.filter.clone(),
+            monte_carlo: self.monte_carlo.clone(),
+        })
+    }
+
+    /// The online filter's configuration for `mode` (what [`run`] and `nav-app ins` use).
+    pub fn online_filter_config(&self, mode: Mode) -> ins_sd_filter::InsSdFilterConfig {
+        engine::online_config(self, mode)
     }
 
     /// The paper's scenario, equal to `configs/paper.toml` (tested).
