@@ -1,6 +1,6 @@
 //! The filter's configuration, in SI units.
 
-use akf::AdaptiveQConfig;
+use akf::{AdaptiveQConfig, QProjection, SageHusaConfig};
 use serde::{Deserialize, Serialize};
 
 use crate::FilterError;
@@ -85,6 +85,20 @@ pub enum Estimator {
     /// Adaptive KF of Mohamed & Schwarz (paper eq. 19): Q̂ from a window of state corrections,
     /// used as the next interval's Q once the window is full (the a-priori Q before).
     MohamedSchwarz(AdaptiveQConfig),
+    /// Sage–Husa with a forgetting factor ([`akf::SageHusaQ`]): the exponentially weighted mean
+    /// of the single-update estimates, used once `warmup` updates have been seen.
+    SageHusa(SageHusaConfig),
+}
+
+impl Estimator {
+    /// The projection of the adaptive estimate (`None` for KF and stand-alone).
+    pub fn projection(&self) -> Option<QProjection> {
+        match self {
+            Estimator::MohamedSchwarz(c) => Some(c.projection),
+            Estimator::SageHusa(c) => Some(c.projection),
+            _ => None,
+        }
+    }
 }
 
 /// Everything the online filter needs besides the landmark table and the initial state.
@@ -196,14 +210,16 @@ impl InsSdFilterConfig {
         {
             return Err(bad("gate_probability", "must be within (0, 1)", p));
         }
-        if let Estimator::MohamedSchwarz(c) = &self.estimator {
-            c.validate(akf::DEFAULT_WINDOW_CAPACITY)
-                .map_err(|e| FilterError::InvalidConfig {
-                    field: "estimator",
-                    requirement: "adaptive-Q configuration must be valid",
-                    value: e.to_string(),
-                })?;
-        }
+        let checked = match &self.estimator {
+            Estimator::MohamedSchwarz(c) => c.validate(akf::DEFAULT_WINDOW_CAPACITY),
+            Estimator::SageHusa(c) => c.validate(),
+            _ => Ok(()),
+        };
+        checked.map_err(|e| FilterError::InvalidConfig {
+            field: "estimator",
+            requirement: "adaptive-Q configuration must be valid",
+            value: e.to_string(),
+        })?;
         Ok(())
     }
 

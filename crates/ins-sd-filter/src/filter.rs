@@ -1,6 +1,6 @@
 //! The online INS/SD filter object.
 
-use akf::{AdaptiveQ, KalmanFilter};
+use akf::{AdaptiveQ, KalmanFilter, QProjection, SageHusaQ};
 use ins_errors::error_model::Mat15;
 use ins_errors::strapdown::{NavState, Strapdown};
 use nalgebra::{Matrix2, Rotation3, SMatrix, SVector, Vector2, Vector3};
@@ -71,6 +71,7 @@ pub struct FilterStatistics {
 enum Adaptive {
     None,
     MohamedSchwarz(AdaptiveQ<15>),
+    SageHusa(SageHusaQ<15>),
 }
 
 /// KF + adaptive estimator + what the Q̂ estimate needs between pushes.
@@ -82,14 +83,47 @@ struct Est {
     p_post_prev: Mat15,
     /// Φ accumulated since the last push (None = identity).
     phi_since_push: Option<Mat15>,
+    /// Structured projection: the fitted noise densities (and Σ q̂_k B_k of the interval they
+    /// were fitted on), once the estimator has an estimate.
+    structured: bool,
+    densities: Option<SVector<f64, 4>>,
+    structured_q: Option<Mat15>,
 }
 
 impl Est {
+    /// The projected estimate (structured: Σ q̂_k B_k of the last fitted interval).
     fn q_estimate(&self) -> Option<&Mat15> {
+        if self.structured {
+            return self.structured_q.as_ref();
+        }
         match &self.adaptive {
             Adaptive::None => None,
             Adaptive::MohamedSchwarz(a) => a.estimate(),
+            Adaptive::SageHusa(a) => a.estimate(),
         }
+    }
+
+    /// The raw (unprojected) estimate once the estimator offers one.
+    fn raw_when_ready(&self) -> Option<&Mat15> {
+        match &self.adaptive {
+            Adaptive::None => None,
+            Adaptive::MohamedSchwarz(a) => a.estimate().and(a.raw_estimate()),
+            Adaptive::SageHusa(a) => a.estimate().and(a.raw_estimate()),
+        }
+    }
+
+    /// The adaptive Q for the prediction over an interval with noise basis `basis` (`None`:
+    /// use the model's): structured, Σ q̂_k B_k on this interval's basis.
+    fn q_for_prediction(&self, basis: &[Mat15; 4]) -> Option<Mat15> {
+        if self.structured {
+            let d = self.densities?;
+            let mut q = Mat15::zeros();
+            for (k, b) in basis.iter().enumerate() {
+                q += b * d[k];
+            }
+            return Some(q);
+        }
+        self.q_estimate().copied()
     }
 }
 
@@ -169,15 +203,19 @@ impl InsSdFilter {
             });
         }
         let ins = Strapdown::new(initial, config.imu_step_s).map_err(FilterError::Ins)?;
-        let interval = IntervalModel::new(
+        let mut interval = IntervalModel::new(
             config.steps_per_update(),
             config.phi_subintervals,
             config.imu_step_s,
             config.process_noise.as_array(),
         );
+        let structured = config.estimator.projection() == Some(QProjection::Structured);
+        if structured {
+            interval.enable_noise_basis();
+        }
         let est = match config.estimator {
             Estimator::StandAlone => None,
-            Estimator::Kalman | Estimator::MohamedSchwarz(_) => {
+            Estimator::Kalman | Estimator::MohamedSchwarz(_) | Estimator::SageHusa(_) => {
                 let mut p0 = Mat15::zeros();
                 for (b, v) in config.p0_sigma.variances().iter().enumerate() {
                     for i in 0..3 {
@@ -186,11 +224,12 @@ impl InsSdFilter {
                 }
                 let kf = KalmanFilter::new(Vec15::zeros(), p0)
                     .map_err(|source| FilterError::Akf { t_s: t0_s, source })?;
+                let ae = |source| FilterError::Akf { t_s: t0_s, source };
                 let adaptive = match config.estimator {
-                    Estimator::MohamedSchwarz(c) => Adaptive::MohamedSchwarz(
-                        AdaptiveQ::new(c)
-                            .map_err(|source| FilterError::Akf { t_s: t0_s, source })?,
-                    ),
+                    Estimator::MohamedSchwarz(c) => {
+                        Adaptive::MohamedSchwarz(AdaptiveQ::new(c).map_err(ae)?)
+                    }
+                    Estimator::SageHusa(c) => Adaptive::SageHusa(SageHusaQ::new(c).map_err(ae)?),
                     _ => Adaptive::None,
                 };
                 Some(Box::new(Est {
@@ -198,6 +237,9 @@ impl InsSdFilter {
                     adaptive,
                     p_post_prev: p0,
                     phi_since_push: None,
+                    structured,
+                    densities: None,
+                    structured_q: None,
                 }))
             }
         };
@@ -383,10 +425,10 @@ impl InsSdFilter {
         }; MAX_BATCH];
         // Predict over the interval.
         let (phi, q_model) = self.interval.take();
-        let q = match est.q_estimate() {
+        let q = match est.q_for_prediction(self.interval.noise_basis()) {
             Some(q_hat) => {
                 report.adaptive_q = true;
-                *q_hat
+                q_hat
             }
             None => q_model,
         };
@@ -454,9 +496,22 @@ impl InsSdFilter {
                 Adaptive::MohamedSchwarz(a) => a
                     .push(&dx, &p_post, &est.p_post_prev, &phi_push)
                     .map(|_| ()),
+                Adaptive::SageHusa(a) => a
+                    .push(&dx, &p_post, &est.p_post_prev, &phi_push)
+                    .map(|_| ()),
             };
-            est.p_post_prev = p_post;
             pushed.map_err(ae)?;
+            if est.structured
+                && let Some(raw) = est.raw_when_ready()
+            {
+                // Fit on this interval's noise basis, residual scaled by the previous P⁺.
+                let scale = est.p_post_prev.diagonal();
+                let fit = akf::project_structured(raw, self.interval.noise_basis(), &scale)
+                    .map_err(ae)?;
+                est.densities = Some(fit.densities);
+                est.structured_q = Some(fit.matrix);
+            }
+            est.p_post_prev = p_post;
         }
         if !est.kf.state().iter().all(|x| x.is_finite()) || !nis_sum.is_finite() {
             return Err(FilterError::NonFiniteState {
@@ -531,6 +586,7 @@ impl InsSdFilter {
     pub fn predicted(&self) -> Option<(Vec15, Mat15)> {
         let est = self.est.as_deref()?;
         let (phi, q_model) = self.interval.peek();
+        // (Structured: the last fitted Σ q̂_k B_k, an approximation for a partial interval.)
         let q = est.q_estimate().copied().unwrap_or(q_model);
         let x = phi * est.kf.state();
         let mut p = phi * est.kf.covariance() * phi.transpose() + q;
@@ -562,6 +618,12 @@ impl InsSdFilter {
             a + Vector3::new(x[9], x[10], x[11]),
             g + Vector3::new(x[12], x[13], x[14]),
         )
+    }
+
+    /// The fitted noise densities of the structured projection (accelerometer white
+    /// (m/s²)²/Hz, gyro white rad²/s, bias RW (m/s²)²/s, drift RW (rad/s)²/s), once fitted.
+    pub fn fitted_noise_densities(&self) -> Option<SVector<f64, 4>> {
+        self.est.as_deref().and_then(|e| e.densities)
     }
 
     /// The adaptive Q̂ over one interval (`None` for the KF or before the window is full).

@@ -51,6 +51,10 @@ pub struct IntervalModel {
     sub_done: usize,
     phi: Transition,
     q: Mat15,
+    // Noise matrices of the four noise inputs at unit density (only when enabled).
+    basis_on: bool,
+    basis: [Mat15; 4],
+    basis_taken: [Mat15; 4],
 }
 
 impl IntervalModel {
@@ -84,7 +88,25 @@ impl IntervalModel {
             sub_done: 0,
             phi: Transition::from_dense(&Mat15::identity()),
             q: Mat15::zeros(),
+            basis_on: false,
+            basis: [Mat15::zeros(); 4],
+            basis_taken: [Mat15::zeros(); 4],
         }
+    }
+
+    /// Also accumulates, per interval, the noise matrices B_k of the four noise inputs at unit
+    /// density (accelerometer white noise on δv, gyro white noise on ψ, random walks on ∇ and
+    /// ε): Q_T = Σ_k psd_k B_k exactly (Q_T is linear in W). Read them with
+    /// [`IntervalModel::noise_basis`] after [`IntervalModel::take`]. Costs four more
+    /// discretisations per sub-interval.
+    pub fn enable_noise_basis(&mut self) {
+        self.basis_on = true;
+    }
+
+    /// The B_k of the interval returned by the last [`IntervalModel::take`] (zeros unless
+    /// [`IntervalModel::enable_noise_basis`]).
+    pub fn noise_basis(&self) -> &[Mat15; 4] {
+        &self.basis_taken
     }
 
     /// The constant W = G Q_c Gᵀ (state units² / s).
@@ -148,6 +170,16 @@ impl IntervalModel {
         let phi12: SMatrix<f64, 9, 6> = phi_s.phi11 * self.phi.phi12 + phi_s.phi12;
         self.phi = Transition { phi11, phi12 };
         error_model::propagate_covariance(&mut self.q, &phi_s, &q_s);
+        if self.basis_on {
+            for (k, b) in self.basis.iter_mut().enumerate() {
+                let mut w = Mat15::zeros();
+                for i in 0..3 {
+                    w[(3 + 3 * k + i, 3 + 3 * k + i)] = 1.0;
+                }
+                let (phi_k, q_k) = error_model::discretize_fast(&a, &w, tau_s);
+                error_model::propagate_covariance(b, &phi_k, &q_k);
+            }
+        }
         self.sub_done += 1;
         self.n = 0;
         self.sum_lat = 0.0;
@@ -179,6 +211,10 @@ impl IntervalModel {
         let out = (self.phi.to_dense(), self.q);
         self.phi = Transition::from_dense(&Mat15::identity());
         self.q = Mat15::zeros();
+        if self.basis_on {
+            self.basis_taken = self.basis;
+            self.basis = [Mat15::zeros(); 4];
+        }
         self.steps_done = 0;
         self.sub_done = 0;
         out

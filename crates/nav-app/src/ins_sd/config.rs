@@ -86,15 +86,39 @@ pub struct FilterConfig {
     pub phi_subintervals: usize,
     /// AKF window N (Mohamed & Schwarz; paper: 10), 1 ..= 64.
     pub akf_window: usize,
-    /// How the AKF's indefinite Q̂ is made PSD: `"eigen_clip"` or `"diagonal"`.
+    /// How the AKF's indefinite Q̂ is made PSD: `"eigen_clip"`, `"diagonal"` or `"structured"`
+    /// (non-negative least squares onto the model's four noise inputs, Q̂ = Σ q̂_k B_k).
     pub akf_projection: QProjection,
     /// Floor of the projected Q̂ (eigenvalues or diagonal), state units² per SD interval (≥ 0).
     pub akf_min_variance: f64,
+    /// Adaptive scheme of the `akf` configuration: `"mohamed_schwarz"` (paper eq. 19, window
+    /// `akf_window`; the default when the key is absent) or `"sage_husa"` (forgetting factor
+    /// `sage_husa_forgetting`, warm-up `akf_window` updates).
+    #[serde(default)]
+    pub akf_scheme: AkfScheme,
+    /// Sage–Husa forgetting factor b, 0 < b ≤ 1 (memory ≈ 1/(1 − b) updates); default 0.95.
+    #[serde(default = "default_forgetting")]
+    pub sage_husa_forgetting: f64,
     /// Measurement matrix of the filter: `"verified"` (default when the key is absent),
     /// `"paper_printed"` (the printed eqs. 15–18) or `"paper_printed_elevation"` (printed, α₀
     /// repaired); the last two for comparison with the paper.
     #[serde(default)]
     pub measurement_jacobian: MeasurementJacobian,
+}
+
+/// `[filter] akf_scheme`: the adaptive process-noise estimator of the `akf` configuration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AkfScheme {
+    /// Mohamed & Schwarz (paper eq. 19), window `akf_window`.
+    #[default]
+    MohamedSchwarz,
+    /// Sage–Husa with forgetting factor `sage_husa_forgetting`.
+    SageHusa,
+}
+
+fn default_forgetting() -> f64 {
+    0.95
 }
 
 impl Default for FilterConfig {
@@ -122,6 +146,8 @@ impl FilterConfig {
             akf_window: 10,
             akf_projection: QProjection::Diagonal,
             akf_min_variance: 0.0,
+            akf_scheme: AkfScheme::MohamedSchwarz,
+            sage_husa_forgetting: 0.95,
             measurement_jacobian: MeasurementJacobian::Verified,
         }
     }
@@ -174,6 +200,13 @@ impl FilterConfig {
                 "filter.phi_subintervals",
                 "must be >= 1",
                 self.phi_subintervals,
+            ));
+        }
+        if !(self.sage_husa_forgetting > 0.0 && self.sage_husa_forgetting <= 1.0) {
+            return Err(ScenarioError::invalid(
+                "filter.sage_husa_forgetting",
+                "must be within (0, 1]",
+                self.sage_husa_forgetting,
             ));
         }
         if self.akf_window == 0 || self.akf_window > akf::DEFAULT_WINDOW_CAPACITY {

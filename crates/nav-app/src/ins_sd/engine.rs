@@ -2,7 +2,7 @@
 //! (truth, IMU errors, sighting generation) around the online filter of `ins-sd-filter`, which
 //! is the one filter code path (the same object `nav-app ins` runs on logs).
 
-use akf::AdaptiveQConfig;
+use akf::{AdaptiveQConfig, QProjection, SageHusaConfig};
 use ins_errors::error_model;
 use ins_errors::imu::{ImuErrorParams, ImuErrors};
 use ins_errors::strapdown::NavState;
@@ -16,7 +16,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sighting_model::Landmark;
 
-use super::{Mode, RunError, RunOutcome, Sample, Scenario};
+use super::{AkfScheme, Mode, RunError, RunOutcome, Sample, Scenario};
 
 /// Sees what a run feeds its filter (for exporting a run as logs, [`super::logs`]). Every
 /// method defaults to nothing; the Monte Carlo uses [`NoObserver`] (compiled away).
@@ -90,14 +90,32 @@ pub(crate) fn online_config(scenario: &Scenario, mode: Mode) -> InsSdFilterConfi
         r_var_m2: f.r_var_m2,
         open_loop_until_s: f.open_loop_until_s,
         gate_probability: None,
-        estimator: match mode {
-            Mode::Standalone => Estimator::StandAlone,
-            Mode::Kf => Estimator::Kalman,
-            Mode::Akf => Estimator::MohamedSchwarz(AdaptiveQConfig {
-                window: f.akf_window,
-                projection: f.akf_projection,
-                min_variance: f.akf_min_variance,
-            }),
+        estimator: {
+            let ms = |projection| {
+                Estimator::MohamedSchwarz(AdaptiveQConfig {
+                    window: f.akf_window,
+                    projection,
+                    min_variance: f.akf_min_variance,
+                })
+            };
+            let sh = |projection| {
+                Estimator::SageHusa(SageHusaConfig {
+                    forgetting: f.sage_husa_forgetting,
+                    warmup: f.akf_window,
+                    projection,
+                    min_variance: f.akf_min_variance,
+                })
+            };
+            match mode {
+                Mode::Standalone => Estimator::StandAlone,
+                Mode::Kf => Estimator::Kalman,
+                Mode::Akf => match f.akf_scheme {
+                    AkfScheme::MohamedSchwarz => ms(f.akf_projection),
+                    AkfScheme::SageHusa => sh(f.akf_projection),
+                },
+                Mode::AkfSageHusa => sh(f.akf_projection),
+                Mode::AkfStructured => ms(QProjection::Structured),
+            }
         },
         jacobian: f.measurement_jacobian,
     }
