@@ -23,6 +23,11 @@ pub enum QProjection {
     /// Keep only diag(Q̂), each entry raised to its own floor (see
     /// [`AdaptiveQ::set_diagonal_floors`]); off-diagonals set to 0. Unit-safe, drops correlations.
     Diagonal,
+    /// Q̂ = Σ q̂_k B_k, q̂ ≥ 0: the non-negative least-squares fit of the raw estimate onto the
+    /// noise matrices B_k of the model's noise inputs ([`project_structured`]). It needs the
+    /// caller's basis, so the estimators of this crate store the [`QProjection::Diagonal`]
+    /// projection as their estimate and the caller fits the raw estimate itself.
+    Structured,
 }
 
 /// Configuration of the adaptive Q̂ estimator.
@@ -267,7 +272,9 @@ impl<const N: usize, const CAP: usize> AdaptiveQ<N, CAP> {
         symmetrise_in_place(&mut raw);
         let projected = match self.config.projection {
             QProjection::EigenClip => project_psd(&raw, self.config.min_variance)?,
-            QProjection::Diagonal => project_diagonal(&raw, &self.floors)?,
+            QProjection::Diagonal | QProjection::Structured => {
+                project_diagonal(&raw, &self.floors)?
+            }
         };
         self.raw = Some(raw);
         self.projected = Some(projected);

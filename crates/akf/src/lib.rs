@@ -67,6 +67,14 @@
 //! * For the 15-state INS error vector (m, m/s, rad, m/s², rad/s) eigenvalue clipping mixes units;
 //!   the diagonal projection with per-state floors is the unit-safe choice.
 //!
+//! ## Other adaptive schemes
+//!
+//! * [`SageHusaQ`]: Sage–Husa with a forgetting factor b — the exponentially weighted mean of
+//!   the single-update estimates Δx Δxᵀ + P⁺ − Φ P⁺₋ Φᵀ (b = 1: the running average).
+//! * [`project_structured`]: the raw estimate projected onto Σ q_k B_k, q ≥ 0 (the model's
+//!   noise inputs) by non-negative least squares ([`nnls_gram`], Lawson–Hanson), selected as
+//!   [`QProjection::Structured`] by callers that own the basis B_k.
+//!
 //! ## Consistency ([`nees`], [`average_band`])
 //!
 //! NEES = eᵀP⁻¹e ~ χ²(N), NIS ~ χ²(M); the average over `runs` Monte Carlo runs times `runs` is
@@ -117,6 +125,8 @@ mod error;
 pub mod interval;
 mod kf;
 mod linalg;
+mod sage_husa;
+mod structured;
 
 pub use adaptive::{
     AdaptiveKalmanFilter, AdaptiveQ, AdaptiveQConfig, DEFAULT_WINDOW_CAPACITY, Projected,
@@ -126,3 +136,5 @@ pub use consistency::{average_band, chi_square_quantile, nees, normal_quantile};
 pub use error::AkfError;
 pub use kf::{Innovation, KalmanFilter, PSD_REL_TOL};
 pub use linalg::{SYMMETRY_REL_TOL, symmetric_eigen};
+pub use sage_husa::{SageHusaConfig, SageHusaQ};
+pub use structured::{StructuredFit, nnls_gram, project_structured};

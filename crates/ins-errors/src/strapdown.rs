@@ -196,12 +196,32 @@ impl Strapdown {
 
     /// One mechanization step with raw measurements (f̃_b m/s², ω̃_ib^b rad/s) representing the
     /// interval [t, t + T_s]. Allocation-free.
+    #[inline]
     pub fn step(
         &mut self,
         specific_force_body_mps2: &Vector3<f64>,
         ang_rate_ib_body_radps: &Vector3<f64>,
     ) {
-        let ts = self.step_s;
+        self.step_with_dt(
+            specific_force_body_mps2,
+            ang_rate_ib_body_radps,
+            self.step_s,
+        );
+    }
+
+    /// One mechanization step over an interval of `dt_s` seconds instead of the nominal T_s
+    /// (irregular or dropped IMU samples): the same equations with T_s replaced by `dt_s`;
+    /// [`Strapdown::step`] is this with `dt_s = T_s`. The midpoint-velocity extrapolation
+    /// assumes the previous step had the same length, so the step is second order only at a
+    /// regular rate (first order across a change of step). The caller checks `dt_s` is finite
+    /// and > 0 (the online filter of `ins-sd-filter` does). Allocation-free.
+    pub fn step_with_dt(
+        &mut self,
+        specific_force_body_mps2: &Vector3<f64>,
+        ang_rate_ib_body_radps: &Vector3<f64>,
+        dt_s: f64,
+    ) {
+        let ts = dt_s;
         let f_b = specific_force_body_mps2 - self.accel_bias_est_body_mps2;
         let w_b = ang_rate_ib_body_radps - self.gyro_drift_est_body_radps;
         let s = &self.state;

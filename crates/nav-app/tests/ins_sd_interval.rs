@@ -7,8 +7,8 @@ use ins_errors::error_model::{self, Mat15, Transition};
 use ins_errors::imu::{ImuErrorParams, ImuErrors};
 use ins_errors::strapdown::{LinearizationPoint, Strapdown};
 use ins_errors::trajectory::Trajectory;
+use ins_sd_filter::interval::IntervalModel;
 use nav_app::ins_sd::Scenario;
-use nav_app::ins_sd::interval::IntervalModel;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 

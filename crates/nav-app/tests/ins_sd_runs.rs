@@ -345,3 +345,21 @@ fn default_akf_stays_bounded_where_eigen_clip_blows_up() {
         "eigen_clip worst peak {clip_worst} m: no blow-up to guard against"
     );
 }
+
+#[test]
+fn adaptive_alternatives_share_the_flight_and_equal_the_kf_until_warm() {
+    // Sage–Husa (warm-up = akf_window) and the structured Mohamed–Schwarz use the a-priori Q
+    // until their estimate exists (10 updates): identical to the KF to t = 10 s (common random
+    // numbers), different afterwards.
+    let sc = Scenario::paper_default().truncated(20.0).unwrap();
+    let seed = run_seed(sc.monte_carlo.seed, Mode::Kf, 2);
+    let kf = run_once(&sc, Mode::Kf, seed);
+    for mode in [Mode::AkfSageHusa, Mode::AkfStructured] {
+        let a = run_once(&sc, mode, seed);
+        for t in 0..=10 {
+            assert_eq!(kf[t], a[t], "{} t = {t}", mode.name());
+        }
+        assert_ne!(kf[15].pos_err_ned_m, a[15].pos_err_ned_m, "{}", mode.name());
+        assert_eq!(kf[20].distance_m, a[20].distance_m);
+    }
+}

@@ -202,6 +202,6 @@ pub use model::{
     sighting_offset_m, sighting_offsets3_m, true_pose_from_errors,
 };
 pub use paper_printed::{
-    PaperAlphaReading, PaperPrintedBlocks, paper_eq15_jacobian3, paper_printed_blocks,
-    paper_printed_jacobian, paper_printed_jacobian3,
+    PaperAlphaReading, PaperPrintedBlocks, paper_eq15_jacobian, paper_eq15_jacobian3,
+    paper_printed_blocks, paper_printed_jacobian, paper_printed_jacobian3,
 };

@@ -212,6 +212,25 @@ pub fn paper_printed_jacobian(
     Ok(h)
 }
 
+/// Eq. 15 for one landmark with α₀ read as `reading`: rows (w, h), as one landmark's rows of
+/// [`paper_eq15_jacobian3`] (the same operations, so the two agree bit for bit).
+///
+/// # Errors
+/// As [`paper_printed_blocks`].
+pub fn paper_eq15_jacobian(
+    computed: &Geodetic,
+    landmark: &Landmark,
+    reading: PaperAlphaReading,
+) -> Result<SMatrix<f64, 2, STATE_DIM>, SightingError> {
+    let c_e_c = ned_from_ecef(computed.lat_rad, computed.lon_rad);
+    let x_c: Vector3<f64> = geodetic_to_ecef(computed);
+    let los = los_from_ecef(landmark, &c_e_c, &x_c)?;
+    let blocks = blocks_from_los(computed, landmark, &los, reading)?;
+    let mut h = SMatrix::<f64, 2, STATE_DIM>::zeros();
+    place(&blocks, &mut h, 0);
+    Ok(h)
+}
+
 /// [`paper_printed_jacobian`] for three landmarks, rows (w₀, h₀, w₁, h₁, w₂, h₂) as
 /// [`crate::sighting_jacobian3`]. Fixed size, no allocation.
 ///

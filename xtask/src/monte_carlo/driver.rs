@@ -200,7 +200,8 @@ where
                     let t = match &e {
                         RunError::NonFinite { t_s, .. }
                         | RunError::Sighting { t_s, .. }
-                        | RunError::Filter { t_s, .. } => Some(*t_s),
+                        | RunError::Filter { t_s, .. }
+                        | RunError::Online { t_s, .. } => Some(*t_s),
                         _ => None,
                     };
                     Some((t, e.to_string()))

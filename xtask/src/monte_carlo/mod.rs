@@ -99,6 +99,7 @@
 //! simulation's wall time is given beside it.
 
 pub mod driver;
+pub mod export;
 pub mod plot;
 pub mod report;
 pub mod stats;
@@ -157,6 +158,15 @@ pub struct RunArgs {
     /// Cut the flight to its first SECONDS (quick looks and tests).
     #[arg(long, value_name = "SECONDS")]
     pub duration: Option<f64>,
+    /// Also write run 0 of the KF and the AKF as IMU/sighting/truth logs into DIR/kf and
+    /// DIR/akf, for `nav-app ins` (formats: nav_app::ins_sd::logs).
+    #[arg(long, value_name = "DIR")]
+    pub export_logs: Option<PathBuf>,
+    /// Configurations to simulate, comma-separated, on the same flights (common random
+    /// numbers): standalone, kf, akf, akf_sage_husa, akf_structured [default: the paper's
+    /// standalone,kf,akf].
+    #[arg(long, value_name = "LIST")]
+    pub filters: Option<String>,
 }
 
 /// Options of `merge`.
@@ -276,6 +286,27 @@ pub struct Resolved {
     pub sharded: bool,
     /// Output directory.
     pub out: PathBuf,
+    /// Configurations simulated, in report order.
+    pub modes: Vec<Mode>,
+}
+
+/// Parses `--filters a,b,…` into modes in report order.
+pub fn parse_filters(text: &str) -> Result<Vec<Mode>> {
+    let mut modes = Vec::new();
+    for name in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let m = Mode::from_name(name).with_context(|| {
+            format!(
+                "--filters: `{name}` is not one of {}",
+                Mode::EVERY.map(Mode::name).join(", ")
+            )
+        })?;
+        if !modes.contains(&m) {
+            modes.push(m);
+        }
+    }
+    ensure!(!modes.is_empty(), "--filters: no configuration given");
+    modes.sort_by_key(|m| Mode::EVERY.iter().position(|x| x == m));
+    Ok(modes)
 }
 
 /// Checks and resolves the arguments (clear errors for bad values).
@@ -319,7 +350,12 @@ pub fn resolve(args: &RunArgs) -> Result<Resolved> {
         }
         target_dir().join("monte-carlo").join(name)
     });
+    let modes = match &args.filters {
+        Some(f) => parse_filters(f)?,
+        None => Mode::ALL.to_vec(),
+    };
     Ok(Resolved {
+        modes,
         scenario,
         source,
         runs,
@@ -336,7 +372,7 @@ pub fn simulate_stats(r: &Resolved, progress: bool) -> Result<Stats> {
     let samples = r.scenario.samples_per_run();
     let range = stats::shard_range(r.runs, r.shard.index, r.shard.count);
     let plan = driver::Plan {
-        modes: Mode::ALL.to_vec(),
+        modes: r.modes.clone(),
         samples,
         range,
         threads: r.threads,
@@ -389,7 +425,7 @@ pub fn simulate(args: &RunArgs) -> Result<PathBuf> {
         } else {
             String::new()
         },
-        Mode::ALL.len(),
+        r.modes.len(),
         r.scenario.duration_s(),
         r.seed,
         r.threads,
@@ -398,6 +434,9 @@ pub fn simulate(args: &RunArgs) -> Result<PathBuf> {
     let stats = simulate_stats(&r, true)?;
     write_outputs(&r.out, &stats, !r.sharded)?;
     print_done(&r.out, &stats, !r.sharded);
+    if let Some(dir) = &args.export_logs {
+        export::export_logs(&r, dir)?;
+    }
     Ok(r.out)
 }
 

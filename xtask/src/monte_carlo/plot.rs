@@ -269,6 +269,8 @@ fn mode_colour(mode: &str) -> RGBColor {
     match mode {
         "standalone" => RGBColor(120, 120, 120),
         "kf" => RGBColor(0, 90, 180),
+        "akf_sage_husa" => RGBColor(0, 150, 60),
+        "akf_structured" => RGBColor(140, 40, 160),
         _ => RGBColor(220, 80, 0),
     }
 }

@@ -768,7 +768,11 @@ fn nees_story(s: &mut String, m: &ModeStats) {
         f(hi, 2),
         parts.join("; ")
     );
-    let reading = if m.mode == "kf" {
+    let reading = if m.mode == "akf_sage_husa" {
+        "Reading: Sage–Husa averages the single-update estimates Δx Δxᵀ + P⁺ − Φ P⁺₋ Φᵀ with a forgetting factor (memory ≈ 1/(1 − b) updates) instead of a window of 10; the longer memory smooths the indefinite P⁺ − Φ P⁺₋ Φᵀ term, so less of Q̂ is clipped away by the projection. Where NEES and NIS are below their bands it still over-estimates the process noise (same innovation-based estimate)."
+    } else if m.mode == "akf_structured" {
+        "Reading: the windowed Mohamed–Schwarz Q̂ projected by non-negative least squares onto the model's four noise inputs (Q = Σ q_k B_k): PSD with the model's correlations, but the raw Q̂ sees the noise only through the innovations (rank ≤ 6 per update), so the fitted densities are not the true ones (a 40 s look: all weight on the gyro white noise and drift random walk)."
+    } else if m.mode == "kf" {
         "Reading: below the band, P₀ and the doubled white-noise Q (config comment: tuned so) keep P larger than the errors; above it late in open loop and just after the switch to feedback at 195 s, the linearisation residue of the INS error grown in open loop (the linear error model degrades as the uncorrected error grows) is not in P; feedback removes it within about a minute. The NIS, which sees only the six measurement directions, stays consistent."
     } else {
         "Reading: the Mohamed–Schwarz Q̂ (innovation-based, fed back into the gain that produces the innovations) does not converge to the true Q; where NEES and NIS are both below their bands it over-estimates the process noise. With the eigenvalue-clipping projection (floor 0) the loop runs away (measured: 100 runs, seed 2009, worst runs 6–7 km at 790–810 s, azimuth σ 22 mrad at 792 s, run-average NEES up to 10⁴): with N = 10 < 15 states Q̂ is dominated by the indefinite P⁺ − Φ P⁺ Φᵀ, clipping its large negative eigenvalues adds their magnitude back as positive mass in mixed-unit directions, a larger Q̂ gives a larger P and more clipped mass, and in straight flight after 600 s (level/azimuth weakly observable) this feedback ends in a Q̂ explosion (≈ 1.5 km per interval on position at 800 s, run 96); the diagonal projection (the default) stays bounded."

@@ -405,7 +405,7 @@ pub fn missing_ranges(stats: &Stats) -> Vec<(u64, u64)> {
     missing
 }
 
-/// Sort key: mode in `Mode::ALL` order, then run index.
+/// Sort key: mode in `Mode::EVERY` order, then run index.
 pub fn order_key(mode: &str, run_index: u64) -> (Option<usize>, u64) {
-    (Mode::ALL.iter().position(|x| x.name() == mode), run_index)
+    (Mode::EVERY.iter().position(|x| x.name() == mode), run_index)
 }

@@ -279,6 +279,7 @@ fn non_finite_runs_are_excluded_and_counted() {
     assert_eq!(b[qi::POS_N].n, 3);
     // The reports count and list them.
     let r = Resolved {
+        modes: Mode::ALL.to_vec(),
         scenario: Scenario::paper_default(),
         source: "stand-in".into(),
         runs: 5,

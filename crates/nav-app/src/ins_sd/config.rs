@@ -56,25 +56,7 @@ impl ScenarioError {
     }
 }
 
-/// `[filter] measurement_jacobian`: which H the filter linearises the SD measurement with.
-/// The simulated measurement is always the true nonlinear model; only the filter's H changes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MeasurementJacobian {
-    /// The verified H, `sighting_model::sighting_jacobian3` (checked against finite
-    /// differences of the nonlinear model). The default.
-    #[default]
-    Verified,
-    /// The paper's eqs. 15–18 as printed, `sighting_model::paper_printed_jacobian3` (α₀ read
-    /// as printed, i.e. the depression: h rows × cos 2ε; printed H₃ kept). For reproducing the
-    /// paper's filter only.
-    PaperPrinted,
-    /// The printed eqs. 15–18 with only α₀ repaired (read as the elevation):
-    /// `sighting_model::paper_eq15_jacobian3` with `PaperAlphaReading::Elevation` = the
-    /// verified H plus the printed H₃ (the tilt term, ≈ ρ/R of the δp entries, with its tan λ
-    /// sign as printed). Isolates the paper's other flaw.
-    PaperPrintedElevation,
-}
+pub use ins_sd_filter::MeasurementJacobian;
 
 /// `[filter]`: initial covariance, process-noise tuning, measurement noise, feedback switch
 /// and the discretisation / adaptive-Q parameters of the INS/SD error-state filter.
@@ -119,15 +101,39 @@ pub struct FilterConfig {
     pub phi_subintervals: usize,
     /// AKF window N (Mohamed & Schwarz; paper: 10), 1 ..= 64.
     pub akf_window: usize,
-    /// How the AKF's indefinite Q̂ is made PSD: `"eigen_clip"` or `"diagonal"`.
+    /// How the AKF's indefinite Q̂ is made PSD: `"eigen_clip"`, `"diagonal"` or `"structured"`
+    /// (non-negative least squares onto the model's four noise inputs, Q̂ = Σ q̂_k B_k).
     pub akf_projection: QProjection,
     /// Floor of the projected Q̂ (eigenvalues or diagonal), state units² per SD interval (≥ 0).
     pub akf_min_variance: f64,
+    /// Adaptive scheme of the `akf` configuration: `"mohamed_schwarz"` (paper eq. 19, window
+    /// `akf_window`; the default when the key is absent) or `"sage_husa"` (forgetting factor
+    /// `sage_husa_forgetting`, warm-up `akf_window` updates).
+    #[serde(default)]
+    pub akf_scheme: AkfScheme,
+    /// Sage–Husa forgetting factor b, 0 < b ≤ 1 (memory ≈ 1/(1 − b) updates); default 0.95.
+    #[serde(default = "default_forgetting")]
+    pub sage_husa_forgetting: f64,
     /// Measurement matrix of the filter: `"verified"` (default when the key is absent),
     /// `"paper_printed"` (the printed eqs. 15–18) or `"paper_printed_elevation"` (printed, α₀
     /// repaired); the last two for comparison with the paper.
     #[serde(default)]
     pub measurement_jacobian: MeasurementJacobian,
+}
+
+/// `[filter] akf_scheme`: the adaptive process-noise estimator of the `akf` configuration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AkfScheme {
+    /// Mohamed & Schwarz (paper eq. 19), window `akf_window`.
+    #[default]
+    MohamedSchwarz,
+    /// Sage–Husa with forgetting factor `sage_husa_forgetting`.
+    SageHusa,
+}
+
+fn default_forgetting() -> f64 {
+    0.95
 }
 
 impl Default for FilterConfig {
@@ -155,6 +161,8 @@ impl FilterConfig {
             akf_window: 10,
             akf_projection: QProjection::Diagonal,
             akf_min_variance: 0.0,
+            akf_scheme: AkfScheme::MohamedSchwarz,
+            sage_husa_forgetting: 0.95,
             measurement_jacobian: MeasurementJacobian::Verified,
         }
     }
@@ -209,6 +217,13 @@ impl FilterConfig {
                 self.phi_subintervals,
             ));
         }
+        if !(self.sage_husa_forgetting > 0.0 && self.sage_husa_forgetting <= 1.0) {
+            return Err(ScenarioError::invalid(
+                "filter.sage_husa_forgetting",
+                "must be within (0, 1]",
+                self.sage_husa_forgetting,
+            ));
+        }
         if self.akf_window == 0 || self.akf_window > akf::DEFAULT_WINDOW_CAPACITY {
             return Err(ScenarioError::invalid(
                 "filter.akf_window",
@@ -219,14 +234,14 @@ impl FilterConfig {
         Ok(())
     }
 
-    /// Initial covariance diagonal in state units (m², (m/s)², rad², (m/s²)², (rad/s)²).
-    pub(crate) fn p0_diagonal(&self) -> [f64; 5] {
+    /// Initial σ in state units (m, m/s, rad, m/s², rad/s).
+    pub(crate) fn p0_sigmas(&self) -> [f64; 5] {
         [
-            self.p0_pos_sigma_m.powi(2),
-            self.p0_vel_sigma_mps.powi(2),
-            (self.p0_psi_sigma_mrad * 1e-3).powi(2),
-            (self.p0_accel_bias_sigma_mg * MG_TO_MPS2).powi(2),
-            (self.p0_gyro_drift_sigma_degph * DEGPH_TO_RADPS).powi(2),
+            self.p0_pos_sigma_m,
+            self.p0_vel_sigma_mps,
+            self.p0_psi_sigma_mrad * 1e-3,
+            self.p0_accel_bias_sigma_mg * MG_TO_MPS2,
+            self.p0_gyro_drift_sigma_degph * DEGPH_TO_RADPS,
         ]
     }
 

@@ -1,104 +1,155 @@
-//! One Monte Carlo run of the INS/SD loop (see the module doc of [`super`]).
+//! One Monte Carlo run of the INS/SD loop (see the module doc of [`super`]): the simulator
+//! (truth, IMU errors, sighting generation) around the online filter of `ins-sd-filter`, which
+//! is the one filter code path (the same object `nav-app ins` runs on logs).
 
-use akf::{AdaptiveKalmanFilter, AdaptiveQConfig, KalmanFilter};
-use ins_errors::error_model::{self, Mat15};
+use akf::{AdaptiveQConfig, QProjection, SageHusaConfig};
+use ins_errors::error_model;
 use ins_errors::imu::{ImuErrorParams, ImuErrors};
-use ins_errors::strapdown::{NavState, Strapdown};
+use ins_errors::strapdown::NavState;
 use ins_errors::trajectory::{Trajectory, TruthSample};
-use nalgebra::{Rotation3, SMatrix, SVector, Vector3};
+use ins_sd_filter::{
+    ErrorSigmas, Estimator, FilterError, InsSdFilter, InsSdFilterConfig, LandmarkEntry,
+    LandmarkTable, ProcessNoisePsd, Sighting, Vec15, nav_pose,
+};
+use nalgebra::{SVector, Vector2, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use sighting_model::{Landmark, NavPose};
+use sighting_model::Landmark;
 
-use super::MeasurementJacobian;
-use super::interval::IntervalModel;
-use super::{Mode, RunError, RunOutcome, Sample, Scenario};
+use super::{AkfScheme, Mode, RunError, RunOutcome, Sample, Scenario};
 
-type Vec15 = SVector<f64, 15>;
-
-/// The error-state filter of a run.
-pub(crate) enum Filter {
-    /// Stand-alone INS: no filter.
-    None,
-    /// Manually tuned KF (boxed: the filter holds a 15×15 P).
-    Kf(Box<KalmanFilter<15>>),
-    /// Adaptive KF (boxed: P, Φ and the Δx window).
-    Akf(Box<AdaptiveKalmanFilter<15>>),
+/// Sees what a run feeds its filter (for exporting a run as logs, [`super::logs`]). Every
+/// method defaults to nothing; the Monte Carlo uses [`NoObserver`] (compiled away).
+pub trait RunObserver {
+    /// The INS start: time 0 and the initial navigation state (the truth at t = 0).
+    fn start(&mut self, _initial: &NavState) {}
+    /// One IMU sample at `t_s` (mean specific force, body m/s², and angular rate, body rad/s,
+    /// over the interval ending at `t_s`).
+    fn imu(
+        &mut self,
+        _t_s: f64,
+        _specific_force_body_mps2: &Vector3<f64>,
+        _ang_rate_body_radps: &Vector3<f64>,
+    ) {
+    }
+    /// A sighting epoch: the sightings handed to the filter and the filter after its update.
+    fn epoch(&mut self, _t_s: f64, _sightings: &[Sighting], _filter: &InsSdFilter) {}
+    /// The truth at a 1 Hz record time (t = 0, 1, …).
+    fn truth(&mut self, _t_s: f64, _truth: &NavState) {}
 }
 
-impl Filter {
-    fn state(&self) -> Vec15 {
-        match self {
-            Filter::None => Vec15::zeros(),
-            Filter::Kf(f) => *f.state(),
-            Filter::Akf(f) => *f.filter().state(),
-        }
-    }
+/// The observer that observes nothing.
+pub struct NoObserver;
 
-    fn covariance(&self) -> Option<&Mat15> {
-        match self {
-            Filter::None => None,
-            Filter::Kf(f) => Some(f.covariance()),
-            Filter::Akf(f) => Some(f.filter().covariance()),
-        }
-    }
-
-    fn reset(&mut self) {
-        match self {
-            Filter::None => {}
-            Filter::Kf(f) => f.reset_error_state(),
-            Filter::Akf(f) => f.reset_error_state(),
-        }
-    }
-}
+impl RunObserver for NoObserver {}
 
 /// Everything a run carries from step to step (built once, no allocation in the loop).
 pub(crate) struct Loop {
-    pub(crate) ins: Strapdown,
+    pub(crate) filter: InsSdFilter,
     pub(crate) imu: ImuErrors,
-    pub(crate) filter: Filter,
-    pub(crate) interval: IntervalModel,
-    pub(crate) landmarks: [Landmark; 3],
-    pub(crate) r: SMatrix<f64, 6, 6>,
+    /// The simulated landmarks (ids = indices in `[sighting] landmarks`), in sighting order.
+    landmarks: Vec<Landmark>,
+    /// Reused sighting buffer (capacity = number of landmarks).
+    sightings: Vec<Sighting>,
     pub(crate) sd_noise_var_m2: f64,
     pub(crate) rng_imu: ChaCha8Rng,
     pub(crate) rng_sd: ChaCha8Rng,
-    pub(crate) open_loop_until_s: f64,
-    /// Which H the filter uses (`[filter] measurement_jacobian`).
-    pub(crate) jacobian: MeasurementJacobian,
-    /// Diagnostic: how many SD updates used the AKF's Q̂ rather than the a-priori Q.
-    pub(crate) adaptive_q_used: usize,
+    step_s: f64,
+    k: u64,
 }
 
 pub(crate) fn nav_state(s: &TruthSample) -> NavState {
     s.nav_state()
 }
 
-fn pose(s: &NavState) -> NavPose {
-    NavPose {
-        position: s.pos,
-        c_b_n: Rotation3::from(s.att_b_to_n),
+/// The online filter's configuration for `mode` from the scenario's `[filter]`, the SD period
+/// of `[sighting]` and the IMU step of `[trajectory]`.
+pub(crate) fn online_config(scenario: &Scenario, mode: Mode) -> InsSdFilterConfig {
+    let f = &scenario.filter;
+    let step_s = scenario.trajectory.step_s;
+    let [pos, vel, psi, acc, gyro] = f.p0_sigmas();
+    let psd = f.psd(step_s);
+    InsSdFilterConfig {
+        imu_step_s: step_s,
+        timestamp_tolerance_s: 1e-6 * step_s,
+        update_period_s: scenario.sighting.update_period_s,
+        phi_subintervals: f.phi_subintervals,
+        p0_sigma: ErrorSigmas {
+            pos_m: pos,
+            vel_mps: vel,
+            psi_rad: psi,
+            accel_bias_mps2: acc,
+            gyro_drift_radps: gyro,
+        },
+        process_noise: ProcessNoisePsd {
+            accel_white_m2ps3: psd[0],
+            gyro_white_rad2ps: psd[1],
+            accel_bias_rw_m2ps5: psd[2],
+            gyro_drift_rw_rad2ps3: psd[3],
+        },
+        r_var_m2: f.r_var_m2,
+        open_loop_until_s: f.open_loop_until_s,
+        gate_probability: None,
+        estimator: {
+            let ms = |projection| {
+                Estimator::MohamedSchwarz(AdaptiveQConfig {
+                    window: f.akf_window,
+                    projection,
+                    min_variance: f.akf_min_variance,
+                })
+            };
+            let sh = |projection| {
+                Estimator::SageHusa(SageHusaConfig {
+                    forgetting: f.sage_husa_forgetting,
+                    warmup: f.akf_window,
+                    projection,
+                    min_variance: f.akf_min_variance,
+                })
+            };
+            match mode {
+                Mode::Standalone => Estimator::StandAlone,
+                Mode::Kf => Estimator::Kalman,
+                Mode::Akf => match f.akf_scheme {
+                    AkfScheme::MohamedSchwarz => ms(f.akf_projection),
+                    AkfScheme::SageHusa => sh(f.akf_projection),
+                },
+                Mode::AkfSageHusa => sh(f.akf_projection),
+                Mode::AkfStructured => ms(QProjection::Structured),
+            }
+        },
+        jacobian: f.measurement_jacobian,
     }
 }
 
-fn nav_finite(s: &NavState) -> bool {
-    s.pos.lat_rad.is_finite()
-        && s.pos.lon_rad.is_finite()
-        && s.pos.alt_m.is_finite()
-        && s.vel_ned_mps.iter().all(|x| x.is_finite())
-        && s.att_b_to_n.coords.iter().all(|x| x.is_finite())
+/// The scenario's landmarks as a table (id = index in `[sighting] landmarks`).
+pub(crate) fn landmark_table(scenario: &Scenario) -> Result<LandmarkTable, RunError> {
+    let entries: Vec<LandmarkEntry> = scenario
+        .sighting
+        .landmarks
+        .iter()
+        .enumerate()
+        .map(|(i, l)| LandmarkEntry {
+            id: i as u32,
+            lat_deg: l.lat_deg,
+            lon_deg: l.lon_deg,
+            alt_m: l.alt_m,
+        })
+        .collect();
+    LandmarkTable::new(&entries).map_err(|source| RunError::Online { t_s: 0.0, source })
 }
 
-/// Initial covariance from `[filter]`.
-pub(crate) fn initial_covariance(scenario: &Scenario) -> Mat15 {
-    let d = scenario.filter.p0_diagonal();
-    let mut p = Mat15::zeros();
-    for (b, v) in d.iter().enumerate() {
-        for i in 0..3 {
-            p[(3 * b + i, 3 * b + i)] = *v;
-        }
+/// Maps the online filter's errors onto the run's error kinds.
+pub(crate) fn run_error(e: FilterError) -> RunError {
+    match e {
+        FilterError::NonFiniteState { what, t_s } => RunError::NonFinite { t_s, what },
+        FilterError::Sighting { t_s, source, .. } => RunError::Sighting { t_s, source },
+        FilterError::Akf { t_s, source } => RunError::Filter { t_s, source },
+        FilterError::Ins(e) => RunError::Ins(e),
+        other => RunError::Online {
+            t_s: f64::NAN,
+            source: other,
+        },
     }
-    p
 }
 
 impl Loop {
@@ -110,93 +161,73 @@ impl Loop {
         mode: Mode,
         seed: u64,
         first: &TruthSample,
-        step_s: f64,
-        steps_per_update: usize,
     ) -> Result<Self, RunError> {
         let params = ImuErrorParams::from_config(&scenario.imu).map_err(RunError::Ins)?;
         let mut rng_imu = ChaCha8Rng::seed_from_u64(seed);
         let imu = ImuErrors::draw(&params, &mut rng_imu);
         let mut rng_sd = ChaCha8Rng::seed_from_u64(seed);
         rng_sd.set_stream(1);
-        let ins = Strapdown::new(nav_state(first), step_s).map_err(RunError::Ins)?;
         let landmarks = scenario
             .sighting
-            .landmarks3()
+            .landmarks()
             .map_err(|source| RunError::Sighting { t_s: 0.0, source })?;
-        let p0 = initial_covariance(scenario);
-        let f = &scenario.filter;
-        let filter = match mode {
-            Mode::Standalone => Filter::None,
-            Mode::Kf => Filter::Kf(Box::new(
-                KalmanFilter::new(Vec15::zeros(), p0)
-                    .map_err(|source| RunError::Filter { t_s: 0.0, source })?,
-            )),
-            Mode::Akf => Filter::Akf(Box::new(
-                AdaptiveKalmanFilter::new(
-                    Vec15::zeros(),
-                    p0,
-                    AdaptiveQConfig {
-                        window: f.akf_window,
-                        projection: f.akf_projection,
-                        min_variance: f.akf_min_variance,
-                    },
-                )
-                .map_err(|source| RunError::Filter { t_s: 0.0, source })?,
-            )),
-        };
+        let filter = InsSdFilter::new(
+            online_config(scenario, mode),
+            landmark_table(scenario)?,
+            nav_state(first),
+            0.0,
+        )
+        .map_err(run_error)?;
         Ok(Self {
-            ins,
-            imu,
             filter,
-            interval: IntervalModel::new(
-                steps_per_update,
-                f.phi_subintervals,
-                step_s,
-                f.psd(step_s),
-            ),
+            imu,
+            sightings: Vec::with_capacity(landmarks.len()),
             landmarks,
-            r: SMatrix::<f64, 6, 6>::identity() * f.r_var_m2,
             sd_noise_var_m2: scenario.sighting.noise_var_m2,
             rng_imu,
             rng_sd,
-            open_loop_until_s: f.open_loop_until_s,
-            jacobian: f.measurement_jacobian,
-            adaptive_q_used: 0,
+            step_s: scenario.trajectory.step_s,
+            k: 0,
         })
     }
 
     /// Current error-state estimate x̂.
     #[cfg(test)]
     pub(crate) fn filter_state(&self) -> Vec15 {
-        self.filter.state()
+        self.filter.error_state()
     }
 
     /// Current covariance P (None in stand-alone mode).
     #[cfg(test)]
-    pub(crate) fn filter_covariance(&self) -> Option<&Mat15> {
+    pub(crate) fn filter_covariance(&self) -> Option<&ins_errors::error_model::Mat15> {
         self.filter.covariance()
     }
 
-    /// One 100 Hz step: corrupt the ideal IMU sample of the interval just flown, mechanize,
-    /// feed the interval model.
+    /// One 100 Hz step: corrupt the ideal IMU sample of the interval just flown and hand it to
+    /// the filter (time stamp k·T_s).
     #[inline]
-    pub(crate) fn step(&mut self, ideal: &TruthSample) {
+    pub(crate) fn step(
+        &mut self,
+        ideal: &TruthSample,
+    ) -> Result<(Vector3<f64>, Vector3<f64>), RunError> {
         let (f, w) = self.imu.measure(
             &ideal.specific_force_body_mps2,
             &ideal.ang_rate_ib_body_radps,
             &mut self.rng_imu,
         );
-        self.ins.step(&f, &w);
-        if !matches!(self.filter, Filter::None) {
-            self.interval.push(&self.ins.linearization_point());
-        }
+        self.k += 1;
+        self.filter
+            .propagate_rates(self.k as f64 * self.step_s, &f, &w)
+            .map_err(run_error)?;
+        Ok((f, w))
     }
 
     /// The full true error of the INS (15 states): δp, δv, ψ of the INS against `truth`,
     /// then the residual sensor errors (true ∇, ε minus the corrections applied so far).
     pub(crate) fn true_error(&self, truth: &NavState) -> Vec15 {
-        let e9 = error_model::error_state(truth, self.ins.state());
-        let (acc_corr, gyro_corr) = self.ins.sensor_corrections();
+        let ins = self.filter.ins();
+        let e9 = error_model::error_state(truth, ins.state());
+        let (acc_corr, gyro_corr) = ins.sensor_corrections();
         let mut e = Vec15::zeros();
         e.fixed_rows_mut::<9>(0).copy_from(&e9);
         e.fixed_rows_mut::<3>(9)
@@ -206,71 +237,51 @@ impl Loop {
         e
     }
 
-    /// SD update at time `t_s` against the truth `truth`: predict over the interval with
-    /// (Φ_T, Q_T) (AKF: Q̂ once available), measure the three landmarks with the nonlinear
-    /// model plus noise, update, and (after `open_loop_until_s`) feed back and reset.
-    /// Returns the NIS.
-    pub(crate) fn sd_update(&mut self, t_s: f64, truth: &NavState) -> Result<f64, RunError> {
-        let (phi, q_model) = self.interval.take();
-        let fe = |source| RunError::Filter { t_s, source };
-        let computed = *self.ins.state();
-        let mut z =
-            sighting_model::sighting_offsets3_m(&pose(truth), &pose(&computed), &self.landmarks)
-                .map_err(|source| RunError::Sighting { t_s, source })?;
-        sighting_model::add_sighting_noise(&mut z, self.sd_noise_var_m2, &mut self.rng_sd)
-            .map_err(|source| RunError::Sighting { t_s, source })?;
-        let h = match self.jacobian {
-            MeasurementJacobian::Verified => {
-                sighting_model::sighting_jacobian3(&computed.pos, &self.landmarks)
-            }
-            MeasurementJacobian::PaperPrinted => {
-                sighting_model::paper_printed_jacobian3(&computed.pos, &self.landmarks)
-            }
-            MeasurementJacobian::PaperPrintedElevation => sighting_model::paper_eq15_jacobian3(
-                &computed.pos,
-                &self.landmarks,
-                sighting_model::PaperAlphaReading::Elevation,
-            ),
-        }
-        .map_err(|source| RunError::Sighting { t_s, source })?;
-        let nis = match &mut self.filter {
-            Filter::None => return Ok(f64::NAN),
-            Filter::Kf(f) => {
-                f.predict(&phi, &q_model).map_err(fe)?;
-                f.update(&z, &h, &self.r).map_err(fe)?.nis
-            }
-            Filter::Akf(f) => {
-                let q = match f.q_estimate() {
-                    Some(q_hat) => {
-                        self.adaptive_q_used += 1;
-                        *q_hat
-                    }
-                    None => q_model,
-                };
-                f.predict(&phi, &q).map_err(fe)?;
-                f.update(&z, &h, &self.r).map_err(fe)?.nis
-            }
-        };
-        if !nis.is_finite() || !self.filter.state().iter().all(|x| x.is_finite()) {
-            return Err(RunError::NonFinite {
-                t_s,
-                what: "filter state",
+    /// The sightings at time `t_s` against the truth `truth`: each landmark measured with the
+    /// nonlinear model (camera pointed with the filter's INS) plus N(0, σ²_SD) noise on w and h
+    /// (drawn in the order w₀, h₀, w₁, h₁, …). Written into the reused buffer.
+    pub(crate) fn simulate_sightings(
+        &mut self,
+        t_s: f64,
+        truth: &NavState,
+    ) -> Result<&[Sighting], RunError> {
+        let computed = self.filter.pointing_pose();
+        let truth_pose = nav_pose(truth);
+        self.sightings.clear();
+        let se = |source| RunError::Sighting { t_s, source };
+        for lm in &self.landmarks {
+            let z = sighting_model::sighting_offset_m(&truth_pose, &computed, lm).map_err(se)?;
+            self.sightings.push(Sighting {
+                landmark_id: lm.id() as u32,
+                w_m: z.x,
+                h_m: z.y,
             });
         }
-        if t_s >= self.open_loop_until_s - 1e-9 {
-            self.feedback();
+        for s in &mut self.sightings {
+            let mut z: SVector<f64, 2> = Vector2::new(s.w_m, s.h_m);
+            sighting_model::add_sighting_noise(&mut z, self.sd_noise_var_m2, &mut self.rng_sd)
+                .map_err(se)?;
+            s.w_m = z.x;
+            s.h_m = z.y;
         }
-        Ok(nis)
+        Ok(&self.sightings)
     }
 
-    /// Feedback: the estimated δp, δv, ψ are removed from the INS, ∇̂, ε̂ added to the sensor
-    /// corrections, the error state reset to zero (P kept).
+    /// SD epoch at time `t_s`: simulate the sightings, then the filter's update (predict,
+    /// update, feedback after `open_loop_until_s`). Returns the NIS (NaN without a filter).
+    pub(crate) fn sd_update(&mut self, t_s: f64, truth: &NavState) -> Result<f64, RunError> {
+        self.simulate_sightings(t_s, truth)?;
+        let report = self
+            .filter
+            .update(t_s, &self.sightings)
+            .map_err(run_error)?;
+        Ok(report.nis.unwrap_or(f64::NAN))
+    }
+
+    /// Feedback now (see [`InsSdFilter::feedback`]).
+    #[cfg(test)]
     pub(crate) fn feedback(&mut self) {
-        let x = self.filter.state();
-        let v = |i: usize| Vector3::new(x[i], x[i + 1], x[i + 2]);
-        self.ins.apply_correction(&v(0), &v(3), &v(6));
-        self.ins.add_sensor_corrections(&v(9), &v(12));
-        self.filter.reset();
+        self.filter.feedback();
     }
 
     /// Writes the 1 Hz record for time `t_s`. The recorded errors are those of the system's
@@ -283,14 +294,7 @@ impl Loop {
         distance_m: f64,
         nis: Option<f64>,
     ) -> Result<Sample, RunError> {
-        let computed = self.ins.state();
-        if !nav_finite(computed) {
-            return Err(RunError::NonFinite {
-                t_s,
-                what: "INS navigation state",
-            });
-        }
-        let e = self.true_error(truth) - self.filter.state();
+        let e = self.true_error(truth) - self.filter.error_state();
         let nees = match (nis, self.filter.covariance()) {
             (Some(_), Some(p)) => {
                 Some(akf::nees(&e, p).map_err(|source| RunError::Filter { t_s, source })?)
@@ -316,6 +320,17 @@ pub(crate) fn run(
     seed: u64,
     out: &mut [Sample],
 ) -> Result<RunOutcome, RunError> {
+    run_observed(scenario, mode, seed, out, &mut NoObserver)
+}
+
+/// [`run`], showing `obs` every IMU sample, sighting epoch and 1 Hz truth.
+pub(crate) fn run_observed<O: RunObserver>(
+    scenario: &Scenario,
+    mode: Mode,
+    seed: u64,
+    out: &mut [Sample],
+    obs: &mut O,
+) -> Result<RunOutcome, RunError> {
     let plan = scenario.plan()?;
     if out.len() != plan.samples {
         return Err(RunError::OutputLength {
@@ -331,15 +346,10 @@ pub(crate) fn run(
             got: 0,
         });
     };
-    let mut lp = Loop::new(
-        scenario,
-        mode,
-        seed,
-        &first,
-        plan.step_s,
-        plan.steps_per_update,
-    )?;
+    let mut lp = Loop::new(scenario, mode, seed, &first)?;
     let truth0 = nav_state(&first);
+    obs.start(&truth0);
+    obs.truth(0.0, &truth0);
     out[0] = lp.sample(0.0, &truth0, 0.0, None)?;
     let mut ideal = first;
     let mut distance_m = 0.0;
@@ -349,7 +359,8 @@ pub(crate) fn run(
     let mut last_nis: Option<f64> = None;
     for k in 1..=plan.steps {
         let Some(s) = truth_it.next() else { break };
-        lp.step(&ideal);
+        let (f, w) = lp.step(&ideal)?;
+        obs.imu(k as f64 * plan.step_s, &f, &w);
         epochs += 1;
         let speed = s.vel_ned_mps.norm();
         distance_m += 0.5 * (speed + speed_prev) * plan.step_s;
@@ -358,18 +369,16 @@ pub(crate) fn run(
         let t_s = k as f64 * plan.step_s;
         let update_due = mode != Mode::Standalone && k % plan.steps_per_update == 0;
         let sample_due = k % plan.steps_per_sample == 0;
-        if !nav_finite(lp.ins.state()) {
-            return Err(RunError::NonFinite {
-                t_s,
-                what: "INS navigation state",
-            });
-        }
         if !(update_due || sample_due) {
             continue;
         }
         let truth = nav_state(&s);
         if update_due {
             last_nis = Some(lp.sd_update(t_s, &truth)?);
+            obs.epoch(t_s, &lp.sightings, &lp.filter);
+        }
+        if sample_due {
+            obs.truth(t_s, &truth);
         }
         if sample_due && written < out.len() {
             out[written] = lp.sample(t_s, &truth, distance_m, last_nis.take())?;

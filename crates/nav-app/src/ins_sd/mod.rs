@@ -5,7 +5,11 @@
 //! the adaptive KF of Mohamed & Schwarz (paper eq. 19). Built on the sibling crates:
 //! `ins-errors` (truth trajectory, IMU errors, NED strapdown, 15-state ψ-angle error model),
 //! `sighting-model` (nonlinear (w, h) offsets and their Jacobian H) and `akf` (Joseph-form KF,
-//! adaptive Q̂).
+//! adaptive Q̂). The filter itself is the online [`ins_sd_filter::InsSdFilter`]: this module
+//! only simulates (truth, IMU errors, sightings) and feeds it time-stamped IMU samples and
+//! sightings, exactly as `nav-app ins` feeds it logs — one filter code path. Moving the loop
+//! onto that object left every record bit-identical (`cargo xtask monte-carlo --runs 20`: the
+//! three `timeseries_*.csv` are byte-equal before and after).
 //!
 //! ## One run
 //!
@@ -183,9 +187,12 @@
 
 mod config;
 mod engine;
-pub mod interval;
+pub mod logs;
+/// The interval discretisation (moved to `ins-sd-filter`; re-exported for existing users).
+pub use ins_sd_filter::interval;
 
-pub use config::{FilterConfig, MeasurementJacobian, MonteCarloConfig, ScenarioError};
+pub use config::{AkfScheme, FilterConfig, MeasurementJacobian, MonteCarloConfig, ScenarioError};
+pub use engine::{NoObserver, RunObserver};
 
 use ins_errors::InsError;
 use ins_errors::config::{ImuConfig, TrajectoryConfig};
@@ -259,6 +266,25 @@ impl Scenario {
             other => other,
         })?;
         Ok(s)
+    }
+
+    /// The scenario as a TOML document that [`Scenario::from_toml_str`] reads back unchanged.
+    ///
+    /// # Errors
+    /// The serializer's (not expected for a validated scenario).
+    pub fn to_toml_string(&self) -> Result<String, toml::ser::Error> {
+        toml::to_string(&config::ScenarioFile {
+            trajectory: self.trajectory.clone(),
+            imu: self.imu.clone(),
+            sighting: self.sighting.clone(),
+            filter: self.filter.clone(),
+            monte_carlo: self.monte_carlo.clone(),
+        })
+    }
+
+    /// The online filter's configuration for `mode` (what [`run`] and `nav-app ins` use).
+    pub fn online_filter_config(&self, mode: Mode) -> ins_sd_filter::InsSdFilterConfig {
+        engine::online_config(self, mode)
     }
 
     /// The paper's scenario, equal to `configs/paper.toml` (tested).
@@ -464,8 +490,15 @@ impl Scenario {
                 self.sighting.update_period_s, f.phi_subintervals
             ),
             format!(
-                "AKF: Mohamed–Schwarz Q̂ with window N = {}, projection {:?} (floor {}), used directly as the next interval's Q; the KF's a-priori Q until the window is full.",
-                f.akf_window, f.akf_projection, f.akf_min_variance
+                "AKF: {} Q̂ with window/warm-up N = {}, projection {:?} (floor {}), used directly as the next interval's Q; the KF's a-priori Q until the window is full. Comparison configurations (--filters): akf_sage_husa = Sage–Husa, forgetting factor {}, same projection; akf_structured = Mohamed–Schwarz with the structured NNLS projection onto the four noise inputs.",
+                match f.akf_scheme {
+                    AkfScheme::MohamedSchwarz => "Mohamed–Schwarz",
+                    AkfScheme::SageHusa => "Sage–Husa",
+                },
+                f.akf_window,
+                f.akf_projection,
+                f.akf_min_variance,
+                f.sage_husa_forgetting
             ),
             "Common random numbers: the three modes of one run index share truth, IMU error draw and IMU noise.".to_string(),
             format!(
@@ -508,21 +541,46 @@ pub enum Mode {
     Standalone,
     /// INS/SD with the manually tuned Kalman filter.
     Kf,
-    /// INS/SD with the adaptive Kalman filter (Mohamed & Schwarz).
+    /// INS/SD with the adaptive Kalman filter of `[filter] akf_scheme` / `akf_projection`
+    /// (default: Mohamed & Schwarz, diagonal projection).
     Akf,
+    /// Comparison: Sage–Husa with `[filter] sage_husa_forgetting` (warm-up `akf_window`) and
+    /// `akf_projection`.
+    #[serde(rename = "akf_sage_husa")]
+    AkfSageHusa,
+    /// Comparison: Mohamed–Schwarz (window `akf_window`) with the structured projection onto
+    /// the model's noise inputs.
+    #[serde(rename = "akf_structured")]
+    AkfStructured,
 }
 
 impl Mode {
-    /// All modes, in report order.
+    /// The paper's three configurations, in report order (what `cargo xtask monte-carlo` runs).
     pub const ALL: [Mode; 3] = [Mode::Standalone, Mode::Kf, Mode::Akf];
 
-    /// `"standalone"`, `"kf"` or `"akf"`.
+    /// Every mode, in report order: the paper's three and the adaptive comparisons.
+    pub const EVERY: [Mode; 5] = [
+        Mode::Standalone,
+        Mode::Kf,
+        Mode::Akf,
+        Mode::AkfSageHusa,
+        Mode::AkfStructured,
+    ];
+
+    /// `"standalone"`, `"kf"`, `"akf"`, `"akf_sage_husa"` or `"akf_structured"`.
     pub fn name(self) -> &'static str {
         match self {
             Mode::Standalone => "standalone",
             Mode::Kf => "kf",
             Mode::Akf => "akf",
+            Mode::AkfSageHusa => "akf_sage_husa",
+            Mode::AkfStructured => "akf_structured",
         }
+    }
+
+    /// The mode called `name` ([`Mode::name`]).
+    pub fn from_name(name: &str) -> Option<Mode> {
+        Mode::EVERY.into_iter().find(|m| m.name() == name)
     }
 }
 
@@ -595,6 +653,15 @@ pub enum RunError {
         t_s: f64,
         /// The filter's error.
         source: akf::AkfError,
+    },
+    /// The online filter rejected its input (time stamps, landmark ids; not expected from the
+    /// simulator).
+    #[error("online filter at t = {t_s} s: {source}")]
+    Online {
+        /// Time, s (NaN when unknown).
+        t_s: f64,
+        /// The filter's error.
+        source: ins_sd_filter::FilterError,
     },
 }
 

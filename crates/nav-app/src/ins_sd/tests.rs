@@ -12,12 +12,12 @@ fn open_loop(mode: Mode, seconds: usize) -> (Loop, ins_errors::strapdown::NavSta
     let tr = Trajectory::new(&sc.trajectory).unwrap();
     let mut it = tr.samples();
     let first = it.next().unwrap();
-    let mut lp = Loop::new(&sc, mode, 11, &first, plan.step_s, plan.steps_per_update).unwrap();
+    let mut lp = Loop::new(&sc, mode, 11, &first).unwrap();
     let mut ideal = first;
     let mut truth = nav_state(&first);
     for k in 1..=seconds * plan.steps_per_update {
         let s = it.next().unwrap();
-        lp.step(&ideal);
+        lp.step(&ideal).unwrap();
         ideal = s;
         truth = nav_state(&s);
         if k % plan.steps_per_update == 0 {

@@ -42,11 +42,19 @@ pub struct IntervalModel {
     sum_vel: Vector3<f64>,
     sum_f: Vector3<f64>,
     sum_c: Matrix3<f64>,
+    // Length of the current sub-interval, s, and whether every step in it had the nominal
+    // length (then τ = n·T_s exactly, as for a regular IMU).
+    sum_dt: f64,
+    all_nominal: bool,
     // Position in the interval.
     steps_done: usize,
     sub_done: usize,
     phi: Transition,
     q: Mat15,
+    // Noise matrices of the four noise inputs at unit density (only when enabled).
+    basis_on: bool,
+    basis: [Mat15; 4],
+    basis_taken: [Mat15; 4],
 }
 
 impl IntervalModel {
@@ -74,11 +82,31 @@ impl IntervalModel {
             sum_vel: Vector3::zeros(),
             sum_f: Vector3::zeros(),
             sum_c: Matrix3::zeros(),
+            sum_dt: 0.0,
+            all_nominal: true,
             steps_done: 0,
             sub_done: 0,
             phi: Transition::from_dense(&Mat15::identity()),
             q: Mat15::zeros(),
+            basis_on: false,
+            basis: [Mat15::zeros(); 4],
+            basis_taken: [Mat15::zeros(); 4],
         }
+    }
+
+    /// Also accumulates, per interval, the noise matrices B_k of the four noise inputs at unit
+    /// density (accelerometer white noise on δv, gyro white noise on ψ, random walks on ∇ and
+    /// ε): Q_T = Σ_k psd_k B_k exactly (Q_T is linear in W). Read them with
+    /// [`IntervalModel::noise_basis`] after [`IntervalModel::take`]. Costs four more
+    /// discretisations per sub-interval.
+    pub fn enable_noise_basis(&mut self) {
+        self.basis_on = true;
+    }
+
+    /// The B_k of the interval returned by the last [`IntervalModel::take`] (zeros unless
+    /// [`IntervalModel::enable_noise_basis`]).
+    pub fn noise_basis(&self) -> &[Mat15; 4] {
+        &self.basis_taken
     }
 
     /// The constant W = G Q_c Gᵀ (state units² / s).
@@ -86,10 +114,23 @@ impl IntervalModel {
         &self.w
     }
 
-    /// Adds the linearisation point after one INS step. Closes a sub-interval when due.
+    /// Adds the linearisation point after one INS step of the nominal length. Closes a
+    /// sub-interval when due.
     #[inline]
     pub fn push(&mut self, lp: &LinearizationPoint) {
+        self.push_dt(lp, self.step_s);
+    }
+
+    /// Adds the linearisation point after one INS step of `dt_s` seconds (irregular samples).
+    /// Sub-intervals still close after `steps_per_interval / subintervals` steps; the
+    /// sub-interval's length is the sum of its steps (n·T_s exactly when every step was
+    /// nominal), and the averages are plain means over the steps (for steps of unequal length
+    /// a first-order approximation of the time average).
+    #[inline]
+    pub fn push_dt(&mut self, lp: &LinearizationPoint, dt_s: f64) {
         self.n += 1;
+        self.sum_dt += dt_s;
+        self.all_nominal &= dt_s == self.step_s;
         self.sum_lat += lp.pos.lat_rad;
         self.sum_lon += lp.pos.lon_rad;
         self.sum_alt += lp.pos.alt_m;
@@ -119,11 +160,26 @@ impl IntervalModel {
             c_b_to_n: self.sum_c * inv,
         };
         let a = error_model::system_matrix(&lp);
-        let (phi_s, q_s) = error_model::discretize_fast(&a, &self.w, self.n as f64 * self.step_s);
+        let tau_s = if self.all_nominal {
+            self.n as f64 * self.step_s
+        } else {
+            self.sum_dt
+        };
+        let (phi_s, q_s) = error_model::discretize_fast(&a, &self.w, tau_s);
         let phi11: SMatrix<f64, 9, 9> = phi_s.phi11 * self.phi.phi11;
         let phi12: SMatrix<f64, 9, 6> = phi_s.phi11 * self.phi.phi12 + phi_s.phi12;
         self.phi = Transition { phi11, phi12 };
         error_model::propagate_covariance(&mut self.q, &phi_s, &q_s);
+        if self.basis_on {
+            for (k, b) in self.basis.iter_mut().enumerate() {
+                let mut w = Mat15::zeros();
+                for i in 0..3 {
+                    w[(3 + 3 * k + i, 3 + 3 * k + i)] = 1.0;
+                }
+                let (phi_k, q_k) = error_model::discretize_fast(&a, &w, tau_s);
+                error_model::propagate_covariance(b, &phi_k, &q_k);
+            }
+        }
         self.sub_done += 1;
         self.n = 0;
         self.sum_lat = 0.0;
@@ -132,11 +188,20 @@ impl IntervalModel {
         self.sum_vel = Vector3::zeros();
         self.sum_f = Vector3::zeros();
         self.sum_c = Matrix3::zeros();
+        self.sum_dt = 0.0;
+        self.all_nominal = true;
     }
 
     /// Number of INS steps pushed since the last [`IntervalModel::take`].
     pub fn steps_done(&self) -> usize {
         self.steps_done
+    }
+
+    /// (Φ, Q) from the last [`IntervalModel::take`] to now, without starting a new interval
+    /// (works on a copy; for predictions between updates).
+    pub fn peek(&self) -> (Mat15, Mat15) {
+        let mut copy = self.clone();
+        copy.take()
     }
 
     /// Returns (Φ_T dense, Q_T) for the steps pushed since the last call (closing a partial
@@ -146,6 +211,10 @@ impl IntervalModel {
         let out = (self.phi.to_dense(), self.q);
         self.phi = Transition::from_dense(&Mat15::identity());
         self.q = Mat15::zeros();
+        if self.basis_on {
+            self.basis_taken = self.basis;
+            self.basis = [Mat15::zeros(); 4];
+        }
         self.steps_done = 0;
         self.sub_done = 0;
         out
