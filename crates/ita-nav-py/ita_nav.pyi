@@ -85,3 +85,72 @@ class LaneTracker:
 def read_frames(path: str) -> list[npt.NDArray[np.uint8]]:
     """Every frame of an input, read as `nav-app --input PATH` reads it: a YUV4MPEG2 file, a
     directory of images or a still image; H x W uint8 arrays. Raises NavError."""
+
+FilterName = Literal["kf", "akf", "akf_sage_husa", "akf_structured"]
+
+class UpdateReport(TypedDict):
+    used: int
+    rejected: int
+    nis: Optional[float]
+    adaptive_q: bool
+    fed_back: bool
+
+class Navigation(TypedDict):
+    lat_rad: float
+    lon_rad: float
+    alt_m: float
+    vel_ned_mps: Tuple[float, float, float]
+    att_quat_wxyz: Tuple[float, float, float, float]
+
+class InsSdFilter:
+    """The online INS/sighting-device filter (crate ins-sd-filter): the same code the Monte Carlo
+    and `nav-app ins` run."""
+
+    def __init__(
+        self,
+        landmarks: str,
+        initial: str,
+        config: Optional[str] = None,
+        filter: FilterName = "kf",
+        gate: Optional[float] = None,
+    ) -> None:
+        """landmarks: TOML landmark table; initial: TOML initial state (the formats export_run
+        writes); config: a scenario file for the filter settings (None: the paper's); gate: chi-square
+        gate probability per sighting (None: no gate). Raises NavError naming the file."""
+    def propagate(
+        self, t_s: float, dv_body_mps: list[float], dtheta_body_rad: list[float]
+    ) -> None:
+        """One IMU sample ending at t_s: velocity and angle increments over it, body FRD.
+        Raises NavError for out-of-order time or non-finite input, ValueError for a wrong length."""
+    def update(self, t_s: float, sightings: list[Tuple[int, float, float]]) -> UpdateReport:
+        """Sightings (landmark_id, w_m, h_m) at the epoch t_s (the INS time); 0 to many."""
+    @property
+    def time_s(self) -> float: ...
+    @property
+    def error_state(self) -> npt.NDArray[np.float64]:
+        """15 error states: dp (m NED), dv (m/s NED), psi (rad), accel bias (m/s^2), gyro drift (rad/s)."""
+    @property
+    def covariance(self) -> Optional[npt.NDArray[np.float64]]:
+        """15 x 15 error covariance."""
+    def navigation(self) -> Navigation:
+        """The corrected navigation solution."""
+    @property
+    def statistics(self) -> dict[str, int]:
+        """imu_samples, epochs, sightings_used, sightings_rejected, adaptive_q_used."""
+
+def export_run(
+    out_dir: str,
+    config: Optional[str] = None,
+    filter: Literal["standalone"] | FilterName = "kf",
+    seed: int = 0,
+) -> int:
+    """Simulate one flight and write its logs (imu.csv, sightings.csv, truth.csv, landmarks.toml,
+    initial.toml, scenario.toml, solution.csv) into out_dir; returns the records written."""
+
+def run_flight(
+    config: Optional[str] = None,
+    filter: Literal["standalone"] | FilterName = "kf",
+    seed: int = 0,
+) -> dict[str, npt.NDArray[np.float64]]:
+    """One simulated flight as numpy arrays: t_s, pos_err_ned_m (n x 3), vel_err_ned_mps,
+    misalignment_rad, distance_m, nees and nis (NaN off the sighting epochs)."""

@@ -31,6 +31,8 @@
 
 use std::time::Instant;
 
+mod ins;
+
 use numpy::{PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -348,5 +350,8 @@ fn ita_nav(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_CONFIG_TOML", nav_app::DEFAULT_TOML)?;
     m.add_class::<LaneTracker>()?;
     m.add_function(wrap_pyfunction!(read_frames, m)?)?;
+    m.add_class::<ins::InsSdFilter>()?;
+    m.add_function(wrap_pyfunction!(ins::export_run, m)?)?;
+    m.add_function(wrap_pyfunction!(ins::run_flight, m)?)?;
     Ok(())
 }

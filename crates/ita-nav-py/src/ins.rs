@@ -1,0 +1,266 @@
+//! The INS/SD half from Python: the online filter object (`ins-sd-filter`, the same code the Monte
+//! Carlo and `nav-app ins` run), log export of a simulated flight, and one simulated flight as
+//! numpy time series.
+
+use std::path::Path;
+
+use nalgebra::Vector3;
+use numpy::{PyArray1, PyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use ins_errors::strapdown::NavState;
+use nav_app::ins_sd::{Mode, Sample, Scenario, logs};
+
+use crate::NavError;
+
+fn err(e: impl std::fmt::Display) -> PyErr {
+    NavError::new_err(e.to_string())
+}
+
+/// `None` → the paper's scenario (`configs/paper.toml`, built in); else a scenario TOML path.
+fn load_scenario(config: Option<&str>) -> PyResult<Scenario> {
+    match config {
+        None => Ok(Scenario::paper_default()),
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| err(format!("{path}: {e}")))?;
+            Scenario::from_toml_named(path, &text).map_err(err)
+        }
+    }
+}
+
+fn mode_of(filter: &str) -> PyResult<Mode> {
+    Ok(match filter {
+        "standalone" => Mode::Standalone,
+        "kf" => Mode::Kf,
+        "akf" => Mode::Akf,
+        "akf_sage_husa" => Mode::AkfSageHusa,
+        "akf_structured" => Mode::AkfStructured,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "filter must be one of standalone, kf, akf, akf_sage_husa, akf_structured; not {other:?}"
+            )));
+        }
+    })
+}
+
+fn vec3(name: &str, v: &[f64]) -> PyResult<Vector3<f64>> {
+    match v {
+        [x, y, z] => Ok(Vector3::new(*x, *y, *z)),
+        _ => Err(PyValueError::new_err(format!(
+            "{name} must have 3 components, got {}",
+            v.len()
+        ))),
+    }
+}
+
+fn nav_dict<'py>(py: Python<'py>, s: &NavState) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("lat_rad", s.pos.lat_rad)?;
+    d.set_item("lon_rad", s.pos.lon_rad)?;
+    d.set_item("alt_m", s.pos.alt_m)?;
+    d.set_item(
+        "vel_ned_mps",
+        (s.vel_ned_mps[0], s.vel_ned_mps[1], s.vel_ned_mps[2]),
+    )?;
+    let q = s.att_b_to_n.quaternion();
+    d.set_item("att_quat_wxyz", (q.w, q.i, q.j, q.k))?;
+    Ok(d)
+}
+
+/// The online INS/SD filter: `InsSdFilter(landmarks, initial, config=None, filter="kf",
+/// gate=None)` with a landmark table and an initial state in the TOML formats of
+/// `nav_app::ins_sd::logs` (what `export_run` writes), the filter settings of a scenario file
+/// (`None`: the paper's), `filter` `"kf"` or `"akf"`, and an optional χ² gate probability per
+/// sighting.
+#[pyclass(module = "ita_nav")]
+pub struct InsSdFilter {
+    inner: ins_sd_filter::InsSdFilter,
+    sightings: Vec<ins_sd_filter::Sighting>,
+}
+
+#[pymethods]
+impl InsSdFilter {
+    #[new]
+    #[pyo3(signature = (landmarks, initial, config=None, filter="kf", gate=None))]
+    fn new(
+        landmarks: &str,
+        initial: &str,
+        config: Option<&str>,
+        filter: &str,
+        gate: Option<f64>,
+    ) -> PyResult<Self> {
+        let scenario = load_scenario(config)?;
+        let mode = mode_of(filter)?;
+        if mode == Mode::Standalone {
+            return Err(PyValueError::new_err(
+                "filter must be a filter (kf, akf, …), not standalone",
+            ));
+        }
+        let mut cfg = scenario.online_filter_config(mode);
+        cfg.gate_probability = gate;
+        let table = logs::read_landmarks(Path::new(landmarks)).map_err(err)?;
+        let init = logs::read_initial(Path::new(initial)).map_err(err)?;
+        let inner = ins_sd_filter::InsSdFilter::new(cfg, table, init.nav_state(), init.t_s)
+            .map_err(|e| err(format!("{initial}: {e}")))?;
+        Ok(InsSdFilter {
+            inner,
+            sightings: Vec::new(),
+        })
+    }
+
+    /// One IMU sample ending at `t_s` (s): `dv_body_mps` = ∫ f̃ dt and `dtheta_body_rad` = ∫ ω̃ dt
+    /// over the sample (3 components each, body FRD). Raises `NavError` for out-of-order time
+    /// or non-finite input.
+    fn propagate(
+        &mut self,
+        t_s: f64,
+        dv_body_mps: Vec<f64>,
+        dtheta_body_rad: Vec<f64>,
+    ) -> PyResult<()> {
+        let dv = vec3("dv_body_mps", &dv_body_mps)?;
+        let dth = vec3("dtheta_body_rad", &dtheta_body_rad)?;
+        self.inner.propagate(t_s, &dv, &dth).map_err(err)
+    }
+
+    /// Sightings at epoch `t_s` (the INS time): `(landmark_id, w_m, h_m)` tuples, 0 to many.
+    /// Returns `{"used", "rejected", "nis", "adaptive_q", "fed_back"}`. Raises `NavError` for an
+    /// unknown landmark, a time off the INS time, or non-finite input (nothing changes then).
+    fn update<'py>(
+        &mut self,
+        py: Python<'py>,
+        t_s: f64,
+        sightings: Vec<(u32, f64, f64)>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        self.sightings.clear();
+        self.sightings.extend(
+            sightings
+                .into_iter()
+                .map(|(id, w, h)| ins_sd_filter::Sighting {
+                    landmark_id: id,
+                    w_m: w,
+                    h_m: h,
+                }),
+        );
+        let r = self.inner.update(t_s, &self.sightings).map_err(err)?;
+        let d = PyDict::new(py);
+        d.set_item("used", r.used)?;
+        d.set_item("rejected", r.rejected)?;
+        d.set_item("nis", r.nis)?;
+        d.set_item("adaptive_q", r.adaptive_q)?;
+        d.set_item("fed_back", r.fed_back)?;
+        Ok(d)
+    }
+
+    /// Time of the INS, s.
+    #[getter]
+    fn time_s(&self) -> f64 {
+        self.inner.time_s()
+    }
+
+    /// The 15 error states (δp m NED, δv m/s, ψ rad, ∇ m/s², ε rad/s), computed − true.
+    #[getter]
+    fn error_state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.inner.error_state().as_slice())
+    }
+
+    /// The 15×15 error covariance (`None` for no estimator).
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        let Some(p) = self.inner.covariance() else {
+            return Ok(None);
+        };
+        let rows: Vec<Vec<f64>> = (0..15)
+            .map(|i| (0..15).map(|j| p[(i, j)]).collect())
+            .collect();
+        Ok(Some(PyArray2::from_vec2(py, &rows)?))
+    }
+
+    /// The corrected navigation solution: `lat_rad`, `lon_rad`, `alt_m`, `vel_ned_mps`,
+    /// `att_quat_wxyz` (body FRD → NED).
+    fn navigation<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        nav_dict(py, &self.inner.navigation_solution())
+    }
+
+    /// Totals: `imu_samples`, `epochs`, `sightings_used`, `sightings_rejected`, `adaptive_q_used`.
+    #[getter]
+    fn statistics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.inner.statistics();
+        let d = PyDict::new(py);
+        d.set_item("imu_samples", s.imu_samples)?;
+        d.set_item("epochs", s.epochs)?;
+        d.set_item("sightings_used", s.sightings_used)?;
+        d.set_item("sightings_rejected", s.sightings_rejected)?;
+        d.set_item("adaptive_q_used", s.adaptive_q_used)?;
+        Ok(d)
+    }
+}
+
+/// Simulate run `seed` of a scenario (`config=None`: the paper's) with `filter` and write its logs
+/// into `out_dir` (imu.csv, sightings.csv, truth.csv, landmarks.toml, initial.toml, scenario.toml
+/// and the simulated filter's solution.csv) — the files `InsSdFilter` and `nav-app ins` replay.
+#[pyfunction]
+#[pyo3(signature = (out_dir, config=None, filter="kf", seed=0))]
+pub fn export_run(out_dir: &str, config: Option<&str>, filter: &str, seed: u64) -> PyResult<usize> {
+    let scenario = load_scenario(config)?;
+    std::fs::create_dir_all(out_dir).map_err(|e| err(format!("{out_dir}: {e}")))?;
+    let (outcome, _) =
+        logs::export_run(&scenario, mode_of(filter)?, seed, Path::new(out_dir)).map_err(err)?;
+    Ok(outcome.samples_written)
+}
+
+/// One simulated flight (`config=None`: the paper's scenario; `filter` one of standalone, kf, akf,
+/// akf_sage_husa, akf_structured; `seed` the run's seed) as numpy arrays at the record rate:
+/// `t_s` (n), `pos_err_ned_m` (n×3), `vel_err_ned_mps` (n×3), `misalignment_rad` (n×3),
+/// `distance_m` (n), `nees` and `nis` (n, NaN off the sighting epochs).
+#[pyfunction]
+#[pyo3(signature = (config=None, filter="kf", seed=0))]
+pub fn run_flight<'py>(
+    py: Python<'py>,
+    config: Option<&str>,
+    filter: &str,
+    seed: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let scenario = load_scenario(config)?;
+    let mode = mode_of(filter)?;
+    let mut out = vec![Sample::default(); scenario.samples_per_run()];
+    let outcome = py
+        .detach(|| nav_app::ins_sd::run(&scenario, mode, seed, &mut out))
+        .map_err(err)?;
+    out.truncate(outcome.samples_written);
+    let col3 = |f: fn(&Sample) -> [f64; 3]| -> Vec<Vec<f64>> {
+        out.iter().map(|s| f(s).to_vec()).collect()
+    };
+    let d = PyDict::new(py);
+    d.set_item(
+        "t_s",
+        PyArray1::from_vec(py, out.iter().map(|s| s.t_s).collect()),
+    )?;
+    d.set_item(
+        "pos_err_ned_m",
+        PyArray2::from_vec2(py, &col3(|s| s.pos_err_ned_m))?,
+    )?;
+    d.set_item(
+        "vel_err_ned_mps",
+        PyArray2::from_vec2(py, &col3(|s| s.vel_err_ned_mps))?,
+    )?;
+    d.set_item(
+        "misalignment_rad",
+        PyArray2::from_vec2(py, &col3(|s| s.misalignment_rad))?,
+    )?;
+    d.set_item(
+        "distance_m",
+        PyArray1::from_vec(py, out.iter().map(|s| s.distance_m).collect()),
+    )?;
+    for (k, f) in [
+        ("nees", (|s: &Sample| s.nees) as fn(&Sample) -> Option<f64>),
+        ("nis", |s: &Sample| s.nis),
+    ] {
+        d.set_item(
+            k,
+            PyArray1::from_vec(py, out.iter().map(|s| f(s).unwrap_or(f64::NAN)).collect()),
+        )?;
+    }
+    Ok(d)
+}
