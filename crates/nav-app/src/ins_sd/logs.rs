@@ -48,6 +48,7 @@ use ins_sd_filter::{
 };
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
+use toml_config::TomlDoc;
 
 use super::engine::{self, RunObserver};
 use super::{Mode, RunError, RunOutcome, Sample, Scenario};
@@ -325,34 +326,37 @@ struct LandmarkFile {
     landmarks: Vec<LandmarkEntry>,
 }
 
-fn toml_err(path: &Path, text: &str, e: &toml::de::Error) -> LogError {
-    let (line, column) = e.span().map_or((1, 1), |span| {
-        let before = &text[..span.start.min(text.len())];
-        let line = before.matches('\n').count() + 1;
-        let column = span.start - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-        (line, column)
-    });
+fn toml_err(path: &Path, e: toml_config::TomlError) -> LogError {
     LogError::Parse {
         path: path.to_path_buf(),
-        line,
-        column,
-        message: e.message().to_string(),
+        line: e.line.unwrap_or(1),
+        column: e.column.unwrap_or(1),
+        message: e.message,
     }
 }
 
 /// Reads a landmark table file.
 ///
 /// # Errors
-/// [`LogError::Io`], [`LogError::Parse`] (TOML errors with their line and column; a duplicate
-/// id or a bad coordinate at line 1).
+/// [`LogError::Io`], [`LogError::Parse`] (TOML errors with their line and column, through the
+/// workspace's one TOML loader `toml-config`; a duplicate id or a bad coordinate at the
+/// `[[landmarks]]` entry concerned).
 pub fn read_landmarks(path: &Path) -> Result<LandmarkTable, LogError> {
     let text = std::fs::read_to_string(path).map_err(io_err(path))?;
-    let file: LandmarkFile = toml::from_str(&text).map_err(|e| toml_err(path, &text, &e))?;
-    LandmarkTable::new(&file.landmarks).map_err(|e| LogError::Parse {
-        path: path.to_path_buf(),
-        line: 1,
-        column: 1,
-        message: e.to_string(),
+    let doc = TomlDoc::parse(path.display().to_string(), &text).map_err(|e| toml_err(path, e))?;
+    let file: LandmarkFile = doc.deserialize().map_err(|e| toml_err(path, e))?;
+    LandmarkTable::new(&file.landmarks).map_err(|e| {
+        // Locate the entry the table refused: the last one with a repeated id, or the one with
+        // the bad coordinate.
+        let id = match &e {
+            FilterError::DuplicateLandmark { id } => Some(*id),
+            FilterError::Sighting { landmark, .. } => Some(*landmark),
+            _ => None,
+        };
+        let at = id
+            .and_then(|id| file.landmarks.iter().rposition(|l| l.id == id))
+            .map_or_else(|| "landmarks".to_owned(), |i| format!("landmarks[{i}]"));
+        toml_err(path, doc.error_at(&at, e.to_string()))
     })
 }
 
@@ -362,7 +366,8 @@ pub fn read_landmarks(path: &Path) -> Result<LandmarkTable, LogError> {
 /// [`LogError::Io`], [`LogError::Parse`].
 pub fn read_initial(path: &Path) -> Result<InitialState, LogError> {
     let text = std::fs::read_to_string(path).map_err(io_err(path))?;
-    toml::from_str(&text).map_err(|e| toml_err(path, &text, &e))
+    let doc = TomlDoc::parse(path.display().to_string(), &text).map_err(|e| toml_err(path, e))?;
+    doc.deserialize().map_err(|e| toml_err(path, e))
 }
 
 fn write_nav<W: Write + ?Sized>(w: &mut W, t_s: f64, s: &NavState) -> std::io::Result<()> {
