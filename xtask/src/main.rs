@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 
 mod eval_lanes;
 mod fixtures;
+mod halves;
 mod monte_carlo;
 mod python;
 mod regress;
@@ -37,6 +38,9 @@ enum Cmd {
     /// Score the lane tracker on the real labelled sets (fixtures/real/), beside the presets and
     /// the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
     EvalLanes(eval_lanes::EvalLanesArgs),
+    /// Check that nav-app's lane and INS halves build alone and that the lane half pulls in no INS,
+    /// V4L2 or CLI crate.
+    Halves,
     /// Build the `ita_nav` Python wheel into target/py-venv and run its pytest suite.
     Python(python::PythonArgs),
     /// The paper's Monte Carlo experiment (stand-alone, KF, AKF): summaries, CSV, Figs. 1–6; `merge` combines shards.
@@ -52,6 +56,7 @@ fn main() -> Result<()> {
         Cmd::Regress(args) => regress::run(args),
         Cmd::EvalLanes(args) => eval_lanes::run(args),
         Cmd::Python(args) => python::run(args),
+        Cmd::Halves => halves::run(),
         Cmd::MonteCarlo(args) => monte_carlo::run(args),
     }
 }
@@ -103,6 +108,11 @@ const STEPS: &[Step] = &[
             "--features",
             "cli",
         ]),
+    },
+    Step {
+        // nav-app's lane and INS halves build alone; the lane half has no INS/V4L2/CLI crate.
+        name: "halves",
+        run: Run::Xtask(&["halves"]),
     },
     Step {
         name: "doctest",

@@ -154,6 +154,7 @@ pub enum NavError {
     /// device node, unknown input, unsupported standard or format, ioctl failure). Fatal.
     /// (The capture error is rendered in the message, so it is not repeated as a `source`.)
     #[error("{device}: {error}")]
+    #[cfg(feature = "lane")]
     Capture {
         /// The device path.
         device: String,
@@ -270,6 +271,7 @@ impl NavError {
         }
     }
 
+    #[cfg(feature = "lane")]
     pub(crate) fn io(path: impl Into<String>, source: io::Error) -> Self {
         NavError::Io {
             path: path.into(),

@@ -92,29 +92,27 @@
 //! # Ok::<(), nav_app::NavError>(())
 //! ```
 
-pub mod birdseye;
-pub mod camera;
-pub mod capture_source;
-mod config;
 mod error;
-mod frame;
-pub mod sources;
-pub mod y4m;
+#[cfg(feature = "lane")]
+pub mod lane;
 
-pub use config::{
+pub use error::NavError;
+
+#[cfg(feature = "lane")]
+pub use lane::config::{
     DEFAULT_TOML, FilterConfig, GradientConfig, INDOOR_TOML, InitConfig, OUTDOOR_TOML, RoiConfig,
     TrackConfig, TrackerConfig,
 };
-pub use error::NavError;
-pub use frame::{FrameMeta, FrameSource, GreyFrame};
-mod tracker;
-mod wrls_lane;
-
-pub use tracker::{
+#[cfg(feature = "lane")]
+pub use lane::frame::{FrameMeta, FrameSource, GreyFrame};
+#[cfg(feature = "lane")]
+pub use lane::tracker::{
     Estimator, LaneReport, LaneState, LaneTracker, LaneView, Side, TrackReport, TrackerCounters,
 };
-pub mod eval;
+#[cfg(feature = "lane")]
+pub use lane::{birdseye, camera, capture_source, eval, labelled, overlay, sources, synth, y4m};
+
+/// The INS half: the sighting-device-aided INS closed loop, its Monte Carlo runs and the log
+/// replay (feature `ins`, on by default).
+#[cfg(feature = "ins")]
 pub mod ins_sd;
-pub mod labelled;
-pub mod overlay;
-pub mod synth;

@@ -1,5 +1,6 @@
 //! The camera file parser (`--camera`): random and mutated inputs never panic (a typed error or a
 //! validated config), valid configs round-trip serialise → parse, and the CLI prints the ego lane.
+#![cfg(feature = "cli")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::process::Command;

@@ -1,4 +1,5 @@
 //! The `nav-app` binary end to end: JSON schema, overlays, bad input and exit codes.
+#![cfg(feature = "cli")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::{Path, PathBuf};

@@ -1,5 +1,6 @@
 //! Scenario file: `configs/paper.toml` equals `Scenario::paper_default()`, bad input is rejected
 //! with an error naming the section or the dotted field.
+#![cfg(feature = "ins")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nav_app::ins_sd::{Mode, Scenario, ScenarioError, run_seed};

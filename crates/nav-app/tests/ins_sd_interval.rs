@@ -1,6 +1,7 @@
 //! Accuracy of the interval discretisation (A averaged on sub-intervals) against the paper's
 //! way: Φ of every 0.01 s INS step multiplied over the 1 s SD interval, and Q_d of every step
 //! (Simpson, `discretize_fast`) accumulated through the same products.
+#![cfg(feature = "ins")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use ins_errors::error_model::{self, Mat15, Transition};

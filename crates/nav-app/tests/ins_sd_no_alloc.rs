@@ -2,6 +2,7 @@
 //! as a run of 20 s with the same segment table (only the per-run setup allocates: trajectory table, boxed filter).
 //! Counted with the `alloc-counter` global allocator, which counts the measuring thread's
 //! allocations only.
+#![cfg(feature = "ins")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use alloc_counter::allocations_in;

@@ -2,6 +2,7 @@
 //! numbers: identical truth, IMU errors and SD noise), KF, open loop for the first 120 s: the
 //! INS is the same in every setting, so the recorded error (INS − x̂) differs only through the
 //! filter's H.
+#![cfg(feature = "ins")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nav_app::ins_sd::{MeasurementJacobian, Mode, Sample, Scenario, run, run_seed};

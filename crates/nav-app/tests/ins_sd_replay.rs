@@ -2,6 +2,7 @@
 //! online filter (`logs::replay`, what `nav-app ins` runs) gives the simulated filter's solution
 //! to round-off; its errors against the exported truth are the Monte Carlo's records; malformed
 //! or truncated logs are errors naming file, line and column.
+#![cfg(feature = "ins")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::{Path, PathBuf};

@@ -1,6 +1,7 @@
 //! Whole runs of the INS/SD loop: stand-alone equals `ins-errors`'s stand-alone INS, perfect
 //! sensors stay at zero error, the KF bounds the error far below stand-alone, bad runs fail
 //! with typed errors, and the KF is consistent (NEES/NIS) within a documented loose band.
+#![cfg(feature = "ins")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use ins_errors::config::BiasModel;

@@ -3,6 +3,7 @@
 //! panics and gives either a valid configuration or the typed error naming the file, a line of
 //! it and the column; a non-finite number in any field is refused at that field's line; valid
 //! configurations round-trip serialise → parse → equal.
+#![cfg(all(feature = "lane", feature = "ins"))]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nav_app::ins_sd::{Scenario, ScenarioError};

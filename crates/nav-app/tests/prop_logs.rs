@@ -2,6 +2,7 @@
 //! landmark table and initial state TOML. Mutated files (flipped bytes, truncation, inserted
 //! bytes, NaN/∞/huge or empty fields, duplicated or deleted lines) never panic and either replay
 //! or fail with an error naming the file, a line inside it and a column; valid files round-trip.
+#![cfg(feature = "ins")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::{Path, PathBuf};

@@ -2,6 +2,7 @@
 //! another size, junk, empty files and truncated PNGs delivers exactly its good frames in name
 //! order and reports every other file as a non-fatal bad frame naming it; a still image of any
 //! bytes decodes or is a typed error. Never a panic.
+#![cfg(feature = "lane")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::{Path, PathBuf};

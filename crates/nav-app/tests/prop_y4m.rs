@@ -2,6 +2,7 @@
 //! streams (flipped bytes, truncation, inserted and deleted bytes, absurd headers, random bytes)
 //! never panic, always end, allocate no more than the bytes present justify, and either deliver
 //! frames or return the typed error; a flipped `FRAME` header loses exactly its frame.
+#![cfg(feature = "lane")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nav_app::y4m::{Y4mChroma, Y4mSource, Y4mWriter};

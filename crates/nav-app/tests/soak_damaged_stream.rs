@@ -9,6 +9,7 @@
 //! short by 1000 bytes and by 3 bytes (it swallows the next frame's header: the next frame is
 //! lost); three whole frames overwritten with junk (lost); bytes dropped across a frame boundary
 //! (the next frame is lost).
+#![cfg(feature = "lane")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::alloc::{GlobalAlloc, Layout};

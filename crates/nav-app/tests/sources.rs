@@ -1,5 +1,6 @@
 //! Frame sources and bad input (issue 4 §2, §5): every case gives a typed error naming the file
 //! or the frame; fatal ones stop, single bad frames are reported and skipped. Never a panic.
+#![cfg(feature = "lane")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::{Path, PathBuf};

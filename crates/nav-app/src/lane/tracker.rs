@@ -115,7 +115,7 @@ pub struct TrackerCounters {
 #[derive(Debug, Clone)]
 enum LaneFilter {
     Kif(ParabolaKif),
-    Wrls(crate::wrls_lane::WrlsLane),
+    Wrls(super::wrls_lane::WrlsLane),
 }
 
 impl LaneFilter {
@@ -684,7 +684,7 @@ impl LaneTracker {
                 Estimator::Kif => ParabolaKif::new(&theta, &self.p0, self.row_norm)
                     .map(LaneFilter::Kif)
                     .map_err(|e| e.to_string()),
-                Estimator::Wrls => crate::wrls_lane::WrlsLane::new(
+                Estimator::Wrls => super::wrls_lane::WrlsLane::new(
                     &theta,
                     &self.p0,
                     self.row_norm,

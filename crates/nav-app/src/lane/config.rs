@@ -11,11 +11,11 @@ use toml_config::TomlDoc;
 use crate::NavError;
 
 /// The default configuration (`nav-app` with no `--config`), as shipped in `configs/default.toml`.
-pub const DEFAULT_TOML: &str = include_str!("../../../configs/default.toml");
+pub const DEFAULT_TOML: &str = include_str!("../../../../configs/default.toml");
 /// The `outdoor` preset (highway, strong light/shadow contrast), as shipped in `configs/outdoor.toml`.
-pub const OUTDOOR_TOML: &str = include_str!("../../../configs/outdoor.toml");
+pub const OUTDOOR_TOML: &str = include_str!("../../../../configs/outdoor.toml");
 /// The `indoor` preset (corridor floor lines, low contrast), as shipped in `configs/indoor.toml`.
-pub const INDOOR_TOML: &str = include_str!("../../../configs/indoor.toml");
+pub const INDOOR_TOML: &str = include_str!("../../../../configs/indoor.toml");
 
 /// Stage I: directional gradient (3×3 Sobel; see the `vision-gradient` crate).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

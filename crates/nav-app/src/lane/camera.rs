@@ -49,9 +49,9 @@ use toml_config::TomlDoc;
 use crate::{LaneTracker, NavError, Side, TrackReport};
 
 /// The robot preset (`configs/camera-robot.toml`).
-pub const CAMERA_ROBOT_TOML: &str = include_str!("../../../configs/camera-robot.toml");
+pub const CAMERA_ROBOT_TOML: &str = include_str!("../../../../configs/camera-robot.toml");
 /// The highway preset for the bundled udacity clip (`configs/camera-highway.toml`).
-pub const CAMERA_HIGHWAY_TOML: &str = include_str!("../../../configs/camera-highway.toml");
+pub const CAMERA_HIGHWAY_TOML: &str = include_str!("../../../../configs/camera-highway.toml");
 
 /// `[intrinsics]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
