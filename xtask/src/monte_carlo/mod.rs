@@ -102,6 +102,7 @@ pub mod driver;
 pub mod export;
 pub mod plot;
 pub mod report;
+pub mod scenarios;
 pub mod stats;
 
 #[cfg(test)]
@@ -132,6 +133,9 @@ pub struct MonteCarloArgs {
 pub enum McCmd {
     /// Merge the `stats.json` of shard directories into the outputs of one run.
     Merge(MergeArgs),
+    /// The matched case and every model-mismatch scenario of configs/mismatch/ (KF and AKF,
+    /// same seeds) in one comparison table.
+    Scenarios(Box<scenarios::ScenariosArgs>),
 }
 
 /// Options of a simulation run.
@@ -187,6 +191,9 @@ pub struct MergeArgs {
 pub fn run(args: MonteCarloArgs) -> Result<()> {
     match args.cmd {
         Some(McCmd::Merge(m)) => merge(&m).map(|_| ()),
+        Some(McCmd::Scenarios(a)) => {
+            scenarios::run(&a, &workspace_root(), &target_dir()).map(|_| ())
+        }
         None => simulate(&args.run).map(|_| ()),
     }
 }

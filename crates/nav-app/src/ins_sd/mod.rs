@@ -188,10 +188,13 @@
 mod config;
 mod engine;
 pub mod logs;
+mod mismatch;
 /// The interval discretisation (moved to `ins-sd-filter`; re-exported for existing users).
 pub use ins_sd_filter::interval;
 
-pub use config::{AkfScheme, FilterConfig, MeasurementJacobian, MonteCarloConfig, ScenarioError};
+pub use config::{
+    AkfScheme, FilterConfig, MeasurementJacobian, MismatchConfig, MonteCarloConfig, ScenarioError,
+};
 pub use engine::{NoObserver, RunObserver};
 
 use ins_errors::InsError;
@@ -212,6 +215,8 @@ pub struct Scenario {
     pub filter: FilterConfig,
     /// `[monte_carlo]`: runs and master seed.
     pub monte_carlo: MonteCarloConfig,
+    /// `[mismatch]` (optional): how the simulated world departs from the filter's model.
+    pub mismatch: MismatchConfig,
 }
 
 /// Step counts derived from a validated scenario.
@@ -244,6 +249,7 @@ impl Scenario {
             sighting: f.sighting,
             filter: f.filter,
             monte_carlo: f.monte_carlo,
+            mismatch: f.mismatch,
         };
         s.validate()?;
         Ok(s)
@@ -260,6 +266,7 @@ impl Scenario {
             sighting: self.sighting.clone(),
             filter: self.filter.clone(),
             monte_carlo: self.monte_carlo.clone(),
+            mismatch: self.mismatch.clone(),
         })
     }
 
@@ -276,6 +283,7 @@ impl Scenario {
             sighting: SightingConfig::paper(),
             filter: FilterConfig::paper(),
             monte_carlo: MonteCarloConfig::paper(),
+            mismatch: MismatchConfig::default(),
         }
     }
 
@@ -304,6 +312,7 @@ impl Scenario {
         self.sighting.landmarks3().map_err(sighting_err)?;
         self.filter.validate()?;
         self.monte_carlo.validate()?;
+        self.mismatch.validate()?;
         let tr = Trajectory::new(&self.trajectory).map_err(ins)?;
         self.sighting
             .check_vehicle(&tr.start())
@@ -344,6 +353,14 @@ impl Scenario {
                     self.sighting.update_period_s,
                 )
             })?;
+        let lat = self.mismatch.latency_s / step_s;
+        if (lat - lat.round()).abs() > 1e-6 || lat.round() as usize >= steps_per_update {
+            return Err(ScenarioError::invalid(
+                "mismatch.latency_s",
+                "must be a multiple of trajectory.step_s below sighting.update_period_s",
+                self.mismatch.latency_s,
+            ));
+        }
         if self.filter.phi_subintervals > steps_per_update {
             return Err(ScenarioError::invalid(
                 "filter.phi_subintervals",
@@ -581,8 +598,11 @@ pub struct Sample {
     pub distance_m: f64,
     /// Filters only, at SD update epochs: eᵀ P⁻¹ e with all 15 states.
     pub nees: Option<f64>,
-    /// Filters only, at SD update epochs: νᵀ S⁻¹ ν, 6 measurements.
+    /// Filters only, at SD update epochs: νᵀ S⁻¹ ν of the sightings used (6 measurements
+    /// for three landmarks; see `nis_dof`).
     pub nis: Option<f64>,
+    /// Degrees of freedom of `nis`: 2 × the sightings used at that epoch (0 when none).
+    pub nis_dof: u32,
 }
 
 /// What a run did.
@@ -592,6 +612,10 @@ pub struct RunOutcome {
     pub samples_written: usize,
     /// 100 Hz INS epochs simulated.
     pub epochs: u64,
+    /// Sightings the filter used.
+    pub sightings_used: u64,
+    /// Sightings the filter's χ² gate rejected.
+    pub sightings_rejected: u64,
 }
 
 /// Failures of [`run`]; each says where (time) and what.
