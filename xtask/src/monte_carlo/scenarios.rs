@@ -46,6 +46,10 @@ pub struct Row {
     pub final_rms_m: f64,
     /// Median of the final 3-D error, m.
     pub final_median_m: f64,
+    /// 10th percentile of the final 3-D error, m.
+    pub final_p10_m: f64,
+    /// 90th percentile of the final 3-D error, m.
+    pub final_p90_m: f64,
     /// Mean NEES over kept runs and epochs t ≥ 1 s.
     pub nees_mean: f64,
     /// Fraction of epochs whose run-average NEES is inside the per-epoch 95 % band.
@@ -115,7 +119,10 @@ pub fn evaluate(name: &str, sc: &Scenario, mode: Mode, runs: u64) -> Row {
     row.final_rms_m = (kept.iter().map(|r| r.final_m * r.final_m).sum::<f64>() / k).sqrt();
     let mut finals: Vec<f64> = kept.iter().map(|r| r.final_m).collect();
     finals.sort_by(f64::total_cmp);
-    row.final_median_m = finals[finals.len() / 2];
+    let q = |f: f64| finals[((finals.len() - 1) as f64 * f).round() as usize];
+    row.final_median_m = q(0.5);
+    row.final_p10_m = q(0.1);
+    row.final_p90_m = q(0.9);
     let band = akf::average_band(15, kept.len(), 0.95).unwrap_or((f64::NAN, f64::NAN));
     let (mut inside, mut epochs, mut sum, mut cnt) = (0usize, 0usize, 0.0, 0usize);
     for t in 1..n {
