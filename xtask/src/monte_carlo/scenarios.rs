@@ -40,8 +40,10 @@ pub struct Row {
     pub mode: String,
     /// Runs that reached the end.
     pub kept: u64,
-    /// Runs lost (failed), with the earliest failure time.
+    /// Runs lost (the simulation failed).
     pub lost: u64,
+    /// Failure times of the lost runs, s (sorted).
+    pub lost_t_s: Vec<f64>,
     /// RMS over kept runs of the final 3-D position error, m.
     pub final_rms_m: f64,
     /// Median of the final 3-D error, m.
@@ -74,16 +76,18 @@ struct RunResult {
 /// Simulates `runs` runs of `sc` in `mode` and summarises them.
 pub fn evaluate(name: &str, sc: &Scenario, mode: Mode, runs: u64) -> Row {
     let n = sc.samples_per_run();
-    let results: Vec<Option<RunResult>> = (0..runs)
+    let results: Vec<Result<RunResult, f64>> = (0..runs)
         .into_par_iter()
         .map(|i| {
             let mut out = vec![Sample::default(); n];
             let seed = ins_sd::run_seed(sc.monte_carlo.seed, mode, i);
-            let o = ins_sd::run(sc, mode, seed, &mut out).ok()?;
-            let last = out.last()?;
+            let o = ins_sd::run(sc, mode, seed, &mut out).map_err(|e| failure_time(&e))?;
+            let Some(last) = out.last() else {
+                return Err(f64::NAN);
+            };
             let p = last.pos_err_ned_m;
             if !p.iter().all(|v| v.is_finite()) {
-                return None;
+                return Err(last.t_s);
             }
             let mut r = RunResult {
                 final_m: (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt(),
@@ -101,15 +105,21 @@ pub fn evaluate(name: &str, sc: &Scenario, mode: Mode, runs: u64) -> Row {
                     r.dof_sum += s.nis_dof as f64;
                 }
             }
-            Some(r)
+            Ok(r)
         })
         .collect();
-    let kept: Vec<&RunResult> = results.iter().flatten().collect();
+    let kept: Vec<&RunResult> = results.iter().filter_map(|r| r.as_ref().ok()).collect();
+    let mut lost_t_s: Vec<f64> = results
+        .iter()
+        .filter_map(|r| r.as_ref().err().copied())
+        .collect();
+    lost_t_s.sort_by(f64::total_cmp);
     let mut row = Row {
         scenario: name.to_string(),
         mode: mode.name().to_string(),
         kept: kept.len() as u64,
         lost: runs - kept.len() as u64,
+        lost_t_s,
         ..Row::default()
     };
     if kept.is_empty() {
@@ -157,6 +167,24 @@ pub fn evaluate(name: &str, sc: &Scenario, mode: Mode, runs: u64) -> Row {
     row
 }
 
+fn failure_time(e: &ins_sd::RunError) -> f64 {
+    match e {
+        ins_sd::RunError::NonFinite { t_s, .. }
+        | ins_sd::RunError::Sighting { t_s, .. }
+        | ins_sd::RunError::Filter { t_s, .. }
+        | ins_sd::RunError::Online { t_s, .. } => *t_s,
+        _ => f64::NAN,
+    }
+}
+
+/// "k of n (t = a…b s)" for the lost-runs column.
+pub fn lost_text(r: &Row) -> String {
+    match (r.lost_t_s.first(), r.lost_t_s.last()) {
+        (Some(a), Some(b)) => format!("{} of {} (t = {a:.0}…{b:.0} s)", r.lost, r.lost + r.kept),
+        _ => format!("{} of {}", r.lost, r.lost + r.kept),
+    }
+}
+
 fn load(path: &Path, duration: Option<f64>) -> Result<Scenario> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
@@ -183,13 +211,12 @@ pub fn table(rows: &[Row], runs: u64, duration_s: f64) -> String {
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.1} | {:.1} | {} of {} | {:.1} | {:.0} % | {:.2} | {:.0} | {:.1} |",
+            "| {} | {} | {:.1} | {:.1} | {} | {:.1} | {:.0} % | {:.2} | {:.0} | {:.1} |",
             r.scenario,
             r.mode,
             r.final_rms_m,
             r.final_median_m,
-            r.lost,
-            r.lost + r.kept,
+            lost_text(r),
             r.nees_mean,
             100.0 * r.nees_in_band,
             r.nis_per_dof,

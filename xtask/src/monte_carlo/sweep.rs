@@ -122,14 +122,13 @@ pub fn run_sweep(
     for (v, r) in &rows {
         let _ = writeln!(
             md,
-            "| {v} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} of {} | {:.1} | {:.0} % | {:.2} |",
+            "| {v} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.1} | {:.0} % | {:.2} |",
             r.mode,
             r.final_median_m,
             r.final_p10_m,
             r.final_p90_m,
             r.final_rms_m,
-            r.lost,
-            r.lost + r.kept,
+            super::scenarios::lost_text(r),
             r.nees_mean,
             100.0 * r.nees_in_band,
             r.nis_per_dof
