@@ -24,7 +24,7 @@ pub enum QProjection {
     /// [`AdaptiveQ::set_diagonal_floors`]); off-diagonals set to 0. Unit-safe, drops correlations.
     Diagonal,
     /// Q̂ = Σ q̂_k B_k, q̂ ≥ 0: the non-negative least-squares fit of the raw estimate onto the
-    /// noise matrices B_k of the model's noise inputs ([`project_structured`]). It needs the
+    /// noise matrices B_k of the model's noise inputs ([`crate::project_structured`]). It needs the
     /// caller's basis, so the estimators of this crate store the [`QProjection::Diagonal`]
     /// projection as their estimate and the caller fits the raw estimate itself.
     Structured,

@@ -38,6 +38,17 @@
 //!   ∇̂, ε̂ added to its sensor corrections, x̂ ← 0, P kept.
 //! * 0 sightings at an epoch: nothing happens (the interval continues to the next epoch).
 //!
+//! ## Estimators ([`Estimator`])
+//!
+//! Stand-alone INS (no filter), the KF with the a-priori Q, and two adaptive Q̂ schemes used
+//! as the next interval's Q once they have an estimate: Mohamed–Schwarz (paper eq. 19, a
+//! window of N updates) and Sage–Husa (a forgetting factor b), each made PSD by eigenvalue
+//! clipping, the diagonal, or the **structured** projection: non-negative least squares of
+//! the raw Q̂ onto the interval noise matrices B_k of the four noise inputs (accelerometer and
+//! gyro white noise, bias and drift random walks; [`interval::IntervalModel::noise_basis`],
+//! Q_T = Σ q_k B_k exactly), residual scaled by the previous P⁺'s diagonal; the prediction then
+//! uses Σ q̂_k B_k on the new interval's basis ([`InsSdFilter::fitted_noise_densities`]).
+//!
 //! ## Errors
 //!
 //! Out-of-order time stamps, an epoch not at the INS time, unknown landmark ids and NaN/∞

@@ -420,3 +420,58 @@ fn a_missing_input_names_the_file_and_its_os_error_once() {
     let e = stderr(&o);
     assert_eq!(e.matches("No such file or directory").count(), 1, "{e}");
 }
+
+#[test]
+fn ins_replays_exported_logs_prints_truth_errors_and_names_bad_lines() {
+    use nav_app::ins_sd::logs::{self, names};
+    use nav_app::ins_sd::{Mode, Scenario};
+    let dir = scratch("ins-replay");
+    let sc = Scenario::paper_default().truncated(20.0).unwrap();
+    let (_, records) = logs::export_run(&sc, Mode::Kf, 7, &dir).unwrap();
+    let p = |n: &str| dir.join(n).display().to_string();
+    let out = p("solution.csv");
+    let args = [
+        "ins",
+        "--imu",
+        &p(names::IMU),
+        "--sightings",
+        &p(names::SIGHTINGS),
+        "--landmarks",
+        &p(names::LANDMARKS),
+        "--init",
+        &p(names::INITIAL),
+        "--config",
+        &p(names::SCENARIO),
+        "--out",
+        &out,
+        "--truth",
+        &p(names::TRUTH),
+    ];
+    let o = nav_app(&args);
+    let e = stderr(&o);
+    assert!(o.status.success(), "{e}");
+    assert!(
+        e.contains("2000 IMU samples, 20 sighting epochs, 60 sightings used"),
+        "{e}"
+    );
+    // The printed final error is the simulated run's record at 20 s (open loop until 195 s:
+    // the solution is the INS corrected by x̂, the record INS − x̂, equal to round-off).
+    let n = records[20].pos_err_ned_m[0];
+    assert!(e.contains(&format!("N {n:.3} m")), "{e} (N {n:.3})");
+    assert_eq!(
+        std::fs::read_to_string(&out).unwrap().lines().count(),
+        21,
+        "header + 20 epochs"
+    );
+    // A malformed IMU line: exit 1, the message names file:line:column.
+    let imu = std::fs::read_to_string(p(names::IMU)).unwrap();
+    let bad = dir.join("imu_bad.csv");
+    std::fs::write(&bad, imu.replacen("\n1e-1,", "\n1e-1x,", 1)).unwrap();
+    let bad_s = bad.display().to_string();
+    let mut a = args;
+    a[2] = &bad_s;
+    let o = nav_app(&a);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains(&format!("{bad_s}:11:1:")), "{e}");
+}

@@ -199,7 +199,7 @@ pub use jacobian::{
 pub use model::{
     DEGENERATE_RANGE_M, Landmark, LineOfSight, NavPose, PAPER_LANDMARKS_DEG_M, PAPER_NOISE_VAR_M2,
     VERTICAL_LOS_FRACTION, add_sighting_noise, check_geometry, line_of_sight, paper_landmarks,
-    sighting_offset_m, sighting_offsets3_m, true_pose_from_errors,
+    sighting_offset_m, sighting_offset_surveyed_m, sighting_offsets3_m, true_pose_from_errors,
 };
 pub use paper_printed::{
     PaperAlphaReading, PaperPrintedBlocks, paper_eq15_jacobian, paper_eq15_jacobian3,

@@ -262,12 +262,23 @@ impl EpochGeometry {
     }
 
     fn offset(&self, landmark: &Landmark) -> Result<Vector2<f64>, SightingError> {
+        self.offset_to(landmark, &landmark.ecef_m)
+    }
+
+    /// The offset of a landmark that really is at `actual_ecef_m` when the camera is pointed
+    /// at its surveyed position `pointed`.
+    fn offset_to(
+        &self,
+        pointed: &Landmark,
+        actual_ecef_m: &Vector3<f64>,
+    ) -> Result<Vector2<f64>, SightingError> {
+        let landmark = pointed;
         // Gimbal command: camera axes from the computed line of sight in the computed NED frame.
         let los = los_from_ecef(landmark, &self.c_e_c, &self.computed_ecef_m)?;
         let c_cam_c = los.camera_axes_ned();
         // True line of sight resolved in the camera axes as actually realised by the true
         // attitude: (C_b^t C̃_b^nᵀ C_cam^c)ᵀ C_e^t (x_L − x).
-        let r_cam = c_cam_c.transpose() * (self.k * (landmark.ecef_m - self.truth_ecef_m));
+        let r_cam = c_cam_c.transpose() * (self.k * (actual_ecef_m - self.truth_ecef_m));
         if !(r_cam.x.is_finite() && r_cam.y.is_finite() && r_cam.z.is_finite()) {
             return Err(SightingError::NonFinite {
                 what: "image offset (poses or attitudes)",
@@ -300,6 +311,21 @@ pub fn sighting_offset_m(
     landmark: &Landmark,
 ) -> Result<Vector2<f64>, SightingError> {
     EpochGeometry::new(truth, computed).offset(landmark)
+}
+
+/// [`sighting_offset_m`] for a landmark whose surveyed position (`surveyed`, where the camera
+/// is pointed) differs from where it really is (`actual_ecef_m`, ECEF m): simulates a landmark
+/// survey error. Equals [`sighting_offset_m`] when `actual_ecef_m` is `surveyed.ecef_m()`.
+///
+/// # Errors
+/// As [`sighting_offset_m`].
+pub fn sighting_offset_surveyed_m(
+    truth: &NavPose,
+    computed: &NavPose,
+    surveyed: &Landmark,
+    actual_ecef_m: &Vector3<f64>,
+) -> Result<Vector2<f64>, SightingError> {
+    EpochGeometry::new(truth, computed).offset_to(surveyed, actual_ecef_m)
 }
 
 /// [`sighting_offset_m`] for three landmarks at once, stacked as (w₀, h₀, w₁, h₁, w₂, h₂);

@@ -102,7 +102,9 @@ pub mod driver;
 pub mod export;
 pub mod plot;
 pub mod report;
+pub mod scenarios;
 pub mod stats;
+pub mod sweep;
 
 #[cfg(test)]
 mod tests;
@@ -132,6 +134,9 @@ pub struct MonteCarloArgs {
 pub enum McCmd {
     /// Merge the `stats.json` of shard directories into the outputs of one run.
     Merge(MergeArgs),
+    /// The matched case and every model-mismatch scenario of configs/mismatch/ (KF and AKF,
+    /// same seeds) in one comparison table.
+    Scenarios(Box<scenarios::ScenariosArgs>),
 }
 
 /// Options of a simulation run.
@@ -167,6 +172,11 @@ pub struct RunArgs {
     /// standalone,kf,akf].
     #[arg(long, value_name = "LIST")]
     pub filters: Option<String>,
+    /// Sweep a scenario key over values on the same seeds instead of one Monte Carlo:
+    /// `section.key[+section.key]=V1,V2,…` (e.g. `filter.akf_window=5,10,20,40`); KF and AKF
+    /// unless --filters; writes sweep.md, sweep.csv and sweep_final_error.svg/png.
+    #[arg(long, value_name = "KEY=V1,V2,…")]
+    pub sweep: Option<String>,
 }
 
 /// Options of `merge`.
@@ -187,6 +197,9 @@ pub struct MergeArgs {
 pub fn run(args: MonteCarloArgs) -> Result<()> {
     match args.cmd {
         Some(McCmd::Merge(m)) => merge(&m).map(|_| ()),
+        Some(McCmd::Scenarios(a)) => {
+            scenarios::run(&a, &workspace_root(), &target_dir()).map(|_| ())
+        }
         None => simulate(&args.run).map(|_| ()),
     }
 }
@@ -413,6 +426,23 @@ pub fn build_stats(r: &Resolved, range: (u64, u64), sim: driver::Simulated) -> S
 /// `cargo xtask monte-carlo`: simulate, write, print. Returns the output directory.
 pub fn simulate(args: &RunArgs) -> Result<PathBuf> {
     let r = resolve(args)?;
+    if let Some(text) = &args.sweep {
+        let sw = sweep::parse_sweep(text)?;
+        let modes = match &args.filters {
+            Some(_) => r.modes.clone(),
+            None => vec![Mode::Kf, Mode::Akf],
+        };
+        let out = args.out.clone().unwrap_or_else(|| {
+            let keys: Vec<String> = sw.keys.iter().map(|(s, k)| format!("{s}.{k}")).collect();
+            target_dir().join("monte-carlo").join(format!(
+                "sweep-{}-runs{}",
+                keys.join("+"),
+                r.runs
+            ))
+        });
+        sweep::run_sweep(&r.scenario, &sw, &modes, r.runs, r.threads, &out)?;
+        return Ok(out);
+    }
     let (lo, hi) = stats::shard_range(r.runs, r.shard.index, r.shard.count);
     eprintln!(
         "monte-carlo: {} runs{} × {} configurations × {} s, seed {}, {} thread(s), scenario {}",

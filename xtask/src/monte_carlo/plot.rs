@@ -444,3 +444,116 @@ pub fn figures(stats: &Stats) -> Result<Vec<(String, Vec<u8>)>> {
     out.push(("fig8_position_rms.png".to_string(), png));
     Ok(out)
 }
+
+/// One point of a sweep figure: the final 3-D error over runs at one swept value.
+#[derive(Clone, Debug)]
+pub struct SweepPoint {
+    /// Configuration (`kf`, `akf`, …).
+    pub mode: String,
+    /// Swept value.
+    pub value: f64,
+    /// Median final 3-D error, m.
+    pub median_m: f64,
+    /// 10th and 90th percentiles of the final 3-D error, m.
+    pub p10_m: f64,
+    /// 90th percentile, m.
+    pub p90_m: f64,
+}
+
+fn draw_sweep<DB: DrawingBackend>(
+    area: DrawingArea<DB, Shift>,
+    key: &str,
+    runs: u64,
+    pts: &[SweepPoint],
+) -> Result<(), Box<dyn Error>>
+where
+    DB::ErrorType: 'static,
+{
+    area.fill(&WHITE)?;
+    let xs: Vec<f64> = pts.iter().map(|p| p.value).collect();
+    let (x0, x1) = xs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    let ys: Vec<f64> = pts
+        .iter()
+        .flat_map(|p| [p.p10_m, p.p90_m, p.median_m])
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
+    let y0 = ys.iter().copied().fold(f64::INFINITY, f64::min).max(1e-3) / 1.5;
+    let y1 = ys.iter().copied().fold(0.0, f64::max).max(y0 * 10.0) * 1.5;
+    let pad = if x1 > x0 { 0.05 * (x1 - x0) } else { 1.0 };
+    let mut chart = ChartBuilder::on(&area)
+        .caption(
+            format!("Final 3-D position error vs {key} ({runs} runs: median, 10–90 % bars)"),
+            ("sans-serif", 22),
+        )
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0 - pad)..(x1 + pad), (y0..y1).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc(key)
+        .y_desc("final 3-D position error (m)")
+        .label_style(("sans-serif", 16))
+        .draw()?;
+    let mut modes: Vec<&str> = Vec::new();
+    for p in pts {
+        if !modes.contains(&p.mode.as_str()) {
+            modes.push(&p.mode);
+        }
+    }
+    for mode in modes {
+        let c = mode_colour(mode);
+        let mine: Vec<&SweepPoint> = pts.iter().filter(|p| p.mode == mode).collect();
+        chart
+            .draw_series(LineSeries::new(
+                mine.iter().map(|p| (p.value, p.median_m.max(y0))),
+                c.stroke_width(2),
+            ))?
+            .label(mode.to_string())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        chart.draw_series(
+            mine.iter()
+                .map(|p| Circle::new((p.value, p.median_m.max(y0)), 4, c.filled())),
+        )?;
+        for p in &mine {
+            chart.draw_series(LineSeries::new(
+                [(p.value, p.p10_m.max(y0)), (p.value, p.p90_m.max(y0))],
+                c.stroke_width(1),
+            ))?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 16))
+        .draw()?;
+    area.present()?;
+    Ok(())
+}
+
+/// The sweep figure as (SVG text, PNG bytes).
+pub fn sweep_figure(key: &str, runs: u64, pts: &[SweepPoint]) -> Result<(String, Vec<u8>)> {
+    register_font()?;
+    let mut svg = String::new();
+    draw_sweep(
+        SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area(),
+        key,
+        runs,
+        pts,
+    )
+    .map_err(|e| anyhow!("SVG sweep figure: {e}"))?;
+    let mut rgb = vec![0u8; (W * H * 3) as usize];
+    draw_sweep(
+        BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area(),
+        key,
+        runs,
+        pts,
+    )
+    .map_err(|e| anyhow!("PNG sweep figure: {e}"))?;
+    Ok((svg, encode_png(rgb)?))
+}

@@ -251,6 +251,8 @@ fn stand_in(_mode: Mode, index: u64, out: &mut [Sample]) -> Result<RunOutcome, R
     Ok(RunOutcome {
         samples_written: out.len(),
         epochs: 100 * (out.len() as u64 - 1),
+        sightings_used: 0,
+        sightings_rejected: 0,
     })
 }
 

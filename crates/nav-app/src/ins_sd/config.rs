@@ -114,6 +114,10 @@ pub struct FilterConfig {
     /// Sage–Husa forgetting factor b, 0 < b ≤ 1 (memory ≈ 1/(1 − b) updates); default 0.95.
     #[serde(default = "default_forgetting")]
     pub sage_husa_forgetting: f64,
+    /// χ² innovation gate of each sighting: rejection probability 1 − p under the model (e.g.
+    /// 0.9999); absent = no gate (the paper's filter).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gate_probability: Option<f64>,
     /// Measurement matrix of the filter: `"verified"` (default when the key is absent),
     /// `"paper_printed"` (the printed eqs. 15–18) or `"paper_printed_elevation"` (printed, α₀
     /// repaired); the last two for comparison with the paper.
@@ -163,6 +167,7 @@ impl FilterConfig {
             akf_min_variance: 0.0,
             akf_scheme: AkfScheme::MohamedSchwarz,
             sage_husa_forgetting: 0.95,
+            gate_probability: None,
             measurement_jacobian: MeasurementJacobian::Verified,
         }
     }
@@ -217,6 +222,15 @@ impl FilterConfig {
                 self.phi_subintervals,
             ));
         }
+        if let Some(p) = self.gate_probability
+            && !(p > 0.0 && p < 1.0)
+        {
+            return Err(ScenarioError::invalid(
+                "filter.gate_probability",
+                "must be within (0, 1)",
+                p,
+            ));
+        }
         if !(self.sage_husa_forgetting > 0.0 && self.sage_husa_forgetting <= 1.0) {
             return Err(ScenarioError::invalid(
                 "filter.sage_husa_forgetting",
@@ -254,6 +268,146 @@ impl FilterConfig {
             self.q_accel_bias_rw_psd_mg2_per_s * MG_TO_MPS2.powi(2),
             self.q_gyro_drift_rw_psd_degph2_per_s * DEGPH_TO_RADPS.powi(2),
         ]
+    }
+}
+
+/// `[mismatch]` (optional; all off by default): how the simulated world departs from the
+/// filter's model. The filter is not told (its `[filter]` stays as it is), which is the point:
+/// each `configs/mismatch/*.toml` turns one of these on. Random draws for the mismatch come
+/// from their own ChaCha stream (2) of the run's seed, so the IMU and sighting noise are the
+/// matched run's (common random numbers).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MismatchConfig {
+    /// σ of each accelerometer scale-factor error, ppm (random constant per run and axis).
+    pub accel_scale_factor_sigma_ppm: f64,
+    /// σ of each gyro scale-factor error, ppm.
+    pub gyro_scale_factor_sigma_ppm: f64,
+    /// σ of each accelerometer axis-misalignment (off-diagonal) entry, mrad.
+    pub accel_misalignment_sigma_mrad: f64,
+    /// σ of each gyro axis-misalignment (off-diagonal) entry, mrad.
+    pub gyro_misalignment_sigma_mrad: f64,
+    /// Steady-state σ of a first-order Gauss–Markov accelerometer bias added to the random
+    /// constant, mg.
+    pub accel_bias_instability_sigma_mg: f64,
+    /// Steady-state σ of a first-order Gauss–Markov gyro drift added to the random constant, °/h.
+    pub gyro_bias_instability_sigma_degph: f64,
+    /// Correlation time of both Gauss–Markov processes, s (> 0).
+    pub bias_correlation_time_s: f64,
+    /// Angular sighting noise σ, mrad: adds N(0, (σ·range)²) m to w and h (metric noise grows
+    /// with the range), on top of `[sighting] noise_var_m2`.
+    pub sighting_noise_mrad: f64,
+    /// σ of each NED component of every landmark's survey error, m (per run): the filter's
+    /// table holds the surveyed positions, the landmarks are elsewhere.
+    pub landmark_survey_sigma_m: f64,
+    /// Fraction of sightings with a gross error (0–1).
+    pub outlier_fraction: f64,
+    /// σ of the gross error added to w and h of an outlier, m.
+    pub outlier_sigma_m: f64,
+    /// Field of regard of the gimballed camera: largest angle between the body down axis and
+    /// the line of sight, degrees (180 = no limit). Landmarks outside are not sighted.
+    pub camera_max_off_nadir_deg: f64,
+    /// Largest slant range at which a landmark is sighted, m (0 = no limit).
+    pub max_range_m: f64,
+    /// Sighting latency, s (a multiple of the IMU step, < the SD period): the image is taken
+    /// this long before the epoch at which the filter processes it as current.
+    pub latency_s: f64,
+}
+
+impl Default for MismatchConfig {
+    fn default() -> Self {
+        Self {
+            accel_scale_factor_sigma_ppm: 0.0,
+            gyro_scale_factor_sigma_ppm: 0.0,
+            accel_misalignment_sigma_mrad: 0.0,
+            gyro_misalignment_sigma_mrad: 0.0,
+            accel_bias_instability_sigma_mg: 0.0,
+            gyro_bias_instability_sigma_degph: 0.0,
+            bias_correlation_time_s: 300.0,
+            sighting_noise_mrad: 0.0,
+            landmark_survey_sigma_m: 0.0,
+            outlier_fraction: 0.0,
+            outlier_sigma_m: 300.0,
+            camera_max_off_nadir_deg: 180.0,
+            max_range_m: 0.0,
+            latency_s: 0.0,
+        }
+    }
+}
+
+impl MismatchConfig {
+    /// True when every mismatch is off (the simulated world is the filter's model).
+    pub fn is_matched(&self) -> bool {
+        *self
+            == Self {
+                bias_correlation_time_s: self.bias_correlation_time_s,
+                outlier_sigma_m: self.outlier_sigma_m,
+                ..Self::default()
+            }
+    }
+
+    /// Checks every field; the error names it as `mismatch.<field>`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        for (f, v) in [
+            (
+                "mismatch.accel_scale_factor_sigma_ppm",
+                self.accel_scale_factor_sigma_ppm,
+            ),
+            (
+                "mismatch.gyro_scale_factor_sigma_ppm",
+                self.gyro_scale_factor_sigma_ppm,
+            ),
+            (
+                "mismatch.accel_misalignment_sigma_mrad",
+                self.accel_misalignment_sigma_mrad,
+            ),
+            (
+                "mismatch.gyro_misalignment_sigma_mrad",
+                self.gyro_misalignment_sigma_mrad,
+            ),
+            (
+                "mismatch.accel_bias_instability_sigma_mg",
+                self.accel_bias_instability_sigma_mg,
+            ),
+            (
+                "mismatch.gyro_bias_instability_sigma_degph",
+                self.gyro_bias_instability_sigma_degph,
+            ),
+            ("mismatch.sighting_noise_mrad", self.sighting_noise_mrad),
+            (
+                "mismatch.landmark_survey_sigma_m",
+                self.landmark_survey_sigma_m,
+            ),
+            ("mismatch.outlier_sigma_m", self.outlier_sigma_m),
+            ("mismatch.max_range_m", self.max_range_m),
+            ("mismatch.latency_s", self.latency_s),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(ScenarioError::invalid(f, "must be finite and >= 0", v));
+            }
+        }
+        if !(self.bias_correlation_time_s.is_finite() && self.bias_correlation_time_s > 0.0) {
+            return Err(ScenarioError::invalid(
+                "mismatch.bias_correlation_time_s",
+                "must be finite and > 0",
+                self.bias_correlation_time_s,
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.outlier_fraction) {
+            return Err(ScenarioError::invalid(
+                "mismatch.outlier_fraction",
+                "must be within [0, 1]",
+                self.outlier_fraction,
+            ));
+        }
+        if !(self.camera_max_off_nadir_deg > 0.0 && self.camera_max_off_nadir_deg <= 180.0) {
+            return Err(ScenarioError::invalid(
+                "mismatch.camera_max_off_nadir_deg",
+                "must be within (0, 180]",
+                self.camera_max_off_nadir_deg,
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -304,9 +458,18 @@ pub(crate) struct ScenarioFile {
     pub sighting: SightingConfig,
     pub filter: FilterConfig,
     pub monte_carlo: MonteCarloConfig,
+    #[serde(default, skip_serializing_if = "MismatchConfig::is_matched")]
+    pub mismatch: MismatchConfig,
 }
 
-const SECTIONS: [&str; 5] = ["trajectory", "imu", "sighting", "filter", "monte_carlo"];
+const SECTIONS: [&str; 6] = [
+    "trajectory",
+    "imu",
+    "sighting",
+    "filter",
+    "monte_carlo",
+    "mismatch",
+];
 
 /// Parses the document section by section (through the workspace's one TOML loader,
 /// `toml_config::TomlDoc`) so that an error names its section, file, line and column.
@@ -330,5 +493,10 @@ pub(crate) fn parse(doc: &toml_config::TomlDoc<'_>) -> Result<ScenarioFile, Scen
         sighting: doc.section("sighting").map_err(located("sighting"))?,
         filter: doc.section("filter").map_err(located("filter"))?,
         monte_carlo: doc.section("monte_carlo").map_err(located("monte_carlo"))?,
+        mismatch: if doc.keys().any(|k| k == "mismatch") {
+            doc.section("mismatch").map_err(located("mismatch"))?
+        } else {
+            MismatchConfig::default()
+        },
     })
 }

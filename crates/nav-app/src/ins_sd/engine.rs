@@ -16,6 +16,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use sighting_model::Landmark;
 
+use super::mismatch::World;
 use super::{AkfScheme, Mode, RunError, RunOutcome, Sample, Scenario};
 
 /// Sees what a run feeds its filter (for exporting a run as logs, [`super::logs`]). Every
@@ -56,6 +57,8 @@ pub(crate) struct Loop {
     pub(crate) rng_sd: ChaCha8Rng,
     step_s: f64,
     k: u64,
+    /// The simulated world's mismatch (`None`: the world is the filter's model).
+    world: Option<Box<World>>,
 }
 
 pub(crate) fn nav_state(s: &TruthSample) -> NavState {
@@ -89,7 +92,7 @@ pub(crate) fn online_config(scenario: &Scenario, mode: Mode) -> InsSdFilterConfi
         },
         r_var_m2: f.r_var_m2,
         open_loop_until_s: f.open_loop_until_s,
-        gate_probability: None,
+        gate_probability: f.gate_probability,
         estimator: {
             let ms = |projection| {
                 Estimator::MohamedSchwarz(AdaptiveQConfig {
@@ -178,7 +181,16 @@ impl Loop {
             0.0,
         )
         .map_err(run_error)?;
+        let world = (!scenario.mismatch.is_matched()).then(|| {
+            Box::new(World::new(
+                &scenario.mismatch,
+                seed,
+                &landmarks,
+                scenario.trajectory.step_s,
+            ))
+        });
         Ok(Self {
+            world,
             filter,
             imu,
             sightings: Vec::with_capacity(landmarks.len()),
@@ -210,11 +222,20 @@ impl Loop {
         &mut self,
         ideal: &TruthSample,
     ) -> Result<(Vector3<f64>, Vector3<f64>), RunError> {
-        let (f, w) = self.imu.measure(
-            &ideal.specific_force_body_mps2,
-            &ideal.ang_rate_ib_body_radps,
-            &mut self.rng_imu,
-        );
+        let (f, w) = match self.world.as_deref_mut() {
+            None => self.imu.measure(
+                &ideal.specific_force_body_mps2,
+                &ideal.ang_rate_ib_body_radps,
+                &mut self.rng_imu,
+            ),
+            Some(world) => {
+                let (f, w) = world.corrupt(
+                    &ideal.specific_force_body_mps2,
+                    &ideal.ang_rate_ib_body_radps,
+                );
+                self.imu.measure(&f, &w, &mut self.rng_imu)
+            }
+        };
         self.k += 1;
         self.filter
             .propagate_rates(self.k as f64 * self.step_s, &f, &w)
@@ -249,6 +270,34 @@ impl Loop {
         let truth_pose = nav_pose(truth);
         self.sightings.clear();
         let se = |source| RunError::Sighting { t_s, source };
+        if let Some(world) = self.world.as_deref_mut() {
+            let sigma_m = self.sd_noise_var_m2.sqrt();
+            for (i, lm) in self.landmarks.iter().enumerate() {
+                // Draws happen for every landmark, visible or not (stable streams).
+                let (nw, nh): (f64, f64) = (
+                    rand::Rng::sample(&mut self.rng_sd, rand_distr::StandardNormal),
+                    rand::Rng::sample(&mut self.rng_sd, rand_distr::StandardNormal),
+                );
+                let (visible, range_m) = world.visible(i, truth);
+                let (ew, eh) = world.sighting_error(range_m);
+                if !visible {
+                    continue;
+                }
+                let z = sighting_model::sighting_offset_surveyed_m(
+                    &truth_pose,
+                    &computed,
+                    lm,
+                    &world.actual_ecef_m[i],
+                )
+                .map_err(se)?;
+                self.sightings.push(Sighting {
+                    landmark_id: lm.id() as u32,
+                    w_m: z.x + sigma_m * nw + ew,
+                    h_m: z.y + sigma_m * nh + eh,
+                });
+            }
+            return Ok(&self.sightings);
+        }
         for lm in &self.landmarks {
             let z = sighting_model::sighting_offset_m(&truth_pose, &computed, lm).map_err(se)?;
             self.sightings.push(Sighting {
@@ -270,12 +319,19 @@ impl Loop {
     /// SD epoch at time `t_s`: simulate the sightings, then the filter's update (predict,
     /// update, feedback after `open_loop_until_s`). Returns the NIS (NaN without a filter).
     pub(crate) fn sd_update(&mut self, t_s: f64, truth: &NavState) -> Result<f64, RunError> {
-        self.simulate_sightings(t_s, truth)?;
+        if self.latency_steps() == 0 {
+            self.simulate_sightings(t_s, truth)?;
+        }
         let report = self
             .filter
             .update(t_s, &self.sightings)
             .map_err(run_error)?;
         Ok(report.nis.unwrap_or(f64::NAN))
+    }
+
+    /// Sighting latency in IMU steps (0 without a mismatch).
+    pub(crate) fn latency_steps(&self) -> usize {
+        self.world.as_deref().map_or(0, |w| w.latency_steps)
     }
 
     /// Feedback now (see [`InsSdFilter::feedback`]).
@@ -309,6 +365,11 @@ impl Loop {
             distance_m,
             nees,
             nis,
+            nis_dof: if nis.is_some() {
+                2 * self.filter.last_report().used as u32
+            } else {
+                0
+            },
         })
     }
 }
@@ -369,6 +430,11 @@ pub(crate) fn run_observed<O: RunObserver>(
         let t_s = k as f64 * plan.step_s;
         let update_due = mode != Mode::Standalone && k % plan.steps_per_update == 0;
         let sample_due = k % plan.steps_per_sample == 0;
+        let lat = lp.latency_steps();
+        if lat > 0 && mode != Mode::Standalone && (k + lat) % plan.steps_per_update == 0 {
+            // The image of the next epoch is taken now (latency): truth and INS of this step.
+            lp.simulate_sightings(t_s, &nav_state(&s))?;
+        }
         if !(update_due || sample_due) {
             continue;
         }
@@ -385,8 +451,11 @@ pub(crate) fn run_observed<O: RunObserver>(
             written += 1;
         }
     }
+    let st = lp.filter.statistics();
     Ok(RunOutcome {
         samples_written: written,
         epochs,
+        sightings_used: st.sightings_used,
+        sightings_rejected: st.sightings_rejected,
     })
 }

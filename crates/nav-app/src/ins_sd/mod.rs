@@ -138,16 +138,27 @@
 //! "paper_printed"> --runs 30` (same figures for the runs that finish; it excludes the failed
 //! runs entirely, the example counts them up to their failure).
 //!
-//! **What does reproduce the paper's figure: no feedback.** With the verified H but
+//! **No feedback: the paper's order of magnitude, but on survivors.** With the verified H but
 //! `open_loop_until_s` beyond the run (the INS is never corrected; the camera is pointed and H
-//! is evaluated at the free INS, kilometres off by 600 s), the same 30 runs give RMS δp
-//! 2.4 / 2.2 / 2.1 m at 195 s, 23 / 33 / 19 m at 600 s (26 runs alive) and 77 / 53 / 19 m at
-//! 900 s (22 alive; 3-D 96 m = 0.34 % of the 28.1 km flown — the paper's "≈ 0.1 km, 0.34 %"),
-//! NIS 6.6 but NEES ≈ 3·10⁴ (the linearisation error at the drifted INS is not in P); the AKF
-//! gives 177 m (paper 0.14 km), so the ordering KF < AKF < stand-alone is reproduced. The 8
-//! failed runs are those whose free INS drifts (vertical channel) until a landmark is behind
-//! the camera. This matches the paper's §7 remark that "H requires a rather accurate estimate
-//! of the UAV position": its filter seems to have been linearised at an uncorrected INS.
+//! is evaluated at the free INS, kilometres off by 600 s), 100 seeded runs (seed 2009, KF and
+//! the AKF with the default diagonal projection, common random numbers;
+//! `cargo xtask monte-carlo --sweep filter.open_loop_until_s=195,1e9`):
+//!
+//! | `open_loop_until_s` | filter | final 3-D median | 10–90 % | RMS | lost runs | NEES mean | epochs with NEES in band |
+//! |---|---|---|---|---|---|---|---|
+//! | 195 (paper) | KF | 1.3 m | 0.6–2.2 m | 1.5 m | 0 of 100 | 12.3 | 7 % |
+//! | 195 (paper) | AKF | 19.0 m | 7.0–36.1 m | 25.4 m | 0 of 100 | 6.4 | 0 % |
+//! | never | KF | 47 m | 12–151 m | 93 m | 38 of 100 (t = 450…886 s) | 6432 | 2 % |
+//! | never | AKF | 66 m | 15–165 m | 107 m | 38 of 100 (t = 450…886 s) | 310 | 2 % |
+//!
+//! The statistics are over the surviving runs only: 38 of 100 runs are lost when the free INS
+//! drifts (vertical channel) until a landmark is behind the camera, and the filter is badly
+//! over-confident (NEES ≫ 15: the linearisation error at the drifted INS is not in P). So the
+//! open-loop filter gives errors of the paper's order (≈ 0.1 km) with KF < AKF, but a figure
+//! over 62 survivors is not a reproduction; an earlier 30-run look (96 m, 22 survivors, AKF
+//! 177 m with the eigenvalue-clipping projection) overstated the match. What this supports is
+//! only the reading of the paper's §7 remark that "H requires a rather accurate estimate of the
+//! UAV position" as a filter linearised at an uncorrected INS — a hypothesis, not a finding.
 //! (`cargo run --release -p nav-app --example paper_h -- 30 open-loop`; with
 //! `measurement_jacobian = "paper_printed"` open loop is 6.0 / 6.9 / 12.4 km at 900 s.)
 //!
@@ -188,10 +199,13 @@
 mod config;
 mod engine;
 pub mod logs;
+mod mismatch;
 /// The interval discretisation (moved to `ins-sd-filter`; re-exported for existing users).
 pub use ins_sd_filter::interval;
 
-pub use config::{AkfScheme, FilterConfig, MeasurementJacobian, MonteCarloConfig, ScenarioError};
+pub use config::{
+    AkfScheme, FilterConfig, MeasurementJacobian, MismatchConfig, MonteCarloConfig, ScenarioError,
+};
 pub use engine::{NoObserver, RunObserver};
 
 use ins_errors::InsError;
@@ -212,6 +226,8 @@ pub struct Scenario {
     pub filter: FilterConfig,
     /// `[monte_carlo]`: runs and master seed.
     pub monte_carlo: MonteCarloConfig,
+    /// `[mismatch]` (optional): how the simulated world departs from the filter's model.
+    pub mismatch: MismatchConfig,
 }
 
 /// Step counts derived from a validated scenario.
@@ -257,6 +273,7 @@ impl Scenario {
             sighting: f.sighting,
             filter: f.filter,
             monte_carlo: f.monte_carlo,
+            mismatch: f.mismatch,
         };
         s.validate().map_err(|e| match e {
             ScenarioError::Invalid { ref field, .. } => ScenarioError::InFile {
@@ -279,6 +296,7 @@ impl Scenario {
             sighting: self.sighting.clone(),
             filter: self.filter.clone(),
             monte_carlo: self.monte_carlo.clone(),
+            mismatch: self.mismatch.clone(),
         })
     }
 
@@ -295,6 +313,7 @@ impl Scenario {
             sighting: SightingConfig::paper(),
             filter: FilterConfig::paper(),
             monte_carlo: MonteCarloConfig::paper(),
+            mismatch: MismatchConfig::default(),
         }
     }
 
@@ -323,6 +342,7 @@ impl Scenario {
         self.sighting.landmarks3().map_err(sighting_err)?;
         self.filter.validate()?;
         self.monte_carlo.validate()?;
+        self.mismatch.validate()?;
         let tr = Trajectory::new(&self.trajectory).map_err(ins)?;
         self.sighting
             .check_vehicle(&tr.start())
@@ -363,6 +383,14 @@ impl Scenario {
                     self.sighting.update_period_s,
                 )
             })?;
+        let lat = self.mismatch.latency_s / step_s;
+        if (lat - lat.round()).abs() > 1e-6 || lat.round() as usize >= steps_per_update {
+            return Err(ScenarioError::invalid(
+                "mismatch.latency_s",
+                "must be a multiple of trajectory.step_s below sighting.update_period_s",
+                self.mismatch.latency_s,
+            ));
+        }
         if self.filter.phi_subintervals > steps_per_update {
             return Err(ScenarioError::invalid(
                 "filter.phi_subintervals",
@@ -600,8 +628,11 @@ pub struct Sample {
     pub distance_m: f64,
     /// Filters only, at SD update epochs: eᵀ P⁻¹ e with all 15 states.
     pub nees: Option<f64>,
-    /// Filters only, at SD update epochs: νᵀ S⁻¹ ν, 6 measurements.
+    /// Filters only, at SD update epochs: νᵀ S⁻¹ ν of the sightings used (6 measurements
+    /// for three landmarks; see `nis_dof`).
     pub nis: Option<f64>,
+    /// Degrees of freedom of `nis`: 2 × the sightings used at that epoch (0 when none).
+    pub nis_dof: u32,
 }
 
 /// What a run did.
@@ -611,6 +642,10 @@ pub struct RunOutcome {
     pub samples_written: usize,
     /// 100 Hz INS epochs simulated.
     pub epochs: u64,
+    /// Sightings the filter used.
+    pub sightings_used: u64,
+    /// Sightings the filter's χ² gate rejected.
+    pub sightings_rejected: u64,
 }
 
 /// Failures of [`run`]; each says where (time) and what.

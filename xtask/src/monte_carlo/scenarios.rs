@@ -1,0 +1,291 @@
+//! `cargo xtask monte-carlo scenarios`: the matched case (`configs/paper.toml`) and every
+//! model-mismatch scenario of `configs/mismatch/`, KF and AKF on the same seeds, in one table:
+//! final errors, lost runs, NEES/NIS, the fraction of epochs whose run-average NEES lies in the
+//! per-epoch 95 % band, and the sightings used and rejected by the gate.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use nav_app::ins_sd::{self, Mode, Sample, Scenario};
+use rayon::prelude::*;
+
+/// Options of `scenarios`.
+#[derive(Args, Debug, Clone)]
+pub struct ScenariosArgs {
+    /// Directory of mismatch scenario files [default: configs/mismatch].
+    #[arg(long)]
+    pub dir: Option<PathBuf>,
+    /// Runs per scenario and filter [default: 100].
+    #[arg(long, default_value_t = 100)]
+    pub runs: u64,
+    /// Output directory [default: target/monte-carlo/scenarios-runs<N>].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Cut every flight to its first SECONDS (tests).
+    #[arg(long, value_name = "SECONDS")]
+    pub duration: Option<f64>,
+}
+
+/// One (scenario, filter) row.
+#[derive(Clone, Debug, Default)]
+pub struct Row {
+    /// Scenario name.
+    pub scenario: String,
+    /// Filter.
+    pub mode: String,
+    /// Runs that reached the end.
+    pub kept: u64,
+    /// Runs lost (the simulation failed).
+    pub lost: u64,
+    /// Failure times of the lost runs, s (sorted).
+    pub lost_t_s: Vec<f64>,
+    /// RMS over kept runs of the final 3-D position error, m.
+    pub final_rms_m: f64,
+    /// Median of the final 3-D error, m.
+    pub final_median_m: f64,
+    /// 10th percentile of the final 3-D error, m.
+    pub final_p10_m: f64,
+    /// 90th percentile of the final 3-D error, m.
+    pub final_p90_m: f64,
+    /// Mean NEES over kept runs and epochs t ≥ 1 s.
+    pub nees_mean: f64,
+    /// Fraction of epochs whose run-average NEES is inside the per-epoch 95 % band.
+    pub nees_in_band: f64,
+    /// Mean NIS per degree of freedom (1 for a consistent filter).
+    pub nis_per_dof: f64,
+    /// Sightings used per run (mean).
+    pub used_per_run: f64,
+    /// Sightings rejected per run (mean).
+    pub rejected_per_run: f64,
+}
+
+struct RunResult {
+    final_m: f64,
+    nees: Vec<f64>,
+    nis_sum: f64,
+    dof_sum: f64,
+    used: u64,
+    rejected: u64,
+}
+
+/// Simulates `runs` runs of `sc` in `mode` and summarises them.
+pub fn evaluate(name: &str, sc: &Scenario, mode: Mode, runs: u64) -> Row {
+    let n = sc.samples_per_run();
+    let results: Vec<Result<RunResult, f64>> = (0..runs)
+        .into_par_iter()
+        .map(|i| {
+            let mut out = vec![Sample::default(); n];
+            let seed = ins_sd::run_seed(sc.monte_carlo.seed, mode, i);
+            let o = ins_sd::run(sc, mode, seed, &mut out).map_err(|e| failure_time(&e))?;
+            let Some(last) = out.last() else {
+                return Err(f64::NAN);
+            };
+            let p = last.pos_err_ned_m;
+            if !p.iter().all(|v| v.is_finite()) {
+                return Err(last.t_s);
+            }
+            let mut r = RunResult {
+                final_m: (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt(),
+                nees: out.iter().map(|s| s.nees.unwrap_or(f64::NAN)).collect(),
+                nis_sum: 0.0,
+                dof_sum: 0.0,
+                used: o.sightings_used,
+                rejected: o.sightings_rejected,
+            };
+            for s in &out {
+                if let Some(v) = s.nis
+                    && s.nis_dof > 0
+                {
+                    r.nis_sum += v;
+                    r.dof_sum += s.nis_dof as f64;
+                }
+            }
+            Ok(r)
+        })
+        .collect();
+    let kept: Vec<&RunResult> = results.iter().filter_map(|r| r.as_ref().ok()).collect();
+    let mut lost_t_s: Vec<f64> = results
+        .iter()
+        .filter_map(|r| r.as_ref().err().copied())
+        .collect();
+    lost_t_s.sort_by(f64::total_cmp);
+    let mut row = Row {
+        scenario: name.to_string(),
+        mode: mode.name().to_string(),
+        kept: kept.len() as u64,
+        lost: runs - kept.len() as u64,
+        lost_t_s,
+        ..Row::default()
+    };
+    if kept.is_empty() {
+        return row;
+    }
+    let k = kept.len() as f64;
+    row.final_rms_m = (kept.iter().map(|r| r.final_m * r.final_m).sum::<f64>() / k).sqrt();
+    let mut finals: Vec<f64> = kept.iter().map(|r| r.final_m).collect();
+    finals.sort_by(f64::total_cmp);
+    let q = |f: f64| finals[((finals.len() - 1) as f64 * f).round() as usize];
+    row.final_median_m = q(0.5);
+    row.final_p10_m = q(0.1);
+    row.final_p90_m = q(0.9);
+    let band = akf::average_band(15, kept.len(), 0.95).unwrap_or((f64::NAN, f64::NAN));
+    let (mut inside, mut epochs, mut sum, mut cnt) = (0usize, 0usize, 0.0, 0usize);
+    for t in 1..n {
+        let vals: Vec<f64> = kept
+            .iter()
+            .map(|r| r.nees[t])
+            .filter(|v| v.is_finite())
+            .collect();
+        if vals.is_empty() {
+            continue;
+        }
+        let avg = vals.iter().sum::<f64>() / vals.len() as f64;
+        sum += vals.iter().sum::<f64>();
+        cnt += vals.len();
+        epochs += 1;
+        if avg >= band.0 && avg <= band.1 {
+            inside += 1;
+        }
+    }
+    row.nees_mean = if cnt > 0 { sum / cnt as f64 } else { f64::NAN };
+    row.nees_in_band = if epochs > 0 {
+        inside as f64 / epochs as f64
+    } else {
+        f64::NAN
+    };
+    let (ns, ds) = kept
+        .iter()
+        .fold((0.0, 0.0), |(a, b), r| (a + r.nis_sum, b + r.dof_sum));
+    row.nis_per_dof = if ds > 0.0 { ns / ds } else { f64::NAN };
+    row.used_per_run = kept.iter().map(|r| r.used as f64).sum::<f64>() / k;
+    row.rejected_per_run = kept.iter().map(|r| r.rejected as f64).sum::<f64>() / k;
+    row
+}
+
+fn failure_time(e: &ins_sd::RunError) -> f64 {
+    match e {
+        ins_sd::RunError::NonFinite { t_s, .. }
+        | ins_sd::RunError::Sighting { t_s, .. }
+        | ins_sd::RunError::Filter { t_s, .. }
+        | ins_sd::RunError::Online { t_s, .. } => *t_s,
+        _ => f64::NAN,
+    }
+}
+
+/// "k of n (t = a…b s)" for the lost-runs column.
+pub fn lost_text(r: &Row) -> String {
+    match (r.lost_t_s.first(), r.lost_t_s.last()) {
+        (Some(a), Some(b)) => format!("{} of {} (t = {a:.0}…{b:.0} s)", r.lost, r.lost + r.kept),
+        _ => format!("{} of {}", r.lost, r.lost + r.kept),
+    }
+}
+
+fn load(path: &Path, duration: Option<f64>) -> Result<Scenario> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let sc =
+        Scenario::from_toml_str(&text).with_context(|| format!("scenario {}", path.display()))?;
+    match duration {
+        Some(d) => sc.truncated(d).with_context(|| format!("--duration {d}")),
+        None => Ok(sc),
+    }
+}
+
+/// The comparison table as Markdown.
+pub fn table(rows: &[Row], runs: u64, duration_s: f64) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# Model-mismatch scenarios ({runs} runs per row, {duration_s} s, same seeds in every row)\n"
+    );
+    let _ = writeln!(
+        s,
+        "| scenario | filter | final 3-D RMS (m) | median (m) | lost runs | NEES mean (15) | epochs with NEES in 95 % band | NIS per dof (1) | sightings used / run | rejected / run |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.1} | {:.1} | {} | {:.1} | {:.0} % | {:.2} | {:.0} | {:.1} |",
+            r.scenario,
+            r.mode,
+            r.final_rms_m,
+            r.final_median_m,
+            lost_text(r),
+            r.nees_mean,
+            100.0 * r.nees_in_band,
+            r.nis_per_dof,
+            r.used_per_run,
+            r.rejected_per_run
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nLost runs (the simulation failed: a landmark behind the camera or a non-finite state) are counted, not hidden; the statistics are over the kept runs. NEES in band: the fraction of 1 Hz epochs at which the run-average NEES lies inside the 95 % band for that number of runs (akf::average_band), the per-epoch test."
+    );
+    s
+}
+
+/// Runs the matched case and every scenario in `dir`, writes `comparison.md`; returns the rows.
+pub fn run(args: &ScenariosArgs, root: &Path, target: &Path) -> Result<Vec<Row>> {
+    let dir = args
+        .dir
+        .clone()
+        .unwrap_or_else(|| root.join("configs/mismatch"));
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    let mut list = vec![("matched".to_string(), root.join("configs/paper.toml"))];
+    for f in files {
+        let name = f
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        list.push((name, f));
+    }
+    let threads = args.threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("thread pool")?;
+    let mut rows = Vec::new();
+    let mut duration_s = 0.0;
+    let start = std::time::Instant::now();
+    for (name, path) in &list {
+        let sc = load(path, args.duration)?;
+        duration_s = sc.duration_s();
+        for mode in [Mode::Kf, Mode::Akf] {
+            let row = pool.install(|| evaluate(name, &sc, mode, args.runs));
+            eprintln!(
+                "scenarios: {name:<20} {:<4} final 3-D RMS {:.1} m, lost {}, NEES {:.1}, rejected/run {:.1}",
+                row.mode, row.final_rms_m, row.lost, row.nees_mean, row.rejected_per_run
+            );
+            rows.push(row);
+        }
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| target.join(format!("monte-carlo/scenarios-runs{}", args.runs)));
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let path = out.join("comparison.md");
+    std::fs::write(&path, table(&rows, args.runs, duration_s))
+        .with_context(|| format!("writing {}", path.display()))?;
+    println!(
+        "scenarios: wrote {} ({:.1} s)",
+        path.display(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(rows)
+}
