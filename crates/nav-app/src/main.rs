@@ -18,7 +18,7 @@
 //! signal-loss changes as they happen). With `--json` every frame object also carries
 //! `"capture": {"sequence", "timestamp_us", "format", "width_px", "height_px", "missed",
 //! "signal_lost", "mean_grey"}`, and the last line is always (also after an error)
-//! `{"summary": {"device": {…}|null, "frames", "errored_dropped", "sequence_gaps", "timeouts",
+//! `{"schema": 1, "summary": {"device": {…}|null, "frames", "errored_dropped", "sequence_gaps", "timeouts",
 //! "restarts", "signal_lost_frames", "controls_set", "elapsed_s", "fps", "tracked_frames",
 //! "lost_frames", "skipped_bytes", "exit", "exit_code", "error"}}` with `exit` one of
 //! `max-frames`, `end`, `device-gone`, `timeout`, `error`.
@@ -45,7 +45,7 @@
 //! `nav_app::y4m::Y4mSource`), a short last frame — is reported on stderr, counted and skipped;
 //! the run goes on. The last stderr line says `N frames tracked, L frames lost (B bytes
 //! skipped)`. With `--json` the last stdout line is always (every input, also after an error)
-//! `{"summary": {"input": …, "tracked_frames", "lost_frames", "skipped_bytes", "exit",
+//! `{"schema": 1, "summary": {"input": …, "tracked_frames", "lost_frames", "skipped_bytes", "exit",
 //! "exit_code", "error"}}` (with `--device`: `"device"` and the capture counters in place of
 //! `"input"`, as above).
 //!
@@ -239,8 +239,14 @@ fn device_options(d: &DeviceArgs) -> Result<DeviceOptions> {
     Ok(opts)
 }
 
+/// Version of the per-frame `--json` objects and of the summary line (README, "Per-frame JSON").
+/// Raised when a field changes meaning or disappears; new fields do not raise it.
+const JSON_SCHEMA: u32 = 1;
+
 #[derive(Serialize)]
 struct FrameJson<'a> {
+    /// [`JSON_SCHEMA`].
+    schema: u32,
     frame: u64,
     t_s: f64,
     lanes: &'a [LaneReport; 2],
@@ -261,6 +267,8 @@ struct FrameJson<'a> {
 /// The last line of a `--json` run.
 #[derive(Serialize)]
 struct SummaryJson<'a> {
+    /// [`JSON_SCHEMA`].
+    schema: u32,
     summary: SummaryBody<'a>,
 }
 
@@ -437,6 +445,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
             serde_json::to_writer(
                 &mut out,
                 &FrameJson {
+                    schema: JSON_SCHEMA,
                     frame: index,
                     t_s: meta.t_s,
                     lanes: &report.lanes,
@@ -672,6 +681,7 @@ fn main() -> ExitCode {
             (None, None) => Some(SAMPLE_NAME.to_owned()),
         };
         let summary = SummaryJson {
+            schema: JSON_SCHEMA,
             summary: SummaryBody {
                 input,
                 device: args

@@ -37,6 +37,10 @@ fn json_output(o: &Output) -> (Vec<serde_json::Value>, serde_json::Value) {
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
     let summary = values.pop().expect("a summary line");
+    assert_eq!(
+        summary["schema"], 1,
+        "the summary line carries the schema version"
+    );
     assert!(
         values.iter().all(|v| v.get("summary").is_none()),
         "only the last line is a summary"
@@ -80,10 +84,29 @@ fn json_is_one_object_per_frame_with_the_documented_schema() {
             .ends_with("straight_solid.y4m")
     );
     for (i, v) in frames.iter().enumerate() {
+        // The documented fields, no more (README "Per-frame JSON"), schema 1.
+        let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+        keys.sort_unstable();
+        assert_eq!(keys, ["frame", "lanes", "schema", "t_s", "track_us"]);
+        assert_eq!(v["schema"], 1);
+        assert!(v["track_us"].as_f64().unwrap() > 0.0);
         assert_eq!(v["frame"].as_u64(), Some(i as u64));
         assert!((v["t_s"].as_f64().unwrap() - i as f64 / 25.0).abs() < 1e-9);
         let lanes = v["lanes"].as_array().unwrap();
         assert_eq!(lanes.len(), 2);
+        for lane in lanes {
+            let mut keys: Vec<&str> = lane
+                .as_object()
+                .unwrap()
+                .keys()
+                .map(String::as_str)
+                .collect();
+            keys.sort_unstable();
+            assert_eq!(
+                keys,
+                ["coeffs", "initialised", "points", "rows", "side", "state"]
+            );
+        }
         assert_eq!(lanes[0]["side"], "left");
         assert_eq!(lanes[1]["side"], "right");
         for lane in lanes {
