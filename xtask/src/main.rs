@@ -16,7 +16,15 @@ mod regress;
 mod vivid;
 
 #[derive(Parser)]
-#[command(name = "cargo xtask", about = "Project chores")]
+#[command(
+    name = "cargo xtask",
+    about = "Project chores",
+    after_help = "With no subcommand this help is printed and nothing runs; `cargo xtask test` is the \
+                  project's one test command, `cargo xtask monte-carlo` its main job (on \
+                  configs/paper.toml when no --config is given).\n\n\
+                  Exit codes: 0 success; 1 a command or a gate step failed (the gate names every \
+                  failed step); 2 bad command line."
+)]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,

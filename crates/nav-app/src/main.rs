@@ -549,7 +549,12 @@ fn failure_kind(e: &anyhow::Error) -> (u8, &'static str) {
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app ins",
-    about = "Replays IMU and sighting logs through the INS/SD filter (formats: nav_app::ins_sd::logs)"
+    about = "Replays IMU and sighting logs through the INS/SD filter (formats: nav_app::ins_sd::logs)",
+    after_help = "All of --imu, --sightings, --landmarks, --init and --out are required (there is no \
+                  bundled flight; `cargo xtask monte-carlo --export-logs DIR` writes one). \
+                  --config defaults to configs/paper.toml.\n\n\
+                  Exit codes: 0 success; 1 error (a malformed log names its file, line and column); \
+                  2 bad command line."
 )]
 struct InsArgs {
     /// IMU log (CSV: t_s, Δv body m/s, Δθ body rad).
