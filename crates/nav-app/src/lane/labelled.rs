@@ -133,7 +133,11 @@ impl LabelSet {
             path: name.to_owned(),
             reason,
         };
-        let set: LabelSet = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+        let set: LabelSet = serde_json::from_str(text).map_err(|e| NavError::Labels {
+            // serde_json locates syntax and schema errors: name the line and column once.
+            path: format!("{name}:{}:{}", e.line(), e.column()),
+            reason: strip_location(&e.to_string()),
+        })?;
         if set.schema != LABEL_SCHEMA {
             return Err(bad(format!(
                 "schema {} (this reader takes {LABEL_SCHEMA})",
@@ -198,6 +202,14 @@ impl LabelSet {
     /// Number of consecutive labelled frames in the longest clip.
     pub fn longest_clip(&self) -> usize {
         self.clips().iter().map(|c| c.len()).max().unwrap_or(0)
+    }
+}
+
+/// serde_json's message without its trailing " at line L column C" (the location goes in the path).
+fn strip_location(msg: &str) -> String {
+    match msg.rfind(" at line ") {
+        Some(i) => msg[..i].to_owned(),
+        None => msg.to_owned(),
     }
 }
 
@@ -599,6 +611,20 @@ mod tests {
                 "{needle}: {e}"
             );
         }
+    }
+
+    #[test]
+    fn a_syntax_or_schema_error_names_the_file_line_and_column_once() {
+        let text = "{\"schema\": 1,\n \"set\": 5}";
+        let e = LabelSet::from_json_str("labels.json", text)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("labels.json:2:"), "{e}");
+        assert_eq!(
+            e.matches("line").count(),
+            0,
+            "located once, in file:line:col form: {e}"
+        );
     }
 
     #[test]
