@@ -2,6 +2,7 @@
 //! takes the world path yet reproduces the matched run bit for bit (common random numbers);
 //! each mismatch changes the run the way it says (fewer sightings in limited view, outliers
 //! gated, …). Short flights, one run each.
+#![cfg(feature = "ins")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nav_app::ins_sd::{Mode, RunOutcome, Sample, Scenario, run, run_seed};
