@@ -18,7 +18,7 @@
 //!    cold build compiles nav-app's whole dependency tree for that target once). `--guest-bin PATH` runs another static build of
 //!    nav-app instead. The guest runs e.g. `nav-app --device /dev/video0 --input-name S-Video
 //!    --std ntsc --max-frames 60 --json` and prints one JSON object per tracked frame (with its
-//!    `"capture"` device fields) and a last `{"summary": {…}}` line, plus its hidden test flags
+//!    `"capture"` device fields) and a last `{"schema": 1, "summary": {…}}` line, plus its hidden test flags
 //!    (`--format --timeout-ms --ctrl NAME=VALUE@FRAME --ctrl-on-timeout NAME=VALUE`) for the
 //!    fault cases; see `crates/nav-app/src/main.rs`.
 //! 3. Kernel: the package `linux-image-amd64` depends on, fetched with `apt-get download` and
@@ -908,12 +908,18 @@ fn split_cases(log: &SerialLog) -> BTreeMap<String, CaseOutput> {
             line.find(key)
                 .and_then(|start| serde_json::from_str::<Value>(&line[start..]).ok())
         };
-        if let Some(v) = parse("{\"frame\"") {
-            o.frames.push(flatten_frame(&v));
-        } else if let Some(v) = parse("{\"summary\"") {
-            let s = v.get("summary").cloned().unwrap_or(Value::Null);
+        // Objects start with `"schema"` (JSON schema 1) or, before it, with their first field.
+        let Some(v) = parse("{\"schema\"")
+            .or_else(|| parse("{\"frame\""))
+            .or_else(|| parse("{\"summary\""))
+        else {
+            continue;
+        };
+        if let Some(s) = v.get("summary") {
             o.open = s.get("device").filter(|d| !d.is_null()).cloned();
-            o.summary = Some(s);
+            o.summary = Some(s.clone());
+        } else if v.get("frame").is_some() {
+            o.frames.push(flatten_frame(&v));
         }
     }
     out
@@ -1207,7 +1213,7 @@ mod tests {
     /// A nav-app `--json` frame line (lanes abridged to what the checks read).
     fn frame(n: u64, seq: u64, ts: u64) -> String {
         format!(
-            r#"{{"frame":{n},"t_s":0.0,"lanes":[{{"side":"left","state":"lost"}},{{"side":"right","state":"lost"}}],"track_us":900.0,"capture":{{"sequence":{seq},"timestamp_us":{ts},"format":"GREY","width_px":320,"height_px":240,"missed":0,"signal_lost":false,"mean_grey":65.0}}}}"#
+            r#"{{"schema":1,"frame":{n},"t_s":0.0,"lanes":[{{"side":"left","state":"lost"}},{{"side":"right","state":"lost"}}],"track_us":900.0,"capture":{{"sequence":{seq},"timestamp_us":{ts},"format":"GREY","width_px":320,"height_px":240,"missed":0,"signal_lost":false,"mean_grey":65.0}}}}"#
         )
     }
 
@@ -1221,7 +1227,7 @@ mod tests {
             ));
         }
         lines.push(format!(
-            r#"{{"summary":{{"device":{{"device":"/dev/video0","input_index":1,"std_id":4096,"width_px":320,"height_px":240,"format":"GREY","stride_bytes":320,"buffers":4}},"frames":{},"errored_dropped":0,"sequence_gaps":0,"controls_set":0,"exit":"max-frames","exit_code":0,"error":null}}}}"#,
+            r#"{{"schema":1,"summary":{{"device":{{"device":"/dev/video0","input_index":1,"std_id":4096,"width_px":320,"height_px":240,"format":"GREY","stride_bytes":320,"buffers":4}},"frames":{},"errored_dropped":0,"sequence_gaps":0,"controls_set":0,"exit":"max-frames","exit_code":0,"error":null}}}}"#,
             seqs.len()
         ));
         lines.push(format!("VIVID-CASE-END s rc={rc}"));
