@@ -31,6 +31,29 @@ pub enum FilterError {
         /// The previous time stamp, s.
         previous_s: f64,
     },
+    /// An IMU sample more than one update interval after the previous one (missing data).
+    #[error("IMU sample at t = {t_s} s is {gap} s after the previous one ({previous_s} s): more than the update interval {max_s} s", gap = t_s - previous_s)]
+    ImuGap {
+        /// The time stamp given, s.
+        t_s: f64,
+        /// The previous time stamp, s.
+        previous_s: f64,
+        /// The largest gap taken, s (the update interval).
+        max_s: f64,
+    },
+    /// An IMU sample whose mean specific force or angular rate is beyond any navigation IMU's
+    /// range (a corrupt record).
+    #[error(
+        "IMU sample at t = {t_s} s is implausible: specific force {specific_force_mps2:e} m/s², angular rate {angular_rate_radps:e} rad/s (limits 2000 m/s², 100 rad/s)"
+    )]
+    ImplausibleImu {
+        /// The time stamp, s.
+        t_s: f64,
+        /// Mean specific force over the sample, m/s².
+        specific_force_mps2: f64,
+        /// Mean angular rate over the sample, rad/s.
+        angular_rate_radps: f64,
+    },
     /// Sightings must be applied at the INS time: propagate the IMU up to the sighting epoch
     /// first.
     #[error(

@@ -21,6 +21,13 @@ pub const MAX_BATCH: usize = 8;
 /// Feedback happens at epochs `t ≥ open_loop_until_s − FEEDBACK_TIME_TOL_S`.
 const FEEDBACK_TIME_TOL_S: f64 = 1e-9;
 
+/// Largest mean specific force an IMU sample may carry, m/s² (≈ 200 g, beyond the range of any
+/// navigation accelerometer): a larger one is a corrupt record, refused with
+/// [`FilterError::ImplausibleImu`].
+pub const MAX_SPECIFIC_FORCE_MPS2: f64 = 2000.0;
+/// Largest mean angular rate an IMU sample may carry, rad/s (≈ 5700 °/s).
+pub const MAX_ANGULAR_RATE_RADPS: f64 = 100.0;
+
 /// One landmark sighting: the landmark's offset from the image centre when the camera is
 /// pointed at it with the filter's [`InsSdFilter::pointing_pose`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -263,7 +270,10 @@ impl InsSdFilter {
     ///
     /// # Errors
     /// [`FilterError::OutOfOrder`] if `t_s` is not after the previous sample,
-    /// [`FilterError::NonFiniteInput`] for NaN/∞ input (filter unchanged);
+    /// [`FilterError::NonFiniteInput`] for NaN/∞ input, [`FilterError::ImuGap`] for a sample more
+    /// than one update interval after the previous one, [`FilterError::ImplausibleImu`] for a
+    /// mean specific force above [`MAX_SPECIFIC_FORCE_MPS2`] or rate above
+    /// [`MAX_ANGULAR_RATE_RADPS`] (filter unchanged);
     /// [`FilterError::NonFiniteState`] if the navigation solution overflowed.
     pub fn propagate(
         &mut self,
@@ -271,7 +281,7 @@ impl InsSdFilter {
         delta_v_body_mps: &Vector3<f64>,
         delta_theta_body_rad: &Vector3<f64>,
     ) -> Result<(), FilterError> {
-        let dt = self.check_imu(t_s, delta_v_body_mps, delta_theta_body_rad)?;
+        let dt = self.check_imu(t_s, delta_v_body_mps, delta_theta_body_rad, true)?;
         self.advance(
             t_s,
             dt,
@@ -291,13 +301,19 @@ impl InsSdFilter {
         specific_force_body_mps2: &Vector3<f64>,
         ang_rate_ib_body_radps: &Vector3<f64>,
     ) -> Result<(), FilterError> {
-        let dt = self.check_imu(t_s, specific_force_body_mps2, ang_rate_ib_body_radps)?;
+        let dt = self.check_imu(t_s, specific_force_body_mps2, ang_rate_ib_body_radps, false)?;
         self.advance(t_s, dt, specific_force_body_mps2, ang_rate_ib_body_radps)
     }
 
     /// Checks an IMU sample; returns the step to mechanise (the nominal step within the
     /// time-stamp tolerance).
-    fn check_imu(&self, t_s: f64, a: &Vector3<f64>, b: &Vector3<f64>) -> Result<f64, FilterError> {
+    fn check_imu(
+        &self,
+        t_s: f64,
+        a: &Vector3<f64>,
+        b: &Vector3<f64>,
+        increments: bool,
+    ) -> Result<f64, FilterError> {
         if !t_s.is_finite() {
             return Err(FilterError::NonFiniteInput {
                 what: "time stamp",
@@ -324,7 +340,25 @@ impl InsSdFilter {
             });
         }
         let dt = t_s - self.t_s;
+        // A gap longer than one update interval is missing IMU data the strapdown cannot bridge
+        // (and the interval model is built on at most one interval of samples).
+        if dt > self.config.update_period_s + self.config.timestamp_tolerance_s {
+            return Err(FilterError::ImuGap {
+                t_s,
+                previous_s: self.t_s,
+                max_s: self.config.update_period_s,
+            });
+        }
         let step = self.config.imu_step_s;
+        let per = if increments { dt } else { 1.0 };
+        let (f_norm, w_norm) = (a.norm() / per, b.norm() / per);
+        if f_norm > MAX_SPECIFIC_FORCE_MPS2 || w_norm > MAX_ANGULAR_RATE_RADPS {
+            return Err(FilterError::ImplausibleImu {
+                t_s,
+                specific_force_mps2: f_norm,
+                angular_rate_radps: w_norm,
+            });
+        }
         Ok(if (dt - step).abs() <= self.config.timestamp_tolerance_s {
             step
         } else {

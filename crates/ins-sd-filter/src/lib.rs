@@ -129,6 +129,7 @@ mod landmarks;
 pub use config::{ErrorSigmas, Estimator, InsSdFilterConfig, MeasurementJacobian, ProcessNoisePsd};
 pub use error::FilterError;
 pub use filter::{
-    FilterStatistics, InsSdFilter, MAX_BATCH, Sighting, UpdateReport, Vec15, nav_pose,
+    FilterStatistics, InsSdFilter, MAX_ANGULAR_RATE_RADPS, MAX_BATCH, MAX_SPECIFIC_FORCE_MPS2,
+    Sighting, UpdateReport, Vec15, nav_pose,
 };
 pub use landmarks::{LandmarkEntry, LandmarkTable};

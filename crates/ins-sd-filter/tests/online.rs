@@ -514,3 +514,27 @@ fn sage_husa_and_structured_filters_run_and_fit_non_negative_densities() {
     assert!(d.iter().all(|v| v.is_finite() && *v >= 0.0), "{d}");
     println!("structured fit after 40 s: densities {d:?}");
 }
+
+#[test]
+fn an_imu_gap_or_an_implausible_sample_is_refused_and_changes_nothing() {
+    let cfg = config(Estimator::Kalman, None);
+    let (mut f, _) = fly(cfg, 2, 3, &|_, _| {});
+    let (t, before) = (f.time_s(), *f.ins().state());
+    let z = Vector3::zeros();
+    // Two seconds of missing data (the update interval is 1 s).
+    assert!(matches!(
+        f.propagate(t + 2.0, &z, &z),
+        Err(FilterError::ImuGap { .. })
+    ));
+    // 4.3e9 m/s gained in 10 ms, or 500 rad/s: no navigation IMU reads that.
+    assert!(matches!(
+        f.propagate(t + 0.01, &Vector3::new(4.294_967_296e9, 0.0, 0.0), &z),
+        Err(FilterError::ImplausibleImu { .. })
+    ));
+    assert!(matches!(
+        f.propagate_rates(t + 0.01, &z, &Vector3::new(0.0, 0.0, 500.0)),
+        Err(FilterError::ImplausibleImu { .. })
+    ));
+    assert_eq!(f.time_s(), t);
+    assert_eq!(*f.ins().state(), before);
+}
