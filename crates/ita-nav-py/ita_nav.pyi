@@ -154,3 +154,33 @@ def run_flight(
 ) -> dict[str, npt.NDArray[np.float64]]:
     """One simulated flight as numpy arrays: t_s, pos_err_ned_m (n x 3), vel_err_ned_mps,
     misalignment_rad, distance_m, nees and nis (NaN off the sighting epochs)."""
+
+class ModeResult(TypedDict):
+    runs_used: int
+    excluded: list[dict]
+    """Runs left out: run_index, t_s, reason."""
+    rms_pos_3d_m: npt.NDArray[np.float64]
+    rms_pos_h_m: npt.NDArray[np.float64]
+    rms_pos_d_m: npt.NDArray[np.float64]
+    mean_nees: npt.NDArray[np.float64]
+    mean_nis: npt.NDArray[np.float64]
+    final_rms_pos_3d_m: float
+    final_rms_pos_h_m: float
+    final_rms_pos_d_m: float
+    final_pos_3d_m: npt.NDArray[np.float64]
+
+class MonteCarloResult(TypedDict):
+    runs: int
+    seed: int
+    t_s: npt.NDArray[np.float64]
+    modes: dict[str, ModeResult]
+
+def monte_carlo(
+    config: Optional[str] = None,
+    runs: Optional[int] = None,
+    seed: Optional[int] = None,
+    filters: Optional[list[str]] = None,
+) -> MonteCarloResult:
+    """The Monte Carlo (config None: the paper's scenario; runs and seed default to the scenario's;
+    filters default to standalone, kf, akf): the same runs and statistics as `cargo xtask
+    monte-carlo`, as numpy series per second (RMS over runs, mean NEES/NIS) and final figures."""

@@ -134,6 +134,10 @@ pub fn run(args: PythonArgs) -> Result<()> {
         Command::new(&python)
             .current_dir(&root)
             .env("NAV_APP_BIN", &nav_app)
+            .env(
+                "XTASK_BIN",
+                std::env::current_exe().context("cannot locate the xtask binary")?,
+            )
             .args(["-m", "pytest", "-q", "crates/ita-nav-py/tests"])
             .args(&args.pytest_args),
         "pytest crates/ita-nav-py/tests",

@@ -264,3 +264,108 @@ pub fn run_flight<'py>(
     }
     Ok(d)
 }
+
+/// The Monte Carlo of the paper (or of any scenario): `runs` flights per filter (default: the
+/// scenario's), run `i` seeded with `run_seed(seed, mode, i)` exactly as `cargo xtask monte-carlo`
+/// does (so the same runs), folded in run order by the same statistics (`nav_app::ins_sd::stats`).
+/// Returns `{"runs", "seed", "t_s", "modes": {name: {"runs_used", "excluded", "rms_pos_3d_m",
+/// "rms_pos_h_m", "rms_pos_d_m", "mean_nees", "mean_nis", "final_rms_pos_3d_m",
+/// "final_rms_pos_h_m", "final_rms_pos_d_m", "final_pos_3d_m"}}}` with the per-second series as numpy
+/// arrays (NaN where undefined) and `final_pos_3d_m` the kept runs' final 3-D errors.
+/// Single-threaded; the GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (config=None, runs=None, seed=None, filters=None))]
+pub fn monte_carlo<'py>(
+    py: Python<'py>,
+    config: Option<&str>,
+    runs: Option<u64>,
+    seed: Option<u64>,
+    filters: Option<Vec<String>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use nav_app::ins_sd::stats::{ModeStats, RunSummary, first_non_finite, qi};
+    let scenario = load_scenario(config)?;
+    let runs = runs.unwrap_or(scenario.monte_carlo.runs as u64);
+    let seed = seed.unwrap_or(scenario.monte_carlo.seed);
+    let names = filters.unwrap_or_else(|| vec!["standalone".into(), "kf".into(), "akf".into()]);
+    let modes: Vec<Mode> = names.iter().map(|n| mode_of(n)).collect::<PyResult<_>>()?;
+    let n = scenario.samples_per_run();
+    type Folded = (ModeStats, Vec<RunSummary>, Vec<(u64, f64, String)>);
+    let folded: Vec<Folded> = py.detach(|| {
+        let mut out = vec![Sample::default(); n];
+        modes
+            .iter()
+            .map(|&mode| {
+                let mut st = ModeStats::new(mode, n);
+                let (mut kept, mut excluded) = (Vec::new(), Vec::new());
+                for i in 0..runs {
+                    let s = nav_app::ins_sd::run_seed(seed, mode, i);
+                    match nav_app::ins_sd::run(&scenario, mode, s, &mut out) {
+                        Err(e) => excluded.push((i, f64::NAN, e.to_string())),
+                        Ok(_) => match first_non_finite(&out) {
+                            Some((t, what)) => excluded.push((i, t, format!("non-finite {what}"))),
+                            None => {
+                                st.push_run(&out);
+                                kept.push(RunSummary::of(mode, i, &out));
+                            }
+                        },
+                    }
+                }
+                (st, kept, excluded)
+            })
+            .collect()
+    });
+    let d = PyDict::new(py);
+    d.set_item("runs", runs)?;
+    d.set_item("seed", seed)?;
+    d.set_item(
+        "t_s",
+        PyArray1::from_vec(
+            py,
+            (0..n)
+                .map(|k| k as f64 * scenario.duration_s() / (n - 1).max(1) as f64)
+                .collect(),
+        ),
+    )?;
+    let per_mode = PyDict::new(py);
+    for (name, (st, kept, excluded)) in names.iter().zip(&folded) {
+        let m = PyDict::new(py);
+        m.set_item("runs_used", st.runs_used)?;
+        let ex: Vec<Bound<'py, PyDict>> = excluded
+            .iter()
+            .map(|(i, t, why)| {
+                let e = PyDict::new(py);
+                e.set_item("run_index", i)?;
+                e.set_item("t_s", t)?;
+                e.set_item("reason", why)?;
+                Ok(e)
+            })
+            .collect::<PyResult<_>>()?;
+        m.set_item("excluded", ex)?;
+        let series = |q: usize, mean: bool| -> Vec<f64> {
+            st.bins
+                .iter()
+                .map(|b| if mean { b[q].mean() } else { b[q].rms() })
+                .collect()
+        };
+        for (key, q, mean) in [
+            ("rms_pos_3d_m", qi::POS_3D, false),
+            ("rms_pos_h_m", qi::POS_H, false),
+            ("rms_pos_d_m", qi::POS_D, false),
+            ("mean_nees", qi::NEES, true),
+            ("mean_nis", qi::NIS, true),
+        ] {
+            let v = series(q, mean);
+            if let Some(last) = v.last().copied().filter(|_| !mean) {
+                m.set_item(format!("final_{key}"), last)?;
+            }
+            m.set_item(key, PyArray1::from_vec(py, v))?;
+        }
+        m.set_item(
+            "final_pos_3d_m",
+            PyArray1::from_vec(py, kept.iter().map(|r| r.final_pos_3d_m).collect()),
+        )?;
+        per_mode.set_item(name, m)?;
+    }
+    d.set_item("modes", per_mode)?;
+    Ok(d)
+}

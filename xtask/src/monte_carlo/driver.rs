@@ -72,32 +72,7 @@ pub fn thread_cpu_s() -> Option<f64> {
     None
 }
 
-/// First record holding a non-finite value, with the field's name.
-pub fn first_non_finite(samples: &[Sample]) -> Option<(f64, &'static str)> {
-    for s in samples {
-        let checks: [(&'static str, bool); 6] = [
-            (
-                "position error",
-                s.pos_err_ned_m.iter().all(|x| x.is_finite()),
-            ),
-            (
-                "velocity error",
-                s.vel_err_ned_mps.iter().all(|x| x.is_finite()),
-            ),
-            (
-                "misalignment",
-                s.misalignment_rad.iter().all(|x| x.is_finite()),
-            ),
-            ("distance", s.distance_m.is_finite()),
-            ("NEES", s.nees.is_none_or(f64::is_finite)),
-            ("NIS", s.nis.is_none_or(f64::is_finite)),
-        ];
-        if let Some((what, _)) = checks.iter().find(|(_, ok)| !ok) {
-            return Some((s.t_s, what));
-        }
-    }
-    None
-}
+pub use nav_app::ins_sd::stats::first_non_finite;
 
 /// Simulates `plan.range` × `plan.modes` with `runner(mode, index, out)` and folds the records.
 ///

@@ -103,7 +103,8 @@ pub mod export;
 pub mod plot;
 pub mod report;
 pub mod scenarios;
-pub mod stats;
+/// The mergeable statistics live in nav-app's INS half (`nav_app::ins_sd::stats`).
+pub use nav_app::ins_sd::stats;
 pub mod sweep;
 
 #[cfg(test)]

@@ -200,6 +200,7 @@ mod config;
 mod engine;
 pub mod logs;
 mod mismatch;
+pub mod stats;
 /// The interval discretisation (moved to `ins-sd-filter`; re-exported for existing users).
 pub use ins_sd_filter::interval;
 

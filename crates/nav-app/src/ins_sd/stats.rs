@@ -6,8 +6,36 @@
 //! process the per-run records are folded in run-index order (see `driver`), so the result
 //! does not depend on the thread count either (bit-identical, tested).
 
-use nav_app::ins_sd::{Mode, Sample};
 use serde::{Deserialize, Serialize};
+
+use super::{Mode, Sample};
+
+/// Why shard statistics cannot be merged.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MergeError {
+    /// Nothing to merge.
+    #[error("merge: no statistics to merge")]
+    Empty,
+    /// A file of another format.
+    #[error("merge: format `{found}` is not `{FORMAT}`")]
+    Format {
+        /// The format found.
+        found: String,
+    },
+    /// The shards disagree on what they simulated.
+    #[error("merge: shards come from different {what} ({a} vs {b})")]
+    Mismatch {
+        /// Which property (`scenarios`, `master seeds`, `total run counts`, `modes or durations`).
+        what: &'static str,
+        /// One value.
+        a: String,
+        /// The other.
+        b: String,
+    },
+    /// Two shards cover the same runs.
+    #[error("merge: run ranges {0}..{1} and {2}..{3} overlap (the same shard given twice?)")]
+    Overlap(u64, u64, u64, u64),
+}
 
 /// Number of accumulated quantities per time bin.
 pub const Q: usize = 14;
@@ -312,43 +340,55 @@ impl Stats {
 /// Merges shard statistics (any order) into one. Checks that they describe the same scenario,
 /// seed and total run count and that their run ranges are disjoint; sums in the order of the
 /// ranges' starts.
-pub fn merge(mut parts: Vec<Stats>) -> anyhow::Result<Stats> {
-    use anyhow::{bail, ensure};
-    ensure!(!parts.is_empty(), "merge: no statistics to merge");
+pub fn merge(mut parts: Vec<Stats>) -> Result<Stats, MergeError> {
+    if parts.is_empty() {
+        return Err(MergeError::Empty);
+    }
     parts.sort_by_key(|p| p.run_ranges.first().map_or(0, |r| r.0));
     let first = parts[0].clone();
+    let differ = |what, a: String, b: String| MergeError::Mismatch { what, a, b };
     for p in &parts {
-        ensure!(
-            p.format == FORMAT,
-            "merge: format `{}` is not `{FORMAT}`",
-            p.format
-        );
-        ensure!(
-            p.scenario_fingerprint == first.scenario_fingerprint,
-            "merge: shards come from different scenarios (fingerprint {} vs {})",
-            p.scenario_fingerprint,
-            first.scenario_fingerprint
-        );
-        ensure!(
-            p.seed == first.seed,
-            "merge: different master seeds ({} vs {})",
-            p.seed,
-            first.seed
-        );
-        ensure!(
-            p.runs_total == first.runs_total,
-            "merge: different total run counts ({} vs {})",
-            p.runs_total,
-            first.runs_total
-        );
-        ensure!(
-            p.modes.len() == first.modes.len()
-                && p.modes
+        if p.format != FORMAT {
+            return Err(MergeError::Format {
+                found: p.format.clone(),
+            });
+        }
+        if p.scenario_fingerprint != first.scenario_fingerprint {
+            return Err(differ(
+                "scenarios",
+                p.scenario_fingerprint.clone(),
+                first.scenario_fingerprint.clone(),
+            ));
+        }
+        if p.seed != first.seed {
+            return Err(differ(
+                "master seeds",
+                p.seed.to_string(),
+                first.seed.to_string(),
+            ));
+        }
+        if p.runs_total != first.runs_total {
+            return Err(differ(
+                "total run counts",
+                p.runs_total.to_string(),
+                first.runs_total.to_string(),
+            ));
+        }
+        let same_modes = p.modes.len() == first.modes.len()
+            && p.modes
+                .iter()
+                .zip(&first.modes)
+                .all(|(a, b)| a.mode == b.mode && a.bins.len() == b.bins.len());
+        if !same_modes {
+            let names = |s: &Stats| {
+                s.modes
                     .iter()
-                    .zip(&first.modes)
-                    .all(|(a, b)| a.mode == b.mode && a.bins.len() == b.bins.len()),
-            "merge: shards hold different modes or durations"
-        );
+                    .map(|m| format!("{} ({} s)", m.mode, m.bins.len().saturating_sub(1)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            return Err(differ("modes or durations", names(p), names(&first)));
+        }
     }
     let mut out = first;
     for p in &parts[1..] {
@@ -365,13 +405,7 @@ pub fn merge(mut parts: Vec<Stats>) -> anyhow::Result<Stats> {
     out.run_ranges.sort_unstable();
     for w in out.run_ranges.windows(2) {
         if w[1].0 < w[0].1 {
-            bail!(
-                "merge: run ranges {}..{} and {}..{} overlap (the same shard given twice?)",
-                w[0].0,
-                w[0].1,
-                w[1].0,
-                w[1].1
-            );
+            return Err(MergeError::Overlap(w[0].0, w[0].1, w[1].0, w[1].1));
         }
     }
     out.shards.sort_by_key(|s| s.index);
@@ -408,4 +442,32 @@ pub fn missing_ranges(stats: &Stats) -> Vec<(u64, u64)> {
 /// Sort key: mode in `Mode::EVERY` order, then run index.
 pub fn order_key(mode: &str, run_index: u64) -> (Option<usize>, u64) {
     (Mode::EVERY.iter().position(|x| x.name() == mode), run_index)
+}
+
+/// First record holding a non-finite value, with the field's name (a run with one is left out
+/// of the statistics).
+pub fn first_non_finite(samples: &[Sample]) -> Option<(f64, &'static str)> {
+    for s in samples {
+        let checks: [(&'static str, bool); 6] = [
+            (
+                "position error",
+                s.pos_err_ned_m.iter().all(|x| x.is_finite()),
+            ),
+            (
+                "velocity error",
+                s.vel_err_ned_mps.iter().all(|x| x.is_finite()),
+            ),
+            (
+                "misalignment",
+                s.misalignment_rad.iter().all(|x| x.is_finite()),
+            ),
+            ("distance", s.distance_m.is_finite()),
+            ("NEES", s.nees.is_none_or(f64::is_finite)),
+            ("NIS", s.nis.is_none_or(f64::is_finite)),
+        ];
+        if let Some((what, _)) = checks.iter().find(|(_, ok)| !ok) {
+            return Some((s.t_s, what));
+        }
+    }
+    None
 }
