@@ -37,14 +37,11 @@
 //! (ground frame: `X` forward, `Y` right, origin on the ground below the camera). Unknown fields
 //! are refused and every out-of-range field is named.
 
-use std::path::Path;
-
 use lane_geometry::{
     EgoLaneEstimator, GeometryError, Homography, Intrinsics, Mounting, PinholeCamera,
 };
 use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
-use toml_config::TomlDoc;
 
 use crate::{LaneTracker, NavError, Side, TrackReport};
 
@@ -167,19 +164,7 @@ impl CameraConfig {
     /// [`NavError::ConfigFile`]: syntax, an unknown or missing field, or the first field out of
     /// range, each with the file, line and column (the workspace's one TOML loader, `toml-config`).
     pub fn from_toml_str(name: &str, text: &str) -> Result<Self, NavError> {
-        let doc = TomlDoc::parse(name, text).map_err(NavError::ConfigFile)?;
-        let cfg: CameraConfig = doc.deserialize().map_err(NavError::ConfigFile)?;
-        cfg.validate().map_err(|e| match e {
-            NavError::ConfigField {
-                field,
-                value,
-                reason,
-            } => {
-                NavError::ConfigFile(doc.error_at(field, format!("`{field}` = {value}: {reason}")))
-            }
-            other => other,
-        })?;
-        Ok(cfg)
+        super::config::parse_validated(name, text, Self::validate)
     }
 
     /// `robot` / `highway` name a preset; anything else is a TOML file path.
@@ -190,11 +175,7 @@ impl CameraConfig {
         match name_or_path {
             "robot" => Self::from_toml_str("preset camera-robot", CAMERA_ROBOT_TOML),
             "highway" => Self::from_toml_str("preset camera-highway", CAMERA_HIGHWAY_TOML),
-            path => {
-                let text = std::fs::read_to_string(Path::new(path))
-                    .map_err(|e| NavError::io(path.to_owned(), e))?;
-                Self::from_toml_str(path, &text)
-            }
+            path => Self::from_toml_str(path, &super::config::read_config_file(path)?),
         }
     }
 

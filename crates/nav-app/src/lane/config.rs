@@ -145,6 +145,33 @@ fn check(
     }
 }
 
+/// Parse `text` (file `name`) with the workspace's one TOML loader and validate it: every error
+/// is a [`NavError::ConfigFile`] naming the file, line and column — syntax, unknown, missing or
+/// mistyped keys, and the first field out of range (located at its key). Shared by every lane
+/// configuration file (tracker, camera).
+pub(crate) fn parse_validated<T: serde::de::DeserializeOwned>(
+    name: &str,
+    text: &str,
+    validate: impl FnOnce(&T) -> Result<(), NavError>,
+) -> Result<T, NavError> {
+    let doc = TomlDoc::parse(name, text).map_err(NavError::ConfigFile)?;
+    let cfg: T = doc.deserialize().map_err(NavError::ConfigFile)?;
+    validate(&cfg).map_err(|e| match e {
+        NavError::ConfigField {
+            field,
+            value,
+            reason,
+        } => NavError::ConfigFile(doc.error_at(field, format!("`{field}` = {value}: {reason}"))),
+        other => other,
+    })?;
+    Ok(cfg)
+}
+
+/// The text of a configuration file; the error names the file and its OS error once.
+pub(crate) fn read_config_file(path: &str) -> Result<String, NavError> {
+    std::fs::read_to_string(Path::new(path)).map_err(|e| NavError::io(path.to_owned(), e))
+}
+
 impl TrackerConfig {
     /// The default configuration (`configs/default.toml`): what `nav-app` runs with no
     /// `--config`, meant to need no preset on roads and indoor floors alike.
@@ -166,19 +193,7 @@ impl TrackerConfig {
     /// [`NavError::ConfigFile`] naming `name`, the line and the column: syntax, unknown, missing
     /// or mistyped keys, and fields out of range (located at their key).
     pub fn from_toml_str(name: &str, text: &str) -> Result<Self, NavError> {
-        let doc = TomlDoc::parse(name, text).map_err(NavError::ConfigFile)?;
-        let cfg: TrackerConfig = doc.deserialize().map_err(NavError::ConfigFile)?;
-        cfg.validate().map_err(|e| match e {
-            NavError::ConfigField {
-                field,
-                value,
-                reason,
-            } => {
-                NavError::ConfigFile(doc.error_at(field, format!("`{field}` = {value}: {reason}")))
-            }
-            other => other,
-        })?;
-        Ok(cfg)
+        parse_validated(name, text, Self::validate)
     }
 
     /// `default` / `indoor` / `outdoor` name a preset; anything else is a TOML file path.
@@ -187,11 +202,7 @@ impl TrackerConfig {
             "default" => Self::default_preset(),
             "outdoor" => Self::outdoor(),
             "indoor" => Self::indoor(),
-            path => {
-                let text = std::fs::read_to_string(Path::new(path))
-                    .map_err(|e| NavError::io(path.to_owned(), e))?;
-                Self::from_toml_str(path, &text)
-            }
+            path => Self::from_toml_str(path, &read_config_file(path)?),
         }
     }
 
