@@ -129,6 +129,35 @@ pub fn project_psd<const N: usize>(
     })
 }
 
+/// Checks the inputs of one adaptive-estimator push (shared by [`AdaptiveQ::push`] and
+/// `SageHusaQ::push`): every one finite, else the error names it.
+pub(crate) fn check_push_inputs<const N: usize>(
+    dx: &SVector<f64, N>,
+    p_post: &SMatrix<f64, N, N>,
+    p_post_prev: &SMatrix<f64, N, N>,
+    phi_interval: &SMatrix<f64, N, N>,
+) -> Result<(), AkfError> {
+    check_finite("dx", dx)?;
+    check_finite("p_post", p_post)?;
+    check_finite("p_post_prev", p_post_prev)?;
+    check_finite("phi_interval", phi_interval)
+}
+
+/// Projects a symmetrised Q̂ as `projection` says: eigenvalue clipping at `min_eigenvalue`, or
+/// the diagonal with per-state `floors` (the structured projection starts from the diagonal one
+/// too). Shared by every adaptive estimator.
+pub(crate) fn apply_projection<const N: usize>(
+    raw: &SMatrix<f64, N, N>,
+    projection: QProjection,
+    min_eigenvalue: f64,
+    floors: &SVector<f64, N>,
+) -> Result<Projected<N>, AkfError> {
+    match projection {
+        QProjection::EigenClip => project_psd(raw, min_eigenvalue),
+        QProjection::Diagonal | QProjection::Structured => project_diagonal(raw, floors),
+    }
+}
+
 /// Diagonal projection: `out = diag(max(q_ii, floors_i))`, off-diagonals dropped.
 pub fn project_diagonal<const N: usize>(
     q: &SMatrix<f64, N, N>,
@@ -252,10 +281,7 @@ impl<const N: usize, const CAP: usize> AdaptiveQ<N, CAP> {
         p_post_prev: &SMatrix<f64, N, N>,
         phi_interval: &SMatrix<f64, N, N>,
     ) -> Result<Option<&SMatrix<f64, N, N>>, AkfError> {
-        check_finite("dx", dx)?;
-        check_finite("p_post", p_post)?;
-        check_finite("p_post_prev", p_post_prev)?;
-        check_finite("phi_interval", phi_interval)?;
+        check_push_inputs(dx, p_post, p_post_prev, phi_interval)?;
         let w = self.config.window;
         self.ring[self.next] = *dx;
         self.next = (self.next + 1) % w;
@@ -270,12 +296,12 @@ impl<const N: usize, const CAP: usize> AdaptiveQ<N, CAP> {
         let mut raw =
             sum / (w as f64) + p_post - phi_interval * p_post_prev * phi_interval.transpose();
         symmetrise_in_place(&mut raw);
-        let projected = match self.config.projection {
-            QProjection::EigenClip => project_psd(&raw, self.config.min_variance)?,
-            QProjection::Diagonal | QProjection::Structured => {
-                project_diagonal(&raw, &self.floors)?
-            }
-        };
+        let projected = apply_projection(
+            &raw,
+            self.config.projection,
+            self.config.min_variance,
+            &self.floors,
+        )?;
         self.raw = Some(raw);
         self.projected = Some(projected);
         Ok(self.projected.as_ref().map(|p| &p.matrix))

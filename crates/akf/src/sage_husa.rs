@@ -22,8 +22,8 @@ use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 use crate::AkfError;
-use crate::adaptive::{Projected, QProjection, project_diagonal, project_psd};
-use crate::linalg::{check_finite, symmetrise_in_place};
+use crate::adaptive::{Projected, QProjection, apply_projection, check_push_inputs};
+use crate::linalg::symmetrise_in_place;
 
 /// Configuration of [`SageHusaQ`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -110,10 +110,7 @@ impl<const N: usize> SageHusaQ<N> {
         p_post_prev: &SMatrix<f64, N, N>,
         phi_interval: &SMatrix<f64, N, N>,
     ) -> Result<Option<&SMatrix<f64, N, N>>, AkfError> {
-        check_finite("dx", dx)?;
-        check_finite("p_post", p_post)?;
-        check_finite("p_post_prev", p_post_prev)?;
-        check_finite("phi_interval", phi_interval)?;
+        check_push_inputs(dx, p_post, p_post_prev, phi_interval)?;
         let q =
             dx * dx.transpose() + p_post - phi_interval * p_post_prev * phi_interval.transpose();
         let d = self.weight(self.count);
@@ -123,12 +120,12 @@ impl<const N: usize> SageHusaQ<N> {
         };
         symmetrise_in_place(&mut raw);
         self.count += 1;
-        let projected = match self.config.projection {
-            QProjection::EigenClip => project_psd(&raw, self.config.min_variance)?,
-            QProjection::Diagonal | QProjection::Structured => {
-                project_diagonal(&raw, &SVector::repeat(self.config.min_variance))?
-            }
-        };
+        let projected = apply_projection(
+            &raw,
+            self.config.projection,
+            self.config.min_variance,
+            &SVector::repeat(self.config.min_variance),
+        )?;
         self.raw = Some(raw);
         self.projected = Some(projected);
         Ok(self.estimate())
