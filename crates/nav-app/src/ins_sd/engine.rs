@@ -124,9 +124,10 @@ pub(crate) fn online_config(scenario: &Scenario, mode: Mode) -> InsSdFilterConfi
     }
 }
 
-/// The scenario's landmarks as a table (id = index in `[sighting] landmarks`).
-pub(crate) fn landmark_table(scenario: &Scenario) -> Result<LandmarkTable, RunError> {
-    let entries: Vec<LandmarkEntry> = scenario
+/// The scenario's landmarks as table entries (id = index in `[sighting] landmarks`): what the
+/// simulated filter uses and what a log export writes.
+pub(crate) fn landmark_entries(scenario: &Scenario) -> Vec<LandmarkEntry> {
+    scenario
         .sighting
         .landmarks
         .iter()
@@ -137,8 +138,13 @@ pub(crate) fn landmark_table(scenario: &Scenario) -> Result<LandmarkTable, RunEr
             lon_deg: l.lon_deg,
             alt_m: l.alt_m,
         })
-        .collect();
-    LandmarkTable::new(&entries).map_err(|source| RunError::Online { t_s: 0.0, source })
+        .collect()
+}
+
+/// The scenario's landmarks as a table ([`landmark_entries`]).
+pub(crate) fn landmark_table(scenario: &Scenario) -> Result<LandmarkTable, RunError> {
+    LandmarkTable::new(&landmark_entries(scenario))
+        .map_err(|source| RunError::Online { t_s: 0.0, source })
 }
 
 /// Maps the online filter's errors onto the run's error kinds.

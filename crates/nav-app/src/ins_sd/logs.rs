@@ -758,18 +758,7 @@ pub fn export_run(
         buf.flush().map_err(io_err(&dir.join(name)))?;
     }
     let landmarks = LandmarkFile {
-        landmarks: scenario
-            .sighting
-            .landmarks
-            .iter()
-            .enumerate()
-            .map(|(i, l)| LandmarkEntry {
-                id: i as u32,
-                lat_deg: l.lat_deg,
-                lon_deg: l.lon_deg,
-                alt_m: l.alt_m,
-            })
-            .collect(),
+        landmarks: engine::landmark_entries(scenario),
     };
     write_text(
         &dir.join(names::LANDMARKS),
