@@ -51,8 +51,10 @@
 //!
 //! ## Errors
 //!
-//! Out-of-order time stamps, an epoch not at the INS time, unknown landmark ids and NaN/∞
-//! inputs are rejected with a typed [`FilterError`] before anything changes.
+//! Out-of-order time stamps, an epoch not at the INS time, unknown landmark ids, NaN/∞ inputs,
+//! an IMU gap longer than one update interval and an implausible IMU sample (mean specific force
+//! above [`MAX_SPECIFIC_FORCE_MPS2`] or rate above [`MAX_ANGULAR_RATE_RADPS`] — a corrupt record)
+//! are rejected with a typed [`FilterError`] before anything changes.
 //!
 //! ## Example
 //!

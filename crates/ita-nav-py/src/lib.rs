@@ -1,8 +1,11 @@
-//! # ita_nav — the lane tracker from Python
+//! # ita_nav — the lane tracker and the INS/SD filter from Python
 //!
 //! A Python extension module (PyO3, built by maturin) over the library crates, not over the binary:
 //! [`nav_app::LaneTracker`] (directional gradient → Hough + least squares → Kalman information
-//! filter, the lane paper's Fig. 1) on numpy frames.
+//! filter, the lane paper's Fig. 1) on numpy frames, with the lane covariance and, given a camera,
+//! the ego lane in metres; and (module `ins`) the online INS/SD filter `InsSdFilter`
+//! (`ins-sd-filter`), `export_run`, `run_flight` and `monte_carlo` (the same runs and statistics,
+//! `nav_app::ins_sd::stats`, as `cargo xtask monte-carlo`).
 //!
 //! ```python
 //! import numpy as np, ita_nav

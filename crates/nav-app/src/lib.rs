@@ -1,7 +1,8 @@
 //! # nav-app — the lane tracker of Pimentel & Hemerly, and the INS/SD closed loop
 //!
-//! The one crate that composes the others (ARCHITECTURE.md). Two applications live here: the lane
-//! tracker below, and [`ins_sd`], the sighting-device-aided INS of Lustosa, Chagas & Waldmann
+//! The one crate that composes the others (ARCHITECTURE.md), in two halves behind features: the
+//! lane tracker below (`src/lane`, feature `lane`; its modules are re-exported at the crate root),
+//! and [`ins_sd`] (feature `ins`), the sighting-device-aided INS of Lustosa, Chagas & Waldmann
 //! (truth → IMU → strapdown INS → 15-state error KF or adaptive KF with landmark sightings every
 //! 1 s, open loop to 195 s then feedback), which `cargo xtask monte-carlo` runs; its module docs
 //! give the model, the tuning and the measured results.
@@ -112,7 +113,6 @@ pub use lane::tracker::{
 #[cfg(feature = "lane")]
 pub use lane::{birdseye, camera, capture_source, eval, labelled, overlay, sources, synth, y4m};
 
-/// The INS half: the sighting-device-aided INS closed loop, its Monte Carlo runs and the log
-/// replay (feature `ins`, on by default).
+// The INS half (feature `ins`): the closed loop, its runs, statistics and the log replay.
 #[cfg(feature = "ins")]
 pub mod ins_sd;
