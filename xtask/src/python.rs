@@ -35,6 +35,19 @@ fn run_checked(cmd: &mut Command, what: &str) -> Result<()> {
     Ok(())
 }
 
+/// `python -m pip install --quiet --disable-pip-version-check`, to be completed by the caller.
+fn pip_install(python: &Path) -> Command {
+    let mut c = Command::new(python);
+    c.args([
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+    ]);
+    c
+}
+
 /// Make `target/py-venv` with the requirements; returns its python.
 fn ensure_venv(root: &Path) -> Result<PathBuf> {
     let venv = root.join("target/py-venv");
@@ -63,15 +76,7 @@ fn ensure_venv(root: &Path) -> Result<PathBuf> {
         && venv.join("bin/maturin").exists();
     if !have {
         run_checked(
-            Command::new(&python)
-                .args([
-                    "-m",
-                    "pip",
-                    "install",
-                    "--quiet",
-                    "--disable-pip-version-check",
-                ])
-                .args(REQUIREMENTS),
+            pip_install(&python).args(REQUIREMENTS),
             &format!("pip install {}", REQUIREMENTS.join(" ")),
         )?;
     }
@@ -104,16 +109,8 @@ pub fn run(args: PythonArgs) -> Result<()> {
         .find(|p| p.extension().is_some_and(|x| x == "whl"))
         .context("maturin wrote no wheel")?;
     run_checked(
-        Command::new(&python)
-            .args([
-                "-m",
-                "pip",
-                "install",
-                "--quiet",
-                "--disable-pip-version-check",
-                "--force-reinstall",
-                "--no-deps",
-            ])
+        pip_install(&python)
+            .args(["--force-reinstall", "--no-deps"])
             .arg(&wheel),
         &format!("pip install {}", wheel.display()),
     )?;
