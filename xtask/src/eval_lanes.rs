@@ -23,7 +23,7 @@ use nav_app::labelled::{
 use nav_app::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
 
-use crate::fixtures::workspace_root;
+use crate::paths::workspace_root;
 
 /// Arguments of `cargo xtask eval-lanes`.
 #[derive(clap::Args, Debug)]

@@ -3,12 +3,14 @@
 
 use std::fs::File;
 use std::io::BufWriter;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use nav_app::GreyFrame;
 use nav_app::synth::{SCENES, SceneRenderer};
 use nav_app::y4m::{Y4mChroma, Y4mWriter};
+
+use crate::paths::workspace_root;
 
 /// Arguments of `cargo xtask fixtures`.
 #[derive(clap::Args, Debug)]
@@ -25,13 +27,6 @@ pub struct FixturesArgs {
 }
 
 /// The workspace root (xtask's parent directory).
-pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .map(Path::to_owned)
-        .unwrap_or_default()
-}
-
 pub fn run(args: FixturesArgs) -> Result<()> {
     let out = workspace_root().join(&args.out);
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;

@@ -1,13 +1,14 @@
 //! `cargo xtask halves`: nav-app's two halves build alone, and the lane half pulls in nothing of
 //! the INS half, of V4L2 or of the command line (`cargo tree -p nav-app --no-default-features
 //! --features lane` lists none of `ins-errors`, `sighting-model`, `akf`, `ins-sd-filter`, `v4l`,
-//! `clap`).
+//! `clap`, nor the Monte Carlo's `rayon` and `plotters`); the INS half builds alone and with the
+//! Monte Carlo library (`--features monte-carlo`).
 
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 
-use crate::fixtures::workspace_root;
+use crate::paths::workspace_root;
 
 /// Crates the lane half alone must not depend on.
 const NOT_IN_LANE: &[&str] = &[
@@ -17,6 +18,8 @@ const NOT_IN_LANE: &[&str] = &[
     "ins-sd-filter",
     "v4l",
     "clap",
+    "rayon",
+    "plotters",
 ];
 
 /// Run `cargo xtask halves`.
@@ -65,7 +68,8 @@ pub fn run() -> Result<()> {
         NOT_IN_LANE.join(", "),
         tree.lines().count()
     );
-    for half in ["lane", "ins"] {
+    // The INS half alone, and with the Monte Carlo library (rayon, plotters) but no binary.
+    for half in ["lane", "ins", "monte-carlo"] {
         eprintln!("halves: clippy -p nav-app --no-default-features --features {half}");
         let status = Command::new(&cargo)
             .current_dir(&root)

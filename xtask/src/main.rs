@@ -11,6 +11,7 @@ mod eval_lanes;
 mod fixtures;
 mod halves;
 mod monte_carlo;
+mod paths;
 mod python;
 mod regress;
 mod vivid;
@@ -20,8 +21,9 @@ mod vivid;
     name = "cargo xtask",
     about = "Project chores",
     after_help = "With no subcommand this help is printed and nothing runs; `cargo xtask test` is the \
-                  project's one test command, `cargo xtask monte-carlo` its main job (on \
-                  configs/paper.toml when no --config is given).\n\n\
+                  project's one test command, `cargo xtask monte-carlo` its main job (the \
+                  product binary's `nav-app monte-carlo` on configs/paper.toml when no --config \
+                  is given).\n\n\
                   Exit codes: 0 success; 1 a command or a gate step failed (the gate names every \
                   failed step); 2 bad command line."
 )]
@@ -51,7 +53,9 @@ enum Cmd {
     Halves,
     /// Build the `ita_nav` Python wheel into target/py-venv and run its pytest suite.
     Python(python::PythonArgs),
-    /// The paper's Monte Carlo experiment (stand-alone, KF, AKF): summaries, CSV, Figs. 1–6; `merge` combines shards.
+    /// The INS/SD paper's Monte Carlo (stand-alone, KF, AKF) on configs/paper.toml: builds the
+    /// product binary and runs `nav-app monte-carlo …` (arguments passed through; outputs under
+    /// target/monte-carlo/).
     MonteCarlo(monte_carlo::MonteCarloArgs),
 }
 

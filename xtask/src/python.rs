@@ -11,7 +11,7 @@ use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 
-use crate::fixtures::workspace_root;
+use crate::paths::workspace_root;
 
 /// Requirements installed into the venv.
 const REQUIREMENTS: &[&str] = &["maturin>=1.9,<2", "pytest>=7", "numpy>=1.21"];
@@ -126,15 +126,11 @@ pub fn run(args: PythonArgs) -> Result<()> {
         ]),
         "cargo build -p nav-app (the binary the Python results are compared with)",
     )?;
-    let nav_app = crate::vivid::target_dir(&root).join("debug/nav-app");
+    let nav_app = crate::paths::target_dir(&root).join("debug/nav-app");
     run_checked(
         Command::new(&python)
             .current_dir(&root)
             .env("NAV_APP_BIN", &nav_app)
-            .env(
-                "XTASK_BIN",
-                std::env::current_exe().context("cannot locate the xtask binary")?,
-            )
             .args(["-m", "pytest", "-q", "crates/ita-nav-py/tests"])
             .args(&args.pytest_args),
         "pytest crates/ita-nav-py/tests",

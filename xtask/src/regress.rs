@@ -18,7 +18,7 @@ use nav_app::synth::SequenceTruth;
 use nav_app::y4m::Y4mSource;
 use nav_app::{Estimator, TrackerConfig};
 
-use crate::fixtures::workspace_root;
+use crate::paths::workspace_root;
 
 /// Arguments of `cargo xtask regress`.
 #[derive(clap::Args, Debug)]

@@ -43,6 +43,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail, ensure};
 use serde_json::Value;
 
+use crate::paths::{target_dir, workspace_root};
+
 /// Options of `cargo xtask vivid`.
 #[derive(clap::Args, Debug)]
 pub struct VividArgs {
@@ -248,7 +250,7 @@ fn cases() -> Vec<Case> {
 /// Run `cargo xtask vivid`.
 pub fn run(args: VividArgs) -> Result<()> {
     let started = Instant::now();
-    let root = workspace_root()?;
+    let root = workspace_root();
     let work = target_dir(&root).join("vivid");
     std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;
 
@@ -342,20 +344,7 @@ pub fn run(args: VividArgs) -> Result<()> {
     Ok(())
 }
 
-fn workspace_root() -> Result<PathBuf> {
-    let manifest = std::env::var("CARGO_MANIFEST_DIR")
-        .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned());
-    Path::new(&manifest)
-        .parent()
-        .map(Path::to_path_buf)
-        .context("xtask manifest dir has no parent")
-}
-
 /// The cargo target directory (`CARGO_TARGET_DIR` or `<root>/target`).
-pub fn target_dir(root: &Path) -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from)
-}
-
 fn is_root() -> bool {
     Command::new("id")
         .arg("-u")

@@ -3,12 +3,15 @@ simulated flight, and the error cases."""
 
 import csv
 import os
+import pathlib
 import subprocess
 
 import numpy as np
 import pytest
 
 import ita_nav
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 
 
 @pytest.fixture(scope="module")
@@ -114,15 +117,17 @@ def test_a_simulated_flight_is_deterministic_and_the_filter_beats_the_free_ins()
         ita_nav.run_flight(filter="ekf")
 
 
-def test_the_monte_carlo_equals_cargo_xtask_monte_carlo(tmp_path):
-    exe = os.environ.get("XTASK_BIN")
+def test_the_monte_carlo_equals_nav_app_monte_carlo(tmp_path):
+    exe = os.environ.get("NAV_APP_BIN")
     if not exe:
-        pytest.fail("XTASK_BIN is not set (cargo xtask python sets it)")
+        pytest.fail("NAV_APP_BIN is not set (cargo xtask python sets it)")
     out = tmp_path / "mc"
-    subprocess.run([exe, "monte-carlo", "--runs", "3", "--out", str(out)],
+    subprocess.run([exe, "monte-carlo", "--config", str(ROOT / "configs" / "paper.toml"),
+                    "--runs", "3", "--out", str(out)],
                    check=True, capture_output=True, text=True)
     import json
     rust = json.loads((out / "summary.json").read_text())
+    assert rust["schema"] == 1
     py = ita_nav.monte_carlo(runs=3)
     assert py["runs"] == 3 and set(py["modes"]) == {"standalone", "kf", "akf"}
     assert len(py["t_s"]) == len(py["modes"]["kf"]["rms_pos_3d_m"]) and py["t_s"][-1] == 900.0

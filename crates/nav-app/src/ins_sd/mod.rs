@@ -200,6 +200,8 @@ mod config;
 mod engine;
 pub mod logs;
 mod mismatch;
+#[cfg(feature = "monte-carlo")]
+pub mod monte_carlo;
 pub mod stats;
 /// The interval discretisation (moved to `ins-sd-filter`; re-exported for existing users).
 pub use ins_sd_filter::interval;

@@ -285,10 +285,14 @@ pub struct Stats {
     pub format: String,
     /// FNV-1a hash of the scenario (shards must agree).
     pub scenario_fingerprint: String,
-    /// Where the scenario came from (path, or "built-in paper default").
+    /// Where the scenario came from (its file).
     pub scenario_source: String,
     /// `Scenario::assumptions()`.
     pub assumptions: Vec<String>,
+    /// σ of the simulated sighting-device noise, m (`[sighting] noise_var_m2`, square-rooted), for
+    /// the reports; absent in files written before it was recorded.
+    #[serde(default)]
+    pub sd_noise_sigma_m: Option<f64>,
     /// Flight duration, s.
     pub duration_s: f64,
     /// Master seed.

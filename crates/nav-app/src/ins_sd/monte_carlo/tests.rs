@@ -4,32 +4,49 @@
 
 use std::path::PathBuf;
 
-use nav_app::ins_sd::{Mode, RunError, RunOutcome, Sample};
-
 use super::driver::{Plan, simulate as drive};
 use super::report::{self, NEES_DOF, NIS_DOF};
 use super::stats::{self, ModeStats, Moments, Stats, qi};
 use super::*;
+use crate::ins_sd::{Mode, RunError, RunOutcome, Sample};
 
 fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("xtask-mc-{name}-{}", std::process::id()));
+    let d = std::env::temp_dir().join(format!("nav-app-mc-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
 }
 
-fn args(runs: usize, duration: f64, threads: usize, shard: Option<&str>) -> RunArgs {
-    RunArgs {
+fn paper_toml() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/paper.toml")
+}
+
+fn args(runs: u64, duration: f64, threads: usize, shard: Option<&str>) -> RunOptions {
+    RunOptions {
         runs: Some(runs),
-        duration: Some(duration),
+        duration_s: Some(duration),
         threads: Some(threads),
-        shard: shard.map(str::to_string),
+        shard: shard.map(|s| parse_shard(s).unwrap()),
         seed: Some(77),
-        ..RunArgs::default()
+        ..RunOptions::new(paper_toml(), temp_dir("default-out"))
     }
 }
 
-fn stats_of(a: &RunArgs) -> Stats {
-    simulate_stats(&resolve(a).unwrap(), false).unwrap()
+fn stats_of(a: &RunOptions) -> Stats {
+    simulate_stats(&resolve(a).unwrap(), &Silent).unwrap()
+}
+
+/// What `nav-app monte-carlo` does with the options: simulate and write (a shard writes only
+/// stats.json).
+fn simulate(a: &RunOptions) -> Result<(), McError> {
+    let r = resolve(a)?;
+    let st = simulate_stats(&r, &Silent)?;
+    write_outputs(&r.out, &st, !r.sharded)
+}
+
+/// What `nav-app monte-carlo merge` does.
+fn merge(dirs: Vec<PathBuf>, out: PathBuf, allow_partial: bool) -> Result<(), McError> {
+    let merged = merge_dirs(&dirs, allow_partial)?;
+    write_outputs(&out, &merged, true)
 }
 
 fn close(a: f64, b: f64, rel: f64) -> bool {
@@ -67,7 +84,7 @@ fn merge_of_two_shards_equals_one_run() {
             let d = temp_dir(&format!("shard{i}"));
             let mut a = args(5, 12.0, 1, Some(&format!("{i}/2")));
             a.out = Some(d.clone());
-            super::simulate(&a).unwrap();
+            simulate(&a).unwrap();
             assert!(d.join("stats.json").exists());
             assert!(
                 !d.join("summary.md").exists(),
@@ -77,12 +94,7 @@ fn merge_of_two_shards_equals_one_run() {
         })
         .collect();
     let out = temp_dir("merged");
-    merge(&MergeArgs {
-        dirs: dirs.iter().rev().cloned().collect(), // any order
-        out: Some(out.clone()),
-        allow_partial: false,
-    })
-    .unwrap();
+    merge(dirs.iter().rev().cloned().collect(), out.clone(), false).unwrap();
     let merged: Stats =
         serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
     assert_eq!(merged.run_ranges, vec![(0, 2), (2, 5)]);
@@ -117,31 +129,16 @@ fn merge_refuses_overlap_and_reports_missing_runs() {
     let d1 = temp_dir("ov1");
     let mut a = args(4, 5.0, 1, Some("1/2"));
     a.out = Some(d1.clone());
-    super::simulate(&a).unwrap();
-    let e = merge(&MergeArgs {
-        dirs: vec![d1.clone(), d1.clone()],
-        out: Some(temp_dir("ov-out")),
-        allow_partial: false,
-    })
-    .unwrap_err();
+    simulate(&a).unwrap();
+    let e = merge(vec![d1.clone(), d1.clone()], temp_dir("ov-out"), false).unwrap_err();
     assert!(format!("{e:#}").contains("overlap"), "{e:#}");
-    let e = merge(&MergeArgs {
-        dirs: vec![d1.clone()],
-        out: Some(temp_dir("ov-out")),
-        allow_partial: false,
-    })
-    .unwrap_err();
+    let e = merge(vec![d1.clone()], temp_dir("ov-out"), false).unwrap_err();
     assert!(
         format!("{e:#}").contains("missing run indices 2..4"),
         "{e:#}"
     );
     let out = temp_dir("ov-partial");
-    merge(&MergeArgs {
-        dirs: vec![d1.clone()],
-        out: Some(out.clone()),
-        allow_partial: true,
-    })
-    .unwrap();
+    merge(vec![d1.clone()], out.clone(), true).unwrap();
     let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
     assert!(md.contains("**Partial:** 2 of 4 runs"), "{md}");
     // A shard of another seed is refused.
@@ -149,13 +146,8 @@ fn merge_refuses_overlap_and_reports_missing_runs() {
     let mut b = args(4, 5.0, 1, Some("2/2"));
     b.seed = Some(78);
     b.out = Some(d2.clone());
-    super::simulate(&b).unwrap();
-    let e = merge(&MergeArgs {
-        dirs: vec![d1.clone(), d2.clone()],
-        out: Some(temp_dir("ov-out")),
-        allow_partial: false,
-    })
-    .unwrap_err();
+    simulate(&b).unwrap();
+    let e = merge(vec![d1.clone(), d2.clone()], temp_dir("ov-out"), false).unwrap_err();
     assert!(format!("{e:#}").contains("seed"), "{e:#}");
     for d in [d1, d2, out, temp_dir("ov-out")] {
         let _ = std::fs::remove_dir_all(d);
@@ -263,9 +255,8 @@ fn non_finite_runs_are_excluded_and_counted() {
         samples: 11,
         range: (0, 5),
         threads: 2,
-        progress: false,
     };
-    let sim = drive(&plan, stand_in).unwrap();
+    let sim = drive(&plan, stand_in, &Silent).unwrap();
     let kf = &sim.modes[0];
     assert_eq!(kf.runs_used, 3, "runs 0, 1, 4 kept");
     let ex: Vec<(u64, Option<f64>)> = sim
@@ -299,11 +290,12 @@ fn non_finite_runs_are_excluded_and_counted() {
     assert!((report::median_final(&st, "kf") - 201f64.sqrt()).abs() < 1e-12);
     let worst = report::worst_runs(&st, "kf", 1);
     assert_eq!((worst[0].run_index, worst[0].peak_t_s), (4, 10.0));
-    let md = report::summary_md(&st);
+    let md = summary::summary_md(&st);
     assert!(md.contains("2 run(s) excluded"), "{md}");
     assert!(md.contains("kf run 2 at t = 7 s"), "{md}");
     assert!(md.contains("kf run 3 at t = 5 s"), "{md}");
-    let js: serde_json::Value = serde_json::from_str(&report::summary_json(&st).unwrap()).unwrap();
+    let js: serde_json::Value = serde_json::from_str(&summary::summary_json(&st).unwrap()).unwrap();
+    assert_eq!(js["schema"], summary::SUMMARY_SCHEMA);
     assert_eq!(js["kf"]["runs_excluded"], 2);
     assert_eq!(js["kf"]["runs_used"], 3);
     assert_eq!(js["excluded_runs"].as_array().unwrap().len(), 2);
@@ -311,7 +303,7 @@ fn non_finite_runs_are_excluded_and_counted() {
 
 #[test]
 fn bad_arguments_give_clear_errors() {
-    let msg = |r: anyhow::Result<ShardInfo>| format!("{:#}", r.unwrap_err());
+    let msg = |r: Result<ShardInfo, McError>| r.unwrap_err().to_string();
     assert!(msg(parse_shard("3/2")).contains("between 1 and 2"));
     assert!(msg(parse_shard("0/2")).contains("1-based"));
     assert!(msg(parse_shard("2")).contains("expected i/n"));
@@ -321,31 +313,37 @@ fn bad_arguments_give_clear_errors() {
         parse_shard("2/3").unwrap(),
         stats::ShardInfo { index: 2, count: 3 }
     );
-    let err = |a: RunArgs| format!("{:#}", resolve(&a).unwrap_err());
+    assert_eq!(
+        parse_filters("akf, kf,kf").unwrap(),
+        vec![Mode::Kf, Mode::Akf],
+        "report order, no duplicates"
+    );
+    assert!(
+        parse_filters("kf,ukf")
+            .unwrap_err()
+            .to_string()
+            .contains("`ukf` is not one of")
+    );
+    let err = |a: RunOptions| resolve(&a).unwrap_err().to_string();
     assert!(err(args(0, 5.0, 1, None)).contains("--runs 0"));
     assert!(err(args(2, 5.0, 0, None)).contains("--threads 0"));
     assert!(err(args(2, 5.0, 1, Some("3/3"))).contains("more shards than runs"));
     assert!(err(args(2, 5000.0, 1, None)).contains("--duration"));
+    // The scenario is read from its file: a missing file is an error naming it, never a silent
+    // fall-back to a built-in scenario.
+    let missing = temp_dir("nofile").join("paper.toml");
+    let e = resolve(&RunOptions::new(&missing, temp_dir("x"))).unwrap_err();
+    assert!(matches!(e, McError::Io { .. }), "{e:?}");
+    assert!(e.to_string().contains("nofile"), "{e}");
     // An invalid config names the field.
     let dir = temp_dir("badcfg");
     std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(workspace_root().join("configs/paper.toml")).unwrap();
+    let text = std::fs::read_to_string(paper_toml()).unwrap();
     let bad = text.replace("r_var_m2 = 40.0", "r_var_m2 = -1.0");
     assert_ne!(bad, text);
     let path = dir.join("bad.toml");
     std::fs::write(&path, bad).unwrap();
-    let a = RunArgs {
-        config: Some(path),
-        ..RunArgs::default()
-    };
-    assert!(err(a).contains("filter.r_var_m2"));
-    // The command line: merge needs directories.
-    use clap::Parser;
-    assert!(crate::Cli::try_parse_from(["xtask", "monte-carlo", "merge"]).is_err());
-    assert!(
-        crate::Cli::try_parse_from(["xtask", "monte-carlo", "--shard", "1/2", "--runs", "4"])
-            .is_ok()
-    );
+    assert!(err(RunOptions::new(&path, &dir)).contains("filter.r_var_m2"));
     let _ = std::fs::remove_dir_all(dir);
 }
 

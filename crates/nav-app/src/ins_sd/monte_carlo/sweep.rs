@@ -1,4 +1,4 @@
-//! `cargo xtask monte-carlo --sweep KEY=V1,V2,…`: the same runs (same seeds) at each value of
+//! `nav-app monte-carlo --sweep KEY=V1,V2,…`: the same runs (same seeds) at each value of
 //! one scenario key — a dotted `section.key` of the scenario file, or several joined with `+`
 //! that take the same value (e.g. `sighting.noise_var_m2+filter.r_var_m2=10,40,160` keeps the
 //! filter matched). Writes `sweep.md`, `sweep.csv` and `sweep_final_error.{svg,png}` (final
@@ -7,11 +7,18 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result, bail, ensure};
-use nav_app::ins_sd::{Mode, Scenario};
-
 use super::plot::{SweepPoint, sweep_figure};
 use super::scenarios::{Row, evaluate};
+use super::{McError, Progress};
+use crate::ins_sd::{Mode, Scenario};
+
+fn bad(value: &str, reason: String) -> McError {
+    McError::Argument {
+        flag: "--sweep",
+        value: value.to_string(),
+        reason,
+    }
+}
 
 /// A parsed `--sweep` argument.
 #[derive(Clone, Debug, PartialEq)]
@@ -23,14 +30,17 @@ pub struct Sweep {
 }
 
 /// Parses `section.key[+section.key…]=v1,v2,…`.
-pub fn parse_sweep(text: &str) -> Result<Sweep> {
+pub fn parse_sweep(text: &str) -> Result<Sweep, McError> {
     let (k, v) = text
         .split_once('=')
-        .with_context(|| format!("--sweep `{text}`: expected KEY=V1,V2,…"))?;
+        .ok_or_else(|| bad(text, "expected KEY=V1,V2,…".to_string()))?;
     let mut keys = Vec::new();
     for key in k.split('+') {
-        let (sec, name) = key.trim().split_once('.').with_context(|| {
-            format!("--sweep: key `{key}` must be section.key, e.g. filter.akf_window")
+        let (sec, name) = key.trim().split_once('.').ok_or_else(|| {
+            bad(
+                text,
+                format!("key `{key}` must be section.key, e.g. filter.akf_window"),
+            )
         })?;
         keys.push((sec.to_string(), name.to_string()));
     }
@@ -39,39 +49,58 @@ pub fn parse_sweep(text: &str) -> Result<Sweep> {
         .map(|s| s.trim().to_string())
         .filter(|s| !s.is_empty())
         .collect();
-    ensure!(!values.is_empty(), "--sweep `{text}`: no values");
+    if values.is_empty() {
+        return Err(bad(text, "no values".to_string()));
+    }
     Ok(Sweep { keys, values })
 }
 
 /// The scenario with every swept key set to `value` (typed like the key's current value).
-pub fn apply(sc: &Scenario, keys: &[(String, String)], value: &str) -> Result<Scenario> {
-    let text = sc.to_toml_string().context("serialising the scenario")?;
-    let mut doc: toml::Table = text.parse().context("re-reading the scenario")?;
+/// An error in a swept value names the key and the value; one the scenario refuses names its
+/// field.
+pub fn apply(sc: &Scenario, keys: &[(String, String)], value: &str) -> Result<Scenario, McError> {
+    // The scenario's own serialisation cannot fail on a validated scenario; if it ever does, the
+    // error says so rather than panicking.
+    let internal = |what: &str, e: &dyn std::fmt::Display| {
+        bad(value, format!("{what} the scenario failed: {e}"))
+    };
+    let text = sc
+        .to_toml_string()
+        .map_err(|e| internal("serialising", &e))?;
+    let mut doc: toml::Table = text.parse().map_err(|e| internal("re-reading", &e))?;
     for (sec, key) in keys {
         let table = doc
             .entry(sec.clone())
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
         let Some(table) = table.as_table_mut() else {
-            bail!("--sweep: `{sec}` is not a section");
+            return Err(bad(value, format!("`{sec}` is not a section")));
         };
         let new = match table.get(key) {
             Some(toml::Value::Integer(_)) => toml::Value::Integer(
                 value
                     .parse()
-                    .with_context(|| format!("--sweep {sec}.{key}: `{value}` is not an integer"))?,
+                    .map_err(|_| bad(value, format!("{sec}.{key}: `{value}` is not an integer")))?,
             ),
             Some(toml::Value::Float(_)) | None => toml::Value::Float(
                 value
                     .parse()
-                    .with_context(|| format!("--sweep {sec}.{key}: `{value}` is not a number"))?,
+                    .map_err(|_| bad(value, format!("{sec}.{key}: `{value}` is not a number")))?,
             ),
             Some(toml::Value::String(_)) => toml::Value::String(value.to_string()),
-            Some(other) => bail!("--sweep {sec}.{key}: cannot sweep a {}", other.type_str()),
+            Some(other) => {
+                return Err(bad(
+                    value,
+                    format!("{sec}.{key}: cannot sweep a {}", other.type_str()),
+                ));
+            }
         };
         table.insert(key.clone(), new);
     }
-    Scenario::from_toml_str(&toml::to_string(&doc).context("writing the swept scenario")?)
-        .with_context(|| format!("--sweep value {value}"))
+    let text = toml::to_string(&doc).map_err(|e| internal("writing", &e))?;
+    Ok(Scenario::from_toml_named(
+        &format!("--sweep value {value}"),
+        &text,
+    )?)
 }
 
 /// Runs the sweep and writes its outputs into `out`; returns the rows.
@@ -82,7 +111,8 @@ pub fn run_sweep(
     runs: u64,
     threads: usize,
     out: &Path,
-) -> Result<Vec<(String, Row)>> {
+    progress: &dyn Progress,
+) -> Result<Vec<(String, Row)>, McError> {
     let label = sweep
         .keys
         .iter()
@@ -90,15 +120,14 @@ pub fn run_sweep(
         .collect::<Vec<_>>()
         .join("+");
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("thread pool")?;
+        .num_threads(super::thread_count(Some(threads))?)
+        .build()?;
     let mut rows = Vec::new();
     for v in &sweep.values {
         let sc = apply(base, &sweep.keys, v)?;
         for &mode in modes {
             let row = pool.install(|| evaluate(v, &sc, mode, runs));
-            eprintln!(
+            progress.note(&format!(
                 "sweep: {label} = {v:<8} {:<14} median {:.1} m (10–90 %: {:.1}–{:.1} m), RMS {:.1} m, lost {}",
                 row.mode,
                 row.final_median_m,
@@ -106,11 +135,14 @@ pub fn run_sweep(
                 row.final_p90_m,
                 row.final_rms_m,
                 row.lost
-            );
+            ));
             rows.push((v.clone(), row));
         }
     }
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    std::fs::create_dir_all(out).map_err(|source| McError::Io {
+        path: out.to_path_buf(),
+        source,
+    })?;
     let mut md = format!(
         "# Sweep of {label} ({runs} runs per point, {} s, same seeds at every point)\n\n| {label} | filter | final 3-D median (m) | 10 % (m) | 90 % (m) | RMS (m) | lost runs | NEES mean (15) | epochs with NEES in 95 % band | NIS per dof |\n|---|---|---|---|---|---|---|---|---|---|\n",
         base.duration_s()
@@ -157,9 +189,9 @@ pub fn run_sweep(
             });
         }
     }
-    let write = |name: &str, bytes: &[u8]| -> Result<()> {
-        let p = out.join(name);
-        std::fs::write(&p, bytes).with_context(|| format!("writing {}", p.display()))
+    let write = |name: &str, bytes: &[u8]| -> Result<(), McError> {
+        let path = out.join(name);
+        std::fs::write(&path, bytes).map_err(|source| McError::Io { path, source })
     };
     write("sweep.md", md.as_bytes())?;
     write("sweep.csv", csv.as_bytes())?;
@@ -168,10 +200,6 @@ pub fn run_sweep(
         write("sweep_final_error.svg", svg.as_bytes())?;
         write("sweep_final_error.png", &png)?;
     }
-    println!(
-        "sweep: wrote {}/sweep.md, sweep.csv, sweep_final_error.svg/png",
-        out.display()
-    );
     Ok(rows)
 }
 
@@ -205,7 +233,16 @@ mod tests {
         let base = Scenario::paper_default().truncated(15.0).unwrap();
         let sw = parse_sweep("filter.akf_window=5,10").unwrap();
         let out = std::env::temp_dir().join(format!("ita-nav-sweep-{}", std::process::id()));
-        let rows = run_sweep(&base, &sw, &[Mode::Kf, Mode::Akf], 2, 1, &out).unwrap();
+        let rows = run_sweep(
+            &base,
+            &sw,
+            &[Mode::Kf, Mode::Akf],
+            2,
+            1,
+            &out,
+            &super::super::Silent,
+        )
+        .unwrap();
         assert_eq!(rows.len(), 4);
         // The KF does not depend on the AKF window: same seeds, same result at both values.
         assert_eq!(rows[0].1.final_median_m, rows[2].1.final_median_m);

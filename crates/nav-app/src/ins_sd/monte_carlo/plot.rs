@@ -3,7 +3,7 @@
 //! and 8 (3-D RMS position error of every configuration), as SVG and PNG, drawn with plotters.
 //!
 //! Text needs a font: plotters' `ab_glyph` feature with DejaVu Sans bundled in
-//! `xtask/assets/` (Bitstream Vera licence, `DejaVuSans-LICENSE.txt` beside it), so the PNGs
+//! `crates/nav-app/assets/` (Bitstream Vera licence, `DejaVuSans-LICENSE.txt` beside it), so the PNGs
 //! and the SVGs carry the same labels and no system font is looked up. PNGs are rendered into
 //! an RGB buffer (plotters' bitmap backend without its own encoder) and encoded with the
 //! workspace's `image` crate.
@@ -11,14 +11,21 @@
 use std::error::Error;
 use std::sync::Once;
 
-use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
+use super::McError;
 use super::stats::{ModeStats, Stats, qi};
 
-static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+fn plot_error(figure: impl Into<String>, message: impl std::fmt::Display) -> McError {
+    McError::Plot {
+        figure: figure.into(),
+        message: message.to_string(),
+    }
+}
+
+static FONT: &[u8] = include_bytes!("../../../assets/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
 const W: u32 = 1000;
@@ -44,11 +51,14 @@ pub fn figure_number(mode: &str, kind: Kind) -> Option<u32> {
     Some(if kind == Kind::Mean { base } else { base + 3 })
 }
 
-fn register_font() -> Result<()> {
+fn register_font() -> Result<(), McError> {
     let mut err = None;
     REGISTER.call_once(|| {
         if plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_err() {
-            err = Some(anyhow!("the bundled DejaVu Sans font could not be parsed"));
+            err = Some(plot_error(
+                "(font)",
+                "the bundled DejaVu Sans font could not be parsed",
+            ));
         }
     });
     err.map_or(Ok(()), Err)
@@ -173,7 +183,7 @@ where
 }
 
 /// One figure as (SVG text, PNG bytes).
-pub fn figure(m: &ModeStats, kind: Kind, runs: u64) -> Result<(String, Vec<u8>)> {
+pub fn figure(m: &ModeStats, kind: Kind, runs: u64) -> Result<(String, Vec<u8>), McError> {
     register_font()?;
     let label = match m.mode.as_str() {
         "standalone" => "Stand-alone INS",
@@ -189,7 +199,7 @@ pub fn figure(m: &ModeStats, kind: Kind, runs: u64) -> Result<(String, Vec<u8>)>
         kind,
         &title,
     )
-    .map_err(|e| anyhow!("SVG figure for {}: {e}", m.mode))?;
+    .map_err(|e| plot_error(format!("SVG figure for {}", m.mode), e))?;
     let mut rgb = vec![0u8; (W * H * 3) as usize];
     draw(
         BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area(),
@@ -197,7 +207,7 @@ pub fn figure(m: &ModeStats, kind: Kind, runs: u64) -> Result<(String, Vec<u8>)>
         kind,
         &title,
     )
-    .map_err(|e| anyhow!("PNG figure for {}: {e}", m.mode))?;
+    .map_err(|e| plot_error(format!("PNG figure for {}", m.mode), e))?;
     Ok((svg, encode_png(rgb)?))
 }
 
@@ -377,27 +387,28 @@ fn render_both(
     what: &str,
     f_svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>, &Stats) -> Result<(), Box<dyn Error>>,
     f_png: impl Fn(DrawingArea<BitMapBackend<'_>, Shift>, &Stats) -> Result<(), Box<dyn Error>>,
-) -> Result<(String, Vec<u8>)> {
+) -> Result<(String, Vec<u8>), McError> {
     let mut svg = String::new();
     f_svg(
         SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area(),
         stats,
     )
-    .map_err(|e| anyhow!("SVG {what}: {e}"))?;
+    .map_err(|e| plot_error(format!("SVG {what}"), e))?;
     let mut rgb = vec![0u8; (W * H * 3) as usize];
     f_png(
         BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area(),
         stats,
     )
-    .map_err(|e| anyhow!("PNG {what}: {e}"))?;
+    .map_err(|e| plot_error(format!("PNG {what}"), e))?;
     Ok((svg, encode_png(rgb)?))
 }
 
-fn encode_png(rgb: Vec<u8>) -> Result<Vec<u8>> {
+fn encode_png(rgb: Vec<u8>) -> Result<Vec<u8>, McError> {
     let img = image::RgbImage::from_raw(W, H, rgb)
-        .ok_or_else(|| anyhow!("PNG buffer has the wrong size"))?;
+        .ok_or_else(|| plot_error("PNG", "the pixel buffer has the wrong size"))?;
     let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| plot_error("PNG", e))?;
     Ok(png)
 }
 
@@ -405,7 +416,7 @@ fn encode_png(rgb: Vec<u8>) -> Result<Vec<u8>> {
 // The closures passed to `render_both` are needed: the generic fn items are not general enough
 // over the backends' lifetime (higher-ranked bound), which clippy's suggestion ignores.
 #[allow(clippy::redundant_closure)]
-pub fn figures(stats: &Stats) -> Result<Vec<(String, Vec<u8>)>> {
+pub fn figures(stats: &Stats) -> Result<Vec<(String, Vec<u8>)>, McError> {
     let mut out = Vec::new();
     for m in &stats.modes {
         for kind in [Kind::Mean, Kind::Sigma] {
@@ -537,7 +548,11 @@ where
 }
 
 /// The sweep figure as (SVG text, PNG bytes).
-pub fn sweep_figure(key: &str, runs: u64, pts: &[SweepPoint]) -> Result<(String, Vec<u8>)> {
+pub fn sweep_figure(
+    key: &str,
+    runs: u64,
+    pts: &[SweepPoint],
+) -> Result<(String, Vec<u8>), McError> {
     register_font()?;
     let mut svg = String::new();
     draw_sweep(
@@ -546,7 +561,7 @@ pub fn sweep_figure(key: &str, runs: u64, pts: &[SweepPoint]) -> Result<(String,
         runs,
         pts,
     )
-    .map_err(|e| anyhow!("SVG sweep figure: {e}"))?;
+    .map_err(|e| plot_error("SVG sweep figure", e))?;
     let mut rgb = vec![0u8; (W * H * 3) as usize];
     draw_sweep(
         BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area(),
@@ -554,6 +569,6 @@ pub fn sweep_figure(key: &str, runs: u64, pts: &[SweepPoint]) -> Result<(String,
         runs,
         pts,
     )
-    .map_err(|e| anyhow!("PNG sweep figure: {e}"))?;
+    .map_err(|e| plot_error("PNG sweep figure", e))?;
     Ok((svg, encode_png(rgb)?))
 }

@@ -6,15 +6,33 @@
 //! (index, mode) order. The statistics are therefore bit-identical for any thread count, and
 //! memory stays bounded (one block of records) however many runs a shard holds.
 
-use std::io::IsTerminal;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use nav_app::ins_sd::{Mode, RunError, RunOutcome, Sample};
 use rayon::prelude::*;
 
+use super::McError;
 use super::stats::{Exclusion, ModeStats, RunSummary};
+use crate::ins_sd::{Mode, RunError, RunOutcome, Sample};
+
+/// Where the driver reports progress: the binary draws a progress bar, tests and the library
+/// default stay [`Silent`]. Called from the worker threads (`run_done`) and from the folding
+/// thread (`start`, `note`, `finish`).
+pub trait Progress: Sync {
+    /// The simulation starts: `total` runs (all configurations) to do.
+    fn start(&self, _total: u64) {}
+    /// One run finished (successfully or not).
+    fn run_done(&self) {}
+    /// A line for the user: a run excluded, a row of a table.
+    fn note(&self, _line: &str) {}
+    /// The simulation ended.
+    fn finish(&self) {}
+}
+
+/// Reports nothing.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Silent;
+
+impl Progress for Silent {}
 
 /// What to simulate.
 #[derive(Clone, Debug)]
@@ -27,8 +45,6 @@ pub struct Plan {
     pub range: (u64, u64),
     /// Worker threads (≥ 1).
     pub threads: usize,
-    /// Draw a progress bar on stderr if it is a terminal.
-    pub progress: bool,
 }
 
 /// The result of simulating a shard.
@@ -72,38 +88,25 @@ pub fn thread_cpu_s() -> Option<f64> {
     None
 }
 
-pub use nav_app::ins_sd::stats::first_non_finite;
+pub use crate::ins_sd::stats::first_non_finite;
 
 /// Simulates `plan.range` × `plan.modes` with `runner(mode, index, out)` and folds the records.
 ///
 /// Runs that fail ([`RunError::NonFinite`], a sighting or filter failure, …) or return a
 /// non-finite record are excluded from the mode's statistics and listed (index, time, reason);
-/// they are also reported on stderr as they happen. An invalid scenario or a wrong buffer
-/// length aborts the whole simulation (these are not properties of one run).
-pub fn simulate<F>(plan: &Plan, runner: F) -> Result<Simulated>
+/// they are also reported through `progress.note` as they happen. An invalid scenario or a
+/// wrong buffer length aborts the whole simulation ([`McError::RunSetup`]: these are not
+/// properties of one run).
+pub fn simulate<F>(plan: &Plan, runner: F, progress: &dyn Progress) -> Result<Simulated, McError>
 where
     F: Fn(Mode, u64, &mut [Sample]) -> Result<RunOutcome, RunError> + Sync,
 {
-    if plan.threads == 0 {
-        bail!("--threads must be at least 1");
-    }
+    let threads = super::thread_count(Some(plan.threads))?;
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(plan.threads)
-        .build()
-        .context("could not build the rayon thread pool")?;
+        .num_threads(threads)
+        .build()?;
     let (lo, hi) = plan.range;
-    let total_jobs = (hi - lo) * plan.modes.len() as u64;
-    let bar = if plan.progress && std::io::stderr().is_terminal() {
-        let bar = ProgressBar::with_draw_target(Some(total_jobs), ProgressDrawTarget::stderr());
-        if let Ok(style) =
-            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} runs, ETA {eta}")
-        {
-            bar.set_style(style);
-        }
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
+    progress.start((hi - lo) * plan.modes.len() as u64);
 
     let mut modes: Vec<ModeStats> = plan
         .modes
@@ -132,7 +135,7 @@ where
                         (Some(a), Some(b)) => b - a,
                         _ => 0.0,
                     };
-                    bar.inc(1);
+                    progress.run_done();
                     Job {
                         index,
                         mode_slot,
@@ -167,9 +170,12 @@ where
                     }
                 }
                 Err(e @ (RunError::Scenario(_) | RunError::OutputLength { .. })) => {
-                    bar.finish_and_clear();
-                    return Err(anyhow::Error::new(e)
-                        .context(format!("run {} ({mode}) could not start", job.index)));
+                    progress.finish();
+                    return Err(McError::RunSetup {
+                        index: job.index,
+                        mode: plan.modes[job.mode_slot].name(),
+                        source: Box::new(e),
+                    });
                 }
                 Err(e) => {
                     let t = match &e {
@@ -192,13 +198,11 @@ where
                     ));
                 }
                 Some((t_s, reason)) => {
-                    bar.suspend(|| {
-                        eprintln!(
-                            "monte-carlo: run {} ({mode}) excluded{}: {reason}",
-                            job.index,
-                            t_s.map_or(String::new(), |t| format!(" at t = {t} s"))
-                        );
-                    });
+                    progress.note(&format!(
+                        "monte-carlo: run {} ({mode}) excluded{}: {reason}",
+                        job.index,
+                        t_s.map_or(String::new(), |t| format!(" at t = {t} s"))
+                    ));
                     exclusions.push(Exclusion {
                         mode,
                         run_index: job.index,
@@ -210,7 +214,7 @@ where
         }
         block_lo = block_hi;
     }
-    bar.finish_and_clear();
+    progress.finish();
     Ok(Simulated {
         modes,
         exclusions,

@@ -1,66 +1,5 @@
-//! `nav-app`: the lane tracker at the terminal.
-//!
-//! ```text
-//! nav-app [--input PATH | --device PATH] [--config outdoor|indoor|FILE.toml] [--estimator kif|wrls]
-//!         [--json] [--overlay DIR|FILE.y4m] [--max-frames N] [--loop]
-//!         [--camera robot|highway|FILE.toml [--birdseye DIR]]
-//!         [--input-name NAME | --input-index N] [--std ntsc|pal|…] [--size WxH] [--max-timeouts N]
-//! ```
-//! With neither `--input` nor `--device` it runs on the bundled 30-frame sample (real highway
-//! video, udacity/CarND-LaneLines-P1, MIT). `--input -` reads a YUV4MPEG2 stream on stdin.
-//!
-//! ## Live capture (`--device`, feature `capture`)
-//! `--device /dev/video0 --input-name S-Video --std ntsc --size 320x240` streams grey frames from
-//! a V4L2 capture node (the paper's BT848/878 card under `bttv`, or vivid) through
-//! `nav_app::capture_source`. The driver's size and format are used; ERROR-flagged buffers are
-//! dropped and counted, dropped frames counted from sequence gaps, signal loss flagged per frame.
-//! On stderr: frames/s, errored and dropped frames, timeouts and signal loss at the end (and
-//! signal-loss changes as they happen). With `--json` every frame object also carries
-//! `"capture": {"sequence", "timestamp_us", "format", "width_px", "height_px", "missed",
-//! "signal_lost", "mean_grey"}`, and the last line is always (also after an error)
-//! `{"schema": 1, "summary": {"device": {…}|null, "frames", "errored_dropped", "sequence_gaps", "timeouts",
-//! "restarts", "signal_lost_frames", "controls_set", "elapsed_s", "fps", "tracked_frames",
-//! "lost_frames", "skipped_bytes", "exit", "exit_code", "error"}}` with `exit` one of
-//! `max-frames`, `end`, `device-gone`, `timeout`, `error`.
-//!
-//! A frame timeout (no frame within the timeout, 1000 ms) restarts the stream and is reported;
-//! the `--max-timeouts`-th in a row (default 3) ends the run. Built without the `capture` feature,
-//! `--device` fails saying capture is not in this build.
-//!
-//! ## INS/SD log replay
-//! `nav-app ins --imu imu.csv --sightings sightings.csv --landmarks landmarks.toml --init
-//! initial.toml [--config configs/paper.toml] [--filter kf|akf] [--gate P] --out solution.csv
-//! [--truth truth.csv]` replays logs through the online filter (`ins_sd_filter`); the formats are
-//! in `nav_app::ins_sd::logs`, and `cargo xtask monte-carlo --export-logs DIR` writes a
-//! simulated run in them.
-//!
-//! Hidden test flags (for `cargo xtask vivid`, not in `--help`): `--format FOURCC` (only this
-//! pixel format), `--timeout-ms MS`, `--ctrl NAME=VALUE@FRAME` (set a V4L2 control once FRAME
-//! frames have been delivered; repeatable), `--ctrl-on-timeout NAME=VALUE` (set at the first
-//! timeout; repeatable).
-//!
-//! ## Damaged input and the summary
-//! A frame that cannot be used — an image of a directory that does not decode, a YUV4MPEG2 stream
-//! damaged where a `FRAME` header should be (the reader skips to the next `FRAME` marker, see
-//! `nav_app::y4m::Y4mSource`), a short last frame — is reported on stderr, counted and skipped;
-//! the run goes on. The last stderr line says `N frames tracked, L frames lost (B bytes
-//! skipped)`. With `--json` the last stdout line is always (every input, also after an error)
-//! `{"schema": 1, "summary": {"input": …, "tracked_frames", "lost_frames", "skipped_bytes", "exit",
-//! "exit_code", "error"}}` (with `--device`: `"device"` and the capture counters in place of
-//! `"input"`, as above).
-//!
-//! ## Lanes in metres (`--camera`)
-//! With a camera file (`nav_app::camera`) every `--json` frame object also carries `ego_lane`
-//! (`lateral_offset_m`, `heading_rad`, `curvature_per_m`, `lane_width_m` and each one's
-//! `*_sigma`; `null` unless both lanes are held) and `lane_cov_px` (each lane's 3×3 covariance
-//! of `[a1, a2, a3]`, rows, or `null`); `--birdseye DIR` writes `birdseye_NNNNNN.png`, the
-//! ground seen from above (`nav_app::birdseye`). The camera file must be for the input's frame
-//! size (`image_size_px`).
-//!
-//! ## Exit codes
-//! 0 success; 1 error (bad input, configuration, capture setup or streaming error); 2 bad
-//! command line; 3 capture device gone (`ENODEV`); 4 `--max-timeouts` frame timeouts in a row;
-//! 5 the run finished but frames of the input were lost (`lost_frames > 0`).
+//! `nav-app [--input …]`: the lane tracker over one frame loop (files, directories, YUV4MPEG2
+//! streams, live capture), with the per-frame JSON, overlays and the metric ego lane.
 
 use std::io::{BufWriter, Cursor, Write};
 use std::path::PathBuf;
@@ -86,7 +25,8 @@ use nav_app::{
 use serde::Serialize;
 
 /// The bundled sample: first 30 frames of udacity's solidWhiteRight, 320×240 grey.
-const SAMPLE_Y4M: &[u8] = include_bytes!("../../../fixtures/udacity/solidWhiteRight-first30.y4m");
+const SAMPLE_Y4M: &[u8] =
+    include_bytes!("../../../../../fixtures/udacity/solidWhiteRight-first30.y4m");
 const SAMPLE_NAME: &str = "bundled sample (udacity solidWhiteRight, 30 frames, MIT)";
 
 /// Shown at the end of `--help`.
@@ -103,7 +43,11 @@ Exit codes:
   2  bad command line
   3  capture device gone (ENODEV)
   4  --max-timeouts frame timeouts in a row
-  5  finished, but frames of the input were lost (lost_frames > 0)";
+  5  finished, but frames of the input were lost (lost_frames > 0)
+
+Subcommands (each with its own --help):
+  nav-app ins …          replay IMU and sighting logs through the INS/SD filter
+  nav-app monte-carlo …  the INS/SD paper's Monte Carlo (also `merge` and `scenarios`)";
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum EstimatorArg {
@@ -545,114 +489,8 @@ fn failure_kind(e: &anyhow::Error) -> (u8, &'static str) {
     }
 }
 
-/// `nav-app ins`: replay IMU and sighting logs through the online INS/SD filter.
-#[derive(Parser, Debug)]
-#[command(
-    name = "nav-app ins",
-    about = "Replays IMU and sighting logs through the INS/SD filter (formats: nav_app::ins_sd::logs)",
-    after_help = "All of --imu, --sightings, --landmarks, --init and --out are required (there is no \
-                  bundled flight; `cargo xtask monte-carlo --export-logs DIR` writes one). \
-                  --config defaults to configs/paper.toml.\n\n\
-                  Exit codes: 0 success; 1 error (a malformed log names its file, line and column); \
-                  2 bad command line."
-)]
-struct InsArgs {
-    /// IMU log (CSV: t_s, Δv body m/s, Δθ body rad).
-    #[arg(long, value_name = "FILE")]
-    imu: PathBuf,
-    /// Sightings log (CSV: t_s, landmark_id, w_m, h_m).
-    #[arg(long, value_name = "FILE")]
-    sightings: PathBuf,
-    /// Landmark table (TOML, [[landmarks]] id, lat_deg, lon_deg, alt_m).
-    #[arg(long, value_name = "FILE")]
-    landmarks: PathBuf,
-    /// Initial INS state (TOML: t_s, lat_rad, lon_rad, alt_m, vel_ned_mps, att_quat_wxyz).
-    #[arg(long, value_name = "FILE")]
-    init: PathBuf,
-    /// Scenario file for the filter settings ([filter], [sighting] update_period_s,
-    /// [trajectory] step_s).
-    #[arg(long, value_name = "FILE", default_value = "configs/paper.toml")]
-    config: PathBuf,
-    /// Filter: kf (tuned KF) or akf (Mohamed–Schwarz adaptive KF).
-    #[arg(long, value_name = "kf|akf", default_value = "kf")]
-    filter: String,
-    /// χ² innovation gate probability per sighting (e.g. 0.9999); no gate when absent.
-    #[arg(long, value_name = "P")]
-    gate: Option<f64>,
-    /// Solution CSV to write.
-    #[arg(long, value_name = "FILE")]
-    out: PathBuf,
-    /// Truth CSV: print the solution's errors against it.
-    #[arg(long, value_name = "FILE")]
-    truth: Option<PathBuf>,
-}
-
-fn run_ins(args: &InsArgs) -> Result<()> {
-    use nav_app::ins_sd::{Mode, Scenario, logs};
-    let text = std::fs::read_to_string(&args.config)
-        .with_context(|| format!("reading {}", args.config.display()))?;
-    let scenario = Scenario::from_toml_str(&text)
-        .with_context(|| format!("scenario {}", args.config.display()))?;
-    let mode = match args.filter.as_str() {
-        "kf" => Mode::Kf,
-        "akf" => Mode::Akf,
-        other => bail!("--filter: `{other}` is not kf or akf"),
-    };
-    let mut config = scenario.online_filter_config(mode);
-    config.gate_probability = args.gate;
-    let inputs = logs::ReplayInputs {
-        imu: args.imu.clone(),
-        sightings: args.sightings.clone(),
-        landmarks: args.landmarks.clone(),
-        initial: args.init.clone(),
-        config,
-    };
-    let file = std::fs::File::create(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
-    let mut out = BufWriter::new(file);
-    let summary = logs::replay(&inputs, &mut out, &args.out)?;
-    eprintln!(
-        "nav-app ins: {} IMU samples, {} sighting epochs, {} sightings used, {} rejected by the gate; wrote {}",
-        summary.imu_samples,
-        summary.epochs,
-        summary.sightings_used,
-        summary.sightings_rejected,
-        args.out.display()
-    );
-    if let Some(truth) = &args.truth {
-        let c = logs::compare_with_truth(truth, &summary.solution)?;
-        if c.matched == 0 {
-            bail!("{}: no truth row at the solution's times", truth.display());
-        }
-        let [n, e, d] = c.last_pos_err_ned_m;
-        let [pn, pe, pd] = c.last_psi_rad;
-        eprintln!(
-            "nav-app ins: against {} ({} epochs): at t = {} s position error N {n:.3} m, E {e:.3} m, D {d:.3} m (3-D {:.3} m), misalignment {:.4} / {:.4} / {:.4} mrad; 3-D RMS {:.3} m, max {:.3} m",
-            truth.display(),
-            c.matched,
-            c.last_t_s,
-            (n * n + e * e + d * d).sqrt(),
-            pn * 1e3,
-            pe * 1e3,
-            pd * 1e3,
-            c.rms_pos_3d_m,
-            c.max_pos_3d_m
-        );
-    }
-    Ok(())
-}
-
-fn main() -> ExitCode {
-    if std::env::args_os().nth(1).is_some_and(|a| a == "ins") {
-        let args = InsArgs::parse_from(std::env::args_os().skip(1));
-        return match run_ins(&args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("nav-app ins: error: {e:#}");
-                ExitCode::from(1)
-            }
-        };
-    }
+/// `nav-app [options]`: track lanes; returns the process exit code.
+pub fn main() -> ExitCode {
     let args = Args::parse();
     let mut monitor = None;
     let mut run_stats = RunStats::default();

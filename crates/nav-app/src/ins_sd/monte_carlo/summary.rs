@@ -1,384 +1,268 @@
-//! From [`Stats`] to the reports: `summary.md`, `summary.json` and the 1 Hz CSV time series.
+//! The two summaries of a Monte Carlo: `summary.json` ([`SummaryJson`], a serde structure with a
+//! `schema` version, for programs) and `summary.md` (for people: the tables, the paper beside
+//! ours, the consistency verdicts and the notes on where we differ).
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use anyhow::Result;
-use serde_json::{Value, json};
+use serde::Serialize;
 
-use super::stats::{ModeStats, Moments, Stats, missing_ranges, qi};
+use super::McError;
+use super::report::{
+    NEES_DOF, NIS_DOF, at, band, consistency, f, final_rms, median_final, paper, report_times,
+    state, throughput, verdict, worst_runs,
+};
+use super::stats::{Exclusion, ModeStats, Moments, RunSummary, Stats, missing_ranges, qi};
 
-/// Degrees of freedom of the NEES (error-state dimension).
-pub const NEES_DOF: usize = 15;
-/// Degrees of freedom of the NIS (three landmarks × (w, h)).
-pub const NIS_DOF: usize = 6;
-/// Confidence of the χ² bands.
-pub const CONFIDENCE: f64 = 0.95;
+/// Version of the `summary.json` layout; raised when a field changes meaning or goes away.
+pub const SUMMARY_SCHEMA: u32 = 1;
 
-/// The paper's reported results at 900 s (Lustosa, Chagas & Waldmann, §6).
-pub struct PaperFigure {
-    /// Mode name.
-    pub mode: &'static str,
-    /// Position error at 900 s, m (None: not given).
+/// `summary.json`. Numbers that are not finite (a configuration with no run kept) are written as
+/// `null`. Each configuration's summary sits at the top level under its name
+/// (`summary["kf"]["final_position_error_m"]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SummaryJson {
+    /// [`SUMMARY_SCHEMA`].
+    pub schema: u32,
+    /// Runs per configuration the Monte Carlo was for.
+    pub runs_total: u64,
+    /// Runs the statistics cover (less than `runs_total` for a partial merge).
+    pub runs_covered: u64,
+    /// Master seed.
+    pub seed: u64,
+    /// Flight duration, s.
+    pub duration_s: f64,
+    /// The scenario file (and the cut, if any).
+    pub scenario_source: String,
+    /// Fingerprint of the scenario (the merge's check that shards agree).
+    pub scenario_fingerprint: String,
+    /// Shards merged (1 for a single run).
+    pub shards: usize,
+    /// Runs excluded (failed or non-finite), every configuration.
+    pub excluded_runs: Vec<Exclusion>,
+    /// 100 Hz INS epochs simulated, every configuration.
+    pub epochs: u64,
+    /// Epochs per second per core (Σ epochs / Σ thread CPU time).
+    pub epochs_per_s_per_core: f64,
+    /// Epochs per second of simulation wall time.
+    pub epochs_per_s_wall: f64,
+    /// Simulation wall time, s (summed over shards).
+    pub wall_s: f64,
+    /// Per configuration, by name (`standalone`, `kf`, `akf`, …).
+    #[serde(flatten)]
+    pub modes: BTreeMap<String, ModeSummary>,
+}
+
+/// One configuration in `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModeSummary {
+    /// Runs kept in the statistics.
+    pub runs_used: u64,
+    /// Runs excluded.
+    pub runs_excluded: usize,
+    /// RMS over runs of the 3-D position error at the final time, m.
+    pub final_position_error_m: f64,
+    /// … of the horizontal error, m.
+    pub final_horizontal_error_m: f64,
+    /// … of the down error, m.
+    pub final_vertical_error_m: f64,
+    /// Mean distance flown, m.
+    pub distance_m: f64,
+    /// Median over runs of the final 3-D error, m.
+    pub final_position_error_median_m: f64,
+    /// The five runs with the largest peak 3-D error.
+    pub worst_runs: Vec<RunSummary>,
+    /// `final_position_error_m` as % of `distance_m`.
+    pub final_error_percent_of_distance: f64,
+    /// At the report times (195, 600, 900 s and the final time), keyed by whole seconds.
+    pub at_time_s: BTreeMap<String, AtTime>,
+    /// NEES (15 dof) against its band; absent for the stand-alone INS.
+    #[serde(flatten, with = "prefix_nees")]
+    pub nees: Option<ChiSquare>,
+    /// NIS (6 dof) against its band; absent for the stand-alone INS.
+    #[serde(flatten, with = "prefix_nis")]
+    pub nis: Option<ChiSquare>,
+    /// The paper's figure for this configuration, if it gives one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub paper: Option<PaperJson>,
+}
+
+/// Statistics at one report time.
+#[derive(Clone, Debug, Serialize)]
+pub struct AtTime {
+    /// Mean over runs of the horizontal error, m.
+    pub horizontal_error_mean_m: f64,
+    /// Its σ over runs, m.
+    pub horizontal_error_sd_m: f64,
+    /// Mean over runs of the down error, m.
+    pub vertical_down_error_mean_m: f64,
+    /// Its σ over runs, m.
+    pub vertical_down_error_sd_m: f64,
+    /// RMS over runs of the 3-D error, m.
+    pub position_error_rms_m: f64,
+    /// Mean misalignment ψ N, E, D, rad.
+    pub misalignment_mean_rad: [f64; 3],
+    /// σ of ψ N, E, D over runs, rad.
+    pub misalignment_sd_rad: [f64; 3],
+    /// Mean distance flown, m.
+    pub distance_m: f64,
+    /// Run-average NEES at this time (null for the stand-alone INS).
+    pub nees_mean: f64,
+    /// Run-average NIS at this time.
+    pub nis_mean: f64,
+}
+
+/// A run-averaged χ² statistic against its two-sided 95 % band (written as `nees_mean`,
+/// `nees_band_95`, `nees_fraction_inside_band`, … and likewise `nis_*`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ChiSquare {
+    /// Mean over runs and epochs.
+    pub mean: f64,
+    /// Band for one epoch's run average, `[lo, hi]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub band_95: Option<[f64; 2]>,
+    /// Fraction of epochs whose run average is inside the band.
+    pub fraction_inside_band: f64,
+    /// … above it (over-confident).
+    pub fraction_above_band: f64,
+    /// … below it (under-confident).
+    pub fraction_below_band: f64,
+}
+
+/// The paper's figure (Lustosa, Chagas & Waldmann, §6).
+#[derive(Clone, Debug, Serialize)]
+pub struct PaperJson {
+    /// Position error at 900 s, m.
     pub error_m: Option<f64>,
-    /// Error as % of distance flown.
-    pub percent: Option<f64>,
+    /// As % of the distance flown.
+    pub percent_of_distance: Option<f64>,
     /// The paper's words.
     pub text: &'static str,
 }
 
-/// What the paper reports, per mode.
-pub const PAPER: [PaperFigure; 3] = [
-    PaperFigure {
-        mode: "standalone",
-        error_m: None,
-        percent: None,
-        text: "diverges, the vertical channel most (Figs. 1, 4)",
-    },
-    PaperFigure {
-        mode: "kf",
-        error_m: Some(100.0),
-        percent: Some(0.34),
-        text: "≈ 0.1 km at 900 s, 0.34 % of distance (Figs. 3, 6)",
-    },
-    PaperFigure {
-        mode: "akf",
-        error_m: Some(140.0),
-        percent: Some(0.47),
-        text: "≈ 0.14 km at 900 s, 0.47 % of distance (Figs. 2, 5)",
-    },
-];
+/// Serialises an optional [`ChiSquare`] flattened with a name prefix (`nees_mean`, …): none of
+/// its keys when absent.
+macro_rules! prefixed {
+    ($module:ident, $prefix:literal) => {
+        mod $module {
+            use serde::ser::{SerializeMap, Serializer};
 
-/// Two-sided 95 % band for the average of `runs` χ²(`dof`) values (exact quantiles, `akf`).
-pub fn band(dof: usize, runs: u64) -> Option<(f64, f64)> {
-    akf::average_band(dof, runs as usize, CONFIDENCE).ok()
-}
-
-/// Time bins (whole seconds) reported in the tables: 195, 600, 900 s where the flight lasts that
-/// long, and always the final time.
-pub fn report_times(duration_s: f64) -> Vec<usize> {
-    let end = duration_s.round() as usize;
-    let mut t: Vec<usize> = [195, 600, 900].into_iter().filter(|&t| t < end).collect();
-    t.push(end);
-    t
-}
-
-/// Consistency of a run-averaged χ² statistic over all epochs that have it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Consistency {
-    /// Mean over all runs and epochs.
-    pub mean: f64,
-    /// Epochs with a value.
-    pub epochs: usize,
-    /// Fraction of epochs whose run average lies inside its 95 % band.
-    pub inside: f64,
-    /// … above the band (filter over-confident: P or S too small).
-    pub above: f64,
-    /// … below the band (filter under-confident: P or S too large).
-    pub below: f64,
-    /// First and last epoch (s) above the band.
-    pub above_span: Option<(f64, f64)>,
-    /// First and last epoch (s) below the band.
-    pub below_span: Option<(f64, f64)>,
-}
-
-/// NEES or NIS consistency of one mode (None for a mode without a filter).
-pub fn consistency(m: &ModeStats, q: usize, dof: usize) -> Option<Consistency> {
-    let mut total = Moments::default();
-    let (mut epochs, mut inside, mut above, mut below) = (0usize, 0usize, 0usize, 0usize);
-    let (mut above_span, mut below_span) = (None, None);
-    let widen = |span: &mut Option<(f64, f64)>, t: f64| {
-        *span = Some(span.map_or((t, t), |(a, _)| (a, t)));
+            pub fn serialize<S: Serializer>(
+                v: &Option<super::ChiSquare>,
+                s: S,
+            ) -> Result<S::Ok, S::Error> {
+                let mut m = s.serialize_map(None)?;
+                if let Some(c) = v {
+                    m.serialize_entry(concat!($prefix, "_mean"), &c.mean)?;
+                    if let Some(b) = c.band_95 {
+                        m.serialize_entry(concat!($prefix, "_band_95"), &b)?;
+                    }
+                    m.serialize_entry(
+                        concat!($prefix, "_fraction_inside_band"),
+                        &c.fraction_inside_band,
+                    )?;
+                    m.serialize_entry(
+                        concat!($prefix, "_fraction_above_band"),
+                        &c.fraction_above_band,
+                    )?;
+                    m.serialize_entry(
+                        concat!($prefix, "_fraction_below_band"),
+                        &c.fraction_below_band,
+                    )?;
+                }
+                m.end()
+            }
+        }
     };
-    for (t, bin) in m.bins.iter().enumerate() {
-        let t = t as f64;
-        let b = bin[q];
-        if b.n == 0 {
-            continue;
-        }
-        total.merge(&b);
-        epochs += 1;
-        let avg = b.mean();
-        match band(dof, b.n) {
-            Some((lo, _)) if avg < lo => {
-                below += 1;
-                widen(&mut below_span, t);
-            }
-            Some((_, hi)) if avg > hi => {
-                above += 1;
-                widen(&mut above_span, t);
-            }
-            _ => inside += 1,
-        }
-    }
-    (epochs > 0).then(|| {
-        let e = epochs as f64;
-        Consistency {
-            mean: total.mean(),
-            epochs,
-            inside: inside as f64 / e,
-            above: above as f64 / e,
-            below: below as f64 / e,
-            above_span,
-            below_span,
-        }
+}
+prefixed!(prefix_nees, "nees");
+prefixed!(prefix_nis, "nis");
+
+fn chi_square(m: &ModeStats, q: usize, dof: usize) -> Option<ChiSquare> {
+    consistency(m, q, dof).map(|c| ChiSquare {
+        mean: c.mean,
+        band_95: band(dof, m.runs_used).map(|(lo, hi)| [lo, hi]),
+        fraction_inside_band: c.inside,
+        fraction_above_band: c.above,
+        fraction_below_band: c.below,
     })
 }
 
-fn at(m: &ModeStats, t: usize) -> &[Moments; super::stats::Q] {
-    &m.bins[t.min(m.bins.len() - 1)]
-}
-
-fn paper(mode: &str) -> Option<&'static PaperFigure> {
-    PAPER.iter().find(|p| p.mode == mode)
-}
-
-/// Final 3-D RMS position error, m.
-fn final_rms(m: &ModeStats) -> f64 {
-    m.bins.last().map_or(f64::NAN, |b| b[qi::POS_3D].rms())
-}
-
-/// Epochs per second per core (Σ epochs / Σ per-run thread CPU time, or Σ per-run wall time
-/// where no CPU clock was available), and aggregate epochs per second of wall time.
-pub fn throughput(stats: &Stats) -> (u64, f64, f64) {
-    let epochs: u64 = stats.modes.iter().map(|m| m.epochs).sum();
-    let cpu: f64 = stats.modes.iter().map(|m| m.run_cpu_s).sum();
-    let run_time: f64 = stats.modes.iter().map(|m| m.run_time_s).sum();
-    let per_core = epochs as f64 / if cpu > 0.0 { cpu } else { run_time.max(1e-12) };
-    let per_wall = epochs as f64 / stats.wall_s.max(1e-12);
-    (epochs, per_core, per_wall)
-}
-
-fn f(x: f64, digits: usize) -> String {
-    if x.is_finite() {
-        format!("{x:.digits$}")
-    } else {
-        "—".to_string()
-    }
-}
-
-fn json_num(x: f64) -> Value {
-    if x.is_finite() { json!(x) } else { Value::Null }
-}
-
-/// `summary.json`.
-pub fn summary_json(stats: &Stats) -> Result<String> {
-    let mut modes = serde_json::Map::new();
-    for m in &stats.modes {
-        let last = m.bins.last().copied().unwrap_or_default();
-        let dist = last[qi::DIST].mean();
-        let mut o = serde_json::Map::new();
-        o.insert("runs_used".into(), json!(m.runs_used));
-        o.insert(
-            "runs_excluded".into(),
-            json!(stats.exclusions.iter().filter(|e| e.mode == m.mode).count()),
-        );
-        o.insert(
-            "final_position_error_m".into(),
-            json_num(last[qi::POS_3D].rms()),
-        );
-        o.insert(
-            "final_horizontal_error_m".into(),
-            json_num(last[qi::POS_H].rms()),
-        );
-        o.insert(
-            "final_vertical_error_m".into(),
-            json_num(last[qi::POS_D].rms()),
-        );
-        o.insert("distance_m".into(), json_num(dist));
-        o.insert(
-            "final_position_error_median_m".into(),
-            json_num(median_final(stats, &m.mode)),
-        );
-        o.insert(
-            "worst_runs".into(),
-            serde_json::to_value(worst_runs(stats, &m.mode, 5))?,
-        );
-        o.insert(
-            "final_error_percent_of_distance".into(),
-            json_num(100.0 * last[qi::POS_3D].rms() / dist),
-        );
-        let mut times = serde_json::Map::new();
-        for t in report_times(stats.duration_s) {
+/// The summary of one configuration.
+pub fn mode_summary(stats: &Stats, m: &ModeStats) -> ModeSummary {
+    let last = m.bins.last().copied().unwrap_or_default();
+    let dist = last[qi::DIST].mean();
+    let at_time_s = report_times(stats.duration_s)
+        .into_iter()
+        .map(|t| {
             let b = at(m, t);
-            times.insert(
+            let three = |q: [usize; 3], g: fn(&Moments) -> f64| q.map(|i| g(&b[i]));
+            (
                 t.to_string(),
-                json!({
-                    "horizontal_error_mean_m": json_num(b[qi::POS_H].mean()),
-                    "horizontal_error_sd_m": json_num(b[qi::POS_H].std_dev()),
-                    "vertical_down_error_mean_m": json_num(b[qi::POS_D].mean()),
-                    "vertical_down_error_sd_m": json_num(b[qi::POS_D].std_dev()),
-                    "position_error_rms_m": json_num(b[qi::POS_3D].rms()),
-                    "misalignment_mean_rad": [json_num(b[qi::PSI_N].mean()), json_num(b[qi::PSI_E].mean()), json_num(b[qi::PSI_D].mean())],
-                    "misalignment_sd_rad": [json_num(b[qi::PSI_N].std_dev()), json_num(b[qi::PSI_E].std_dev()), json_num(b[qi::PSI_D].std_dev())],
-                    "distance_m": json_num(b[qi::DIST].mean()),
-                    "nees_mean": json_num(b[qi::NEES].mean()),
-                    "nis_mean": json_num(b[qi::NIS].mean()),
-                }),
-            );
-        }
-        o.insert("at_time_s".into(), Value::Object(times));
-        for (name, q, dof) in [("nees", qi::NEES, NEES_DOF), ("nis", qi::NIS, NIS_DOF)] {
-            if let Some(c) = consistency(m, q, dof) {
-                o.insert(format!("{name}_mean"), json_num(c.mean));
-                if let Some((lo, hi)) = band(dof, m.runs_used) {
-                    o.insert(format!("{name}_band_95"), json!([lo, hi]));
-                }
-                o.insert(format!("{name}_fraction_inside_band"), json_num(c.inside));
-                o.insert(format!("{name}_fraction_above_band"), json_num(c.above));
-                o.insert(format!("{name}_fraction_below_band"), json_num(c.below));
-            }
-        }
-        if let Some(p) = paper(&m.mode) {
-            o.insert(
-                "paper".into(),
-                json!({"error_m": p.error_m, "percent_of_distance": p.percent, "text": p.text}),
-            );
-        }
-        modes.insert(m.mode.clone(), Value::Object(o));
+                AtTime {
+                    horizontal_error_mean_m: b[qi::POS_H].mean(),
+                    horizontal_error_sd_m: b[qi::POS_H].std_dev(),
+                    vertical_down_error_mean_m: b[qi::POS_D].mean(),
+                    vertical_down_error_sd_m: b[qi::POS_D].std_dev(),
+                    position_error_rms_m: b[qi::POS_3D].rms(),
+                    misalignment_mean_rad: three([qi::PSI_N, qi::PSI_E, qi::PSI_D], Moments::mean),
+                    misalignment_sd_rad: three([qi::PSI_N, qi::PSI_E, qi::PSI_D], Moments::std_dev),
+                    distance_m: b[qi::DIST].mean(),
+                    nees_mean: b[qi::NEES].mean(),
+                    nis_mean: b[qi::NIS].mean(),
+                },
+            )
+        })
+        .collect();
+    ModeSummary {
+        runs_used: m.runs_used,
+        runs_excluded: stats.exclusions.iter().filter(|e| e.mode == m.mode).count(),
+        final_position_error_m: last[qi::POS_3D].rms(),
+        final_horizontal_error_m: last[qi::POS_H].rms(),
+        final_vertical_error_m: last[qi::POS_D].rms(),
+        distance_m: dist,
+        final_position_error_median_m: median_final(stats, &m.mode),
+        worst_runs: worst_runs(stats, &m.mode, 5),
+        final_error_percent_of_distance: 100.0 * last[qi::POS_3D].rms() / dist,
+        at_time_s,
+        nees: chi_square(m, qi::NEES, NEES_DOF),
+        nis: chi_square(m, qi::NIS, NIS_DOF),
+        paper: paper(&m.mode).map(|p| PaperJson {
+            error_m: p.error_m,
+            percent_of_distance: p.percent,
+            text: p.text,
+        }),
     }
+}
+
+/// The whole `summary.json` structure.
+pub fn summary(stats: &Stats) -> SummaryJson {
     let (epochs, per_core, per_wall) = throughput(stats);
-    let doc = json!({
-        "runs_total": stats.runs_total,
-        "runs_covered": stats.runs_covered(),
-        "seed": stats.seed,
-        "duration_s": stats.duration_s,
-        "scenario_source": stats.scenario_source,
-        "scenario_fingerprint": stats.scenario_fingerprint,
-        "shards": stats.shards.len(),
-        "excluded_runs": stats.exclusions,
-        "epochs": epochs,
-        "epochs_per_s_per_core": per_core,
-        "epochs_per_s_wall": per_wall,
-        "wall_s": stats.wall_s,
-    });
-    // Each mode at the top level: `summary["kf"]["final_position_error_m"]`.
-    let mut top = match doc {
-        Value::Object(o) => o,
-        _ => serde_json::Map::new(),
-    };
-    for (k, v) in modes {
-        top.insert(k, v);
-    }
-    Ok(serde_json::to_string_pretty(&Value::Object(top))? + "\n")
-}
-
-/// The 1 Hz CSV time series of one mode.
-pub fn timeseries_csv(m: &ModeStats) -> String {
-    let mut s = String::from("t_s,runs");
-    let cols = [
-        (qi::POS_N, "pos_n_m"),
-        (qi::POS_E, "pos_e_m"),
-        (qi::POS_D, "pos_d_m"),
-        (qi::POS_H, "pos_horizontal_m"),
-        (qi::VEL_N, "vel_n_mps"),
-        (qi::VEL_E, "vel_e_mps"),
-        (qi::VEL_D, "vel_d_mps"),
-        (qi::PSI_N, "psi_n_rad"),
-        (qi::PSI_E, "psi_e_rad"),
-        (qi::PSI_D, "psi_d_rad"),
-    ];
-    for (_, name) in cols {
-        let _ = write!(s, ",{name}_mean,{name}_sd");
-    }
-    s.push_str(",pos_3d_rms_m,distance_m,nees_mean,nees_runs,nees_band_lo,nees_band_hi,nis_mean,nis_runs,nis_band_lo,nis_band_hi\n");
-    let e = |x: f64| {
-        if x.is_finite() {
-            format!("{x:.9e}")
-        } else {
-            String::new()
-        }
-    };
-    for (t, bin) in m.bins.iter().enumerate() {
-        let _ = write!(s, "{t},{}", bin[qi::POS_N].n);
-        for (q, _) in cols {
-            let _ = write!(s, ",{},{}", e(bin[q].mean()), e(bin[q].std_dev()));
-        }
-        let _ = write!(
-            s,
-            ",{},{}",
-            e(bin[qi::POS_3D].rms()),
-            e(bin[qi::DIST].mean())
-        );
-        for (q, dof) in [(qi::NEES, NEES_DOF), (qi::NIS, NIS_DOF)] {
-            let b = bin[q];
-            let (lo, hi) = band(dof, b.n).unwrap_or((f64::NAN, f64::NAN));
-            let _ = write!(s, ",{},{},{},{}", e(b.mean()), b.n, e(lo), e(hi));
-        }
-        s.push('\n');
-    }
-    s
-}
-
-/// One word for a consistency result.
-fn state(c: &Consistency) -> &'static str {
-    if c.inside >= 0.9 {
-        "consistent"
-    } else if c.above >= 0.05 && c.below >= 0.05 {
-        "inconsistent both ways"
-    } else if c.above >= c.below {
-        "over-confident"
-    } else {
-        "under-confident"
+    SummaryJson {
+        schema: SUMMARY_SCHEMA,
+        runs_total: stats.runs_total,
+        runs_covered: stats.runs_covered(),
+        seed: stats.seed,
+        duration_s: stats.duration_s,
+        scenario_source: stats.scenario_source.clone(),
+        scenario_fingerprint: stats.scenario_fingerprint.clone(),
+        shards: stats.shards.len(),
+        excluded_runs: stats.exclusions.clone(),
+        epochs,
+        epochs_per_s_per_core: per_core,
+        epochs_per_s_wall: per_wall,
+        wall_s: stats.wall_s,
+        modes: stats
+            .modes
+            .iter()
+            .map(|m| (m.mode.clone(), mode_summary(stats, m)))
+            .collect(),
     }
 }
 
-/// How a χ² statistic sits against its band, in words.
-fn verdict(c: &Consistency) -> String {
-    let span =
-        |x: Option<(f64, f64)>| x.map_or(String::new(), |(a, b)| format!(" (t = {a:.0}…{b:.0} s)"));
-    let word = match state(c) {
-        "consistent" => "consistent".to_string(),
-        "over-confident" => {
-            "**over-confident** (its covariance is smaller than its actual errors)".to_string()
-        }
-        "under-confident" => {
-            "**under-confident** (its covariance is larger than its actual errors)".to_string()
-        }
-        other => format!(
-            "**{other}**: under-confident at some epochs, over-confident (covariance too small) at others"
-        ),
-    };
-    format!(
-        "run average inside its 95 % band at {:.0} % of the epochs, above at {:.0} %{}, below at {:.0} %{} → {word}",
-        100.0 * c.inside,
-        100.0 * c.above,
-        span(c.above_span),
-        100.0 * c.below,
-        span(c.below_span)
-    )
-}
-
-/// Median of the final 3-D errors of the kept runs of `mode`.
-pub fn median_final(stats: &Stats, mode: &str) -> f64 {
-    let mut v: Vec<f64> = stats
-        .runs
-        .iter()
-        .filter(|r| r.mode == mode)
-        .map(|r| r.final_pos_3d_m)
-        .collect();
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
-/// The `k` kept runs of `mode` with the largest peak 3-D error, largest first.
-pub fn worst_runs(stats: &Stats, mode: &str, k: usize) -> Vec<super::stats::RunSummary> {
-    let mut v: Vec<_> = stats
-        .runs
-        .iter()
-        .filter(|r| r.mode == mode)
-        .cloned()
-        .collect();
-    v.sort_by(|a, b| b.peak_pos_3d_m.total_cmp(&a.peak_pos_3d_m));
-    v.truncate(k);
-    v
+/// `summary.json` as pretty-printed text.
+pub fn summary_json(stats: &Stats) -> Result<String, McError> {
+    Ok(serde_json::to_string_pretty(&summary(stats))? + "\n")
 }
 
 /// `summary.md`.
@@ -682,8 +566,10 @@ fn differences(s: &mut String, stats: &Stats) {
         if ratio < 0.316 {
             let _ = writeln!(
                 s,
-                "Ours is much smaller. Every second the SD gives six image offsets of σ = {} m at the landmark; a filter whose model matches the simulated errors (its NIS says whether it does) averages them down to metres, and with three landmarks always in view the INS errors stay observable. Read this way, the SD noise alone does not account for the paper's figure: its error budget must contain effects its text does not state (landmark geometry and ranges, its tuning of Q and P₀, or a mismatch between its simulation and its filter model). Two of them were tested on 30 seeded runs (`cargo run --release -p nav-app --example paper_h -- 30`, and `-- 30 open-loop`): the paper's printed sighting Jacobian (eqs. 15–18) read literally makes the KF diverge to kilometres, so it is not what the authors ran; the verified H with the INS never corrected (`[filter] open_loop_until_s = 1e9`) gives 96 m, 0.34 % of the distance at 900 s for the KF — the paper's own figure — and 177 m for the AKF (paper 140 m). A filter linearised about an uncorrected, drifting INS (the paper's §7: \"H requires a rather accurate estimate of the UAV position\") is the likely reason for the gap; we keep the feedback the paper describes.",
-                f(40f64.sqrt(), 1)
+                "Ours is much smaller. Every second the SD gives six image offsets{} at the landmark; a filter whose model matches the simulated errors (its NIS says whether it does) averages them down to metres, and with three landmarks always in view the INS errors stay observable. Read this way, the SD noise alone does not account for the paper's figure: its error budget must contain effects its text does not state (landmark geometry and ranges, its tuning of Q and P₀, or a mismatch between its simulation and its filter model). The README (\"Not reproduced with the paper's stated design\") gives the two explanations we tested and what they measured: the paper's printed sighting Jacobian read literally, and the INS never corrected (`[filter] open_loop_until_s`); we keep the feedback the paper describes.",
+                stats
+                    .sd_noise_sigma_m
+                    .map_or(String::new(), |sd| format!(" of σ = {} m", f(sd, 1)))
             );
         } else if ratio > 3.16 {
             let _ = writeln!(
@@ -771,11 +657,11 @@ fn nees_story(s: &mut String, m: &ModeStats) {
     let reading = if m.mode == "akf_sage_husa" {
         "Reading: Sage–Husa averages the single-update estimates Δx Δxᵀ + P⁺ − Φ P⁺₋ Φᵀ with a forgetting factor (memory ≈ 1/(1 − b) updates) instead of a window of 10; the longer memory smooths the indefinite P⁺ − Φ P⁺₋ Φᵀ term, so less of Q̂ is clipped away by the projection. Where NEES and NIS are below their bands it still over-estimates the process noise (same innovation-based estimate)."
     } else if m.mode == "akf_structured" {
-        "Reading: the windowed Mohamed–Schwarz Q̂ projected by non-negative least squares onto the model's four noise inputs (Q = Σ q_k B_k): PSD with the model's correlations, but the raw Q̂ sees the noise only through the innovations (rank ≤ 6 per update), so the fitted densities are not the true ones (a 40 s look: all weight on the gyro white noise and drift random walk)."
+        "Reading: the windowed Mohamed–Schwarz Q̂ projected by non-negative least squares onto the model's four noise inputs (Q = Σ q_k B_k): PSD with the model's correlations, but the raw Q̂ sees the noise only through the innovations (rank ≤ 6 per update), so the fitted densities are not the true ones."
     } else if m.mode == "kf" {
         "Reading: below the band, P₀ and the doubled white-noise Q (config comment: tuned so) keep P larger than the errors; above it late in open loop and just after the switch to feedback at 195 s, the linearisation residue of the INS error grown in open loop (the linear error model degrades as the uncorrected error grows) is not in P; feedback removes it within about a minute. The NIS, which sees only the six measurement directions, stays consistent."
     } else {
-        "Reading: the Mohamed–Schwarz Q̂ (innovation-based, fed back into the gain that produces the innovations) does not converge to the true Q; where NEES and NIS are both below their bands it over-estimates the process noise. With the eigenvalue-clipping projection (floor 0) the loop runs away (measured: 100 runs, seed 2009, worst runs 6–7 km at 790–810 s, azimuth σ 22 mrad at 792 s, run-average NEES up to 10⁴): with N = 10 < 15 states Q̂ is dominated by the indefinite P⁺ − Φ P⁺ Φᵀ, clipping its large negative eigenvalues adds their magnitude back as positive mass in mixed-unit directions, a larger Q̂ gives a larger P and more clipped mass, and in straight flight after 600 s (level/azimuth weakly observable) this feedback ends in a Q̂ explosion (≈ 1.5 km per interval on position at 800 s, run 96); the diagonal projection (the default) stays bounded."
+        "Reading: the Mohamed–Schwarz Q̂ (innovation-based, fed back into the gain that produces the innovations) does not converge to the true Q; where NEES and NIS are both below their bands it over-estimates the process noise. With the eigenvalue-clipping projection (`[filter] akf_projection = \"eigen_clip\"`) the loop can run away (the README gives the measured runs): with N = 10 < 15 states Q̂ is dominated by the indefinite P⁺ − Φ P⁺ Φᵀ, clipping its large negative eigenvalues adds their magnitude back as positive mass in mixed-unit directions, a larger Q̂ gives a larger P and more clipped mass, and in straight flight after 600 s (level/azimuth weakly observable) this feedback can end in a Q̂ explosion; the diagonal projection (the default) stays bounded."
     };
     let _ = writeln!(s, "  {reading}");
 }

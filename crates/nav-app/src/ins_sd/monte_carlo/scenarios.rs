@@ -1,4 +1,4 @@
-//! `cargo xtask monte-carlo scenarios`: the matched case (`configs/paper.toml`) and every
+//! `nav-app monte-carlo scenarios`: the matched case (`configs/paper.toml`) and every
 //! model-mismatch scenario of `configs/mismatch/`, KF and AKF on the same seeds, in one table:
 //! final errors, lost runs, NEES/NIS, the fraction of epochs whose run-average NEES lies in the
 //! per-epoch 95 % band, and the sightings used and rejected by the gate.
@@ -6,29 +6,26 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
-use clap::Args;
-use nav_app::ins_sd::{self, Mode, Sample, Scenario};
 use rayon::prelude::*;
 
+use super::{McError, Progress, load_scenario};
+use crate::ins_sd::{self, Mode, Sample, Scenario};
+
 /// Options of `scenarios`.
-#[derive(Args, Debug, Clone)]
-pub struct ScenariosArgs {
-    /// Directory of mismatch scenario files [default: configs/mismatch].
-    #[arg(long)]
-    pub dir: Option<PathBuf>,
-    /// Runs per scenario and filter [default: 100].
-    #[arg(long, default_value_t = 100)]
+#[derive(Debug, Clone)]
+pub struct ScenarioOptions {
+    /// Directory of mismatch scenario files (`configs/mismatch`); every `*.toml` in it is a row.
+    pub dir: PathBuf,
+    /// The matched scenario, the first row (`configs/paper.toml`).
+    pub matched: PathBuf,
+    /// Runs per scenario and filter.
     pub runs: u64,
-    /// Output directory [default: target/monte-carlo/scenarios-runs<N>].
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Worker threads [default: all cores].
-    #[arg(long)]
+    /// Output directory (gets `comparison.md`).
+    pub out: PathBuf,
+    /// Worker threads [None: all cores].
     pub threads: Option<usize>,
-    /// Cut every flight to its first SECONDS (tests).
-    #[arg(long, value_name = "SECONDS")]
-    pub duration: Option<f64>,
+    /// Cut every flight to its first seconds [None: whole flights].
+    pub duration_s: Option<f64>,
 }
 
 /// One (scenario, filter) row.
@@ -185,17 +182,6 @@ pub fn lost_text(r: &Row) -> String {
     }
 }
 
-fn load(path: &Path, duration: Option<f64>) -> Result<Scenario> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let sc =
-        Scenario::from_toml_str(&text).with_context(|| format!("scenario {}", path.display()))?;
-    match duration {
-        Some(d) => sc.truncated(d).with_context(|| format!("--duration {d}")),
-        None => Ok(sc),
-    }
-}
-
 /// The comparison table as Markdown.
 pub fn table(rows: &[Row], runs: u64, duration_s: f64) -> String {
     let mut s = String::new();
@@ -231,61 +217,49 @@ pub fn table(rows: &[Row], runs: u64, duration_s: f64) -> String {
     s
 }
 
-/// Runs the matched case and every scenario in `dir`, writes `comparison.md`; returns the rows.
-pub fn run(args: &ScenariosArgs, root: &Path, target: &Path) -> Result<Vec<Row>> {
-    let dir = args
-        .dir
-        .clone()
-        .unwrap_or_else(|| root.join("configs/mismatch"));
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .with_context(|| format!("reading {}", dir.display()))?
+/// Runs the matched case and every scenario in `opts.dir`, writes `comparison.md` into
+/// `opts.out`; returns the rows and the path written. Each row is also given to
+/// `progress.note` as it is done.
+pub fn run(
+    opts: &ScenarioOptions,
+    progress: &dyn Progress,
+) -> Result<(Vec<Row>, PathBuf), McError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| McError::Io { path, source }
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&opts.dir)
+        .map_err(io(&opts.dir))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .collect();
     files.sort();
-    let mut list = vec![("matched".to_string(), root.join("configs/paper.toml"))];
+    let mut list = vec![("matched".to_string(), opts.matched.clone())];
     for f in files {
         let name = f
             .file_stem()
             .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
         list.push((name, f));
     }
-    let threads = args.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("thread pool")?;
+        .num_threads(super::thread_count(opts.threads)?)
+        .build()?;
     let mut rows = Vec::new();
     let mut duration_s = 0.0;
-    let start = std::time::Instant::now();
     for (name, path) in &list {
-        let sc = load(path, args.duration)?;
+        let sc = load_scenario(path, opts.duration_s)?;
         duration_s = sc.duration_s();
         for mode in [Mode::Kf, Mode::Akf] {
-            let row = pool.install(|| evaluate(name, &sc, mode, args.runs));
-            eprintln!(
+            let row = pool.install(|| evaluate(name, &sc, mode, opts.runs));
+            progress.note(&format!(
                 "scenarios: {name:<20} {:<4} final 3-D RMS {:.1} m, lost {}, NEES {:.1}, rejected/run {:.1}",
                 row.mode, row.final_rms_m, row.lost, row.nees_mean, row.rejected_per_run
-            );
+            ));
             rows.push(row);
         }
     }
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| target.join(format!("monte-carlo/scenarios-runs{}", args.runs)));
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    let path = out.join("comparison.md");
-    std::fs::write(&path, table(&rows, args.runs, duration_s))
-        .with_context(|| format!("writing {}", path.display()))?;
-    println!(
-        "scenarios: wrote {} ({:.1} s)",
-        path.display(),
-        start.elapsed().as_secs_f64()
-    );
-    Ok(rows)
+    std::fs::create_dir_all(&opts.out).map_err(io(&opts.out))?;
+    let path = opts.out.join("comparison.md");
+    std::fs::write(&path, table(&rows, opts.runs, duration_s)).map_err(io(&path))?;
+    Ok((rows, path))
 }

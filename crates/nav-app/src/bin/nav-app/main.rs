@@ -1,0 +1,91 @@
+//! `nav-app`: the product binary — the lane tracker at the terminal (`lane.rs`), the INS/SD log
+//! replay (`nav-app ins`, `ins.rs`) and the INS/SD paper's Monte Carlo (`nav-app monte-carlo`,
+//! `monte_carlo.rs`). Each is a thin layer of argument parsing and printing over the library
+//! (`nav_app::lane`, `nav_app::ins_sd`, `nav_app::ins_sd::monte_carlo`).
+//!
+//! ```text
+//! nav-app [--input PATH | --device PATH] [--config outdoor|indoor|FILE.toml] [--estimator kif|wrls]
+//!         [--json] [--overlay DIR|FILE.y4m] [--max-frames N] [--loop]
+//!         [--camera robot|highway|FILE.toml [--birdseye DIR]]
+//!         [--input-name NAME | --input-index N] [--std ntsc|pal|…] [--size WxH] [--max-timeouts N]
+//! ```
+//! With neither `--input` nor `--device` it runs on the bundled 30-frame sample (real highway
+//! video, udacity/CarND-LaneLines-P1, MIT). `--input -` reads a YUV4MPEG2 stream on stdin.
+//!
+//! ## Live capture (`--device`, feature `capture`)
+//! `--device /dev/video0 --input-name S-Video --std ntsc --size 320x240` streams grey frames from
+//! a V4L2 capture node (the paper's BT848/878 card under `bttv`, or vivid) through
+//! `nav_app::capture_source`. The driver's size and format are used; ERROR-flagged buffers are
+//! dropped and counted, dropped frames counted from sequence gaps, signal loss flagged per frame.
+//! On stderr: frames/s, errored and dropped frames, timeouts and signal loss at the end (and
+//! signal-loss changes as they happen). With `--json` every frame object also carries
+//! `"capture": {"sequence", "timestamp_us", "format", "width_px", "height_px", "missed",
+//! "signal_lost", "mean_grey"}`, and the last line is always (also after an error)
+//! `{"schema": 1, "summary": {"device": {…}|null, "frames", "errored_dropped", "sequence_gaps", "timeouts",
+//! "restarts", "signal_lost_frames", "controls_set", "elapsed_s", "fps", "tracked_frames",
+//! "lost_frames", "skipped_bytes", "exit", "exit_code", "error"}}` with `exit` one of
+//! `max-frames`, `end`, `device-gone`, `timeout`, `error`.
+//!
+//! A frame timeout (no frame within the timeout, 1000 ms) restarts the stream and is reported;
+//! the `--max-timeouts`-th in a row (default 3) ends the run. Built without the `capture` feature,
+//! `--device` fails saying capture is not in this build.
+//!
+//! ## INS/SD log replay
+//! `nav-app ins --imu imu.csv --sightings sightings.csv --landmarks landmarks.toml --init
+//! initial.toml [--config configs/paper.toml] [--filter kf|akf] [--gate P] --out solution.csv
+//! [--truth truth.csv]` replays logs through the online filter (`ins_sd_filter`); the formats are
+//! in `nav_app::ins_sd::logs`, and `nav-app monte-carlo --export-logs DIR` writes a
+//! simulated run in them.
+//!
+//! ## The INS/SD Monte Carlo
+//! `nav-app monte-carlo [--config configs/paper.toml] [--runs N] [--seed S] [--out DIR]
+//! [--threads T] [--shard i/n] [--duration S] [--filters LIST] [--sweep KEY=V1,…]
+//! [--export-logs DIR]`, `nav-app monte-carlo merge DIR… [--out DIR] [--allow-partial]` and
+//! `nav-app monte-carlo scenarios [--dir configs/mismatch] [--matched configs/paper.toml]`:
+//! see `nav_app::ins_sd::monte_carlo` (outputs, statistics, shards on a cluster). The scenario
+//! file is required to exist (`configs/paper.toml` in the current directory unless `--config`).
+//!
+//! Hidden test flags (for `cargo xtask vivid`, not in `--help`): `--format FOURCC` (only this
+//! pixel format), `--timeout-ms MS`, `--ctrl NAME=VALUE@FRAME` (set a V4L2 control once FRAME
+//! frames have been delivered; repeatable), `--ctrl-on-timeout NAME=VALUE` (set at the first
+//! timeout; repeatable).
+//!
+//! ## Damaged input and the summary
+//! A frame that cannot be used — an image of a directory that does not decode, a YUV4MPEG2 stream
+//! damaged where a `FRAME` header should be (the reader skips to the next `FRAME` marker, see
+//! `nav_app::y4m::Y4mSource`), a short last frame — is reported on stderr, counted and skipped;
+//! the run goes on. The last stderr line says `N frames tracked, L frames lost (B bytes
+//! skipped)`. With `--json` the last stdout line is always (every input, also after an error)
+//! `{"schema": 1, "summary": {"input": …, "tracked_frames", "lost_frames", "skipped_bytes", "exit",
+//! "exit_code", "error"}}` (with `--device`: `"device"` and the capture counters in place of
+//! `"input"`, as above).
+//!
+//! ## Lanes in metres (`--camera`)
+//! With a camera file (`nav_app::camera`) every `--json` frame object also carries `ego_lane`
+//! (`lateral_offset_m`, `heading_rad`, `curvature_per_m`, `lane_width_m` and each one's
+//! `*_sigma`; `null` unless both lanes are held) and `lane_cov_px` (each lane's 3×3 covariance
+//! of `[a1, a2, a3]`, rows, or `null`); `--birdseye DIR` writes `birdseye_NNNNNN.png`, the
+//! ground seen from above (`nav_app::birdseye`). The camera file must be for the input's frame
+//! size (`image_size_px`).
+//!
+//! ## Exit codes
+//! Of the tracker: 0 success; 1 error (bad input, configuration, capture setup or streaming error); 2 bad
+//! command line; 3 capture device gone (`ENODEV`); 4 `--max-timeouts` frame timeouts in a row;
+//! 5 the run finished but frames of the input were lost (`lost_frames > 0`). Of `ins` and
+//! `monte-carlo`: 0 success, 1 error (named file, line, option or run), 2 bad command line.
+
+use std::process::ExitCode;
+
+mod ins;
+mod lane;
+mod monte_carlo;
+
+fn main() -> ExitCode {
+    // Subcommands are dispatched by hand so that the tracker's flags stay at the top level
+    // (`nav-app --input …`), as the paper's tool and every earlier release had them.
+    match std::env::args_os().nth(1) {
+        Some(a) if a == "ins" => ins::main(std::env::args_os().skip(1)),
+        Some(a) if a == "monte-carlo" => monte_carlo::main(std::env::args_os().skip(1)),
+        _ => lane::main(),
+    }
+}
