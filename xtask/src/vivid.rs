@@ -20,7 +20,7 @@
 //!    --std ntsc --max-frames 60 --json` and prints one JSON object per tracked frame (with its
 //!    `"capture"` device fields) and a last `{"schema": 1, "summary": {…}}` line, plus its hidden test flags
 //!    (`--format --timeout-ms --ctrl NAME=VALUE@FRAME --ctrl-on-timeout NAME=VALUE`) for the
-//!    fault cases; see `crates/nav-app/src/main.rs`.
+//!    fault cases; see `crates/nav-app/src/bin/nav-app/lane.rs`.
 //! 3. Kernel: the package `linux-image-amd64` depends on, fetched with `apt-get download` and
 //!    unpacked with `dpkg -x` (not installed).
 //! 4. Initramfs (newc cpio written here): busybox, `/init`, the modules rc-core, cec, mc,
@@ -94,7 +94,7 @@ const VIVID_PARAMS: &str = "n_devs=1 node_types=0x1 num_inputs=2 input_types=0x9
 /// Common guest arguments: vivid's S-Video input, NTSC, 320×240.
 const BASE: &str = "--device /dev/video0 --input-name S-Video --std ntsc --size 320x240 --json";
 
-/// nav-app's exit codes (see `crates/nav-app/src/main.rs`).
+/// nav-app's exit codes (see `crates/nav-app/src/bin/nav-app/lane.rs`).
 const EXIT_ERROR: i64 = 1;
 const EXIT_DEVICE_GONE: i64 = 3;
 const EXIT_TIMEOUTS: i64 = 4;
