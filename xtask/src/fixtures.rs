@@ -46,7 +46,7 @@ pub fn run(args: FixturesArgs) -> Result<()> {
         )?;
         for i in 0..spec.frames {
             renderer.render(i, &mut frame);
-            writer.write_grey(&frame.data)?;
+            writer.write_grey(frame.data())?;
         }
         writer.finish()?;
         let truth_path = out.join(format!("{}.json", spec.name));

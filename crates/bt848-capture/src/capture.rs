@@ -48,27 +48,7 @@ pub struct CaptureStats {
     pub signal_lost_frames: u64,
 }
 
-/// A grey frame buffer owned by the caller, reused frame after frame.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct GreyFrame {
-    /// Width, pixels.
-    pub width: u32,
-    /// Height, pixels.
-    pub height: u32,
-    /// `width·height` bytes, row-major.
-    pub pixels: Vec<u8>,
-}
-
-impl GreyFrame {
-    /// A black frame of the given size (allocate once, outside the frame loop).
-    pub fn new(width: u32, height: u32) -> Self {
-        Self {
-            width,
-            height,
-            pixels: vec![0; width as usize * height as usize],
-        }
-    }
-}
+pub use grey_frame::GreyFrame;
 
 /// One mmap'd driver buffer.
 struct Mapping {
@@ -435,15 +415,16 @@ impl Capture {
     /// # Errors
     /// As [`Capture::next_frame`]; [`CaptureError::OutputSize`] if `frame`'s size differs.
     pub fn next_grey_frame(&mut self, frame: &mut GreyFrame) -> Result<FrameInfo, CaptureError> {
-        if (frame.width, frame.height) != (self.width, self.height) {
+        let (w, h) = (self.width as usize, self.height as usize);
+        if (frame.width(), frame.height()) != (w, h) {
             return Err(CaptureError::OutputSize {
-                expected: self.width as usize * self.height as usize,
-                got: frame.width as usize * frame.height as usize,
+                expected: w * h,
+                got: frame.data().len(),
                 width: self.width,
                 height: self.height,
             });
         }
-        self.next_frame(&mut frame.pixels)
+        self.next_frame(frame.data_mut())
     }
 
     /// Counters since open.

@@ -94,7 +94,7 @@
 //!
 //! let cfg = CaptureConfig { input: InputSelect::Name("Composite0".into()), ..Default::default() };
 //! let mut cap = Capture::open("/dev/video0", &cfg)?;
-//! let mut frame = GreyFrame::new(cap.width_px(), cap.height_px());
+//! let mut frame = GreyFrame::new(cap.width_px() as usize, cap.height_px() as usize);
 //! let info = cap.next_grey_frame(&mut frame)?;
 //! println!("seq {} at {} µs, signal lost: {}", info.sequence, info.timestamp_us, info.signal_lost);
 //! # }

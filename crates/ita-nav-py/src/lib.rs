@@ -339,8 +339,8 @@ fn read_frames<'py>(py: Python<'py>, path: &str) -> PyResult<Vec<Bound<'py, nump
     let mut frame = nav_app::GreyFrame::default();
     let mut out = Vec::new();
     while src.next_frame(&mut frame).map_err(nav_err)?.is_some() {
-        let a = numpy::PyArray1::from_slice(py, &frame.data);
-        out.push(a.reshape([frame.height, frame.width])?);
+        let a = numpy::PyArray1::from_slice(py, frame.data());
+        out.push(a.reshape([frame.height(), frame.width()])?);
     }
     Ok(out)
 }

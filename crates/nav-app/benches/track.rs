@@ -50,7 +50,7 @@ fn tracking_frame(c: &mut Criterion) {
     ];
     for (name, frame) in &cases {
         for (est_name, est) in [("kif", Estimator::Kif), ("wrls", Estimator::Wrls)] {
-            let mut tracker = LaneTracker::new(&cfg, est, frame.width, frame.height).unwrap();
+            let mut tracker = LaneTracker::new(&cfg, est, frame.width(), frame.height()).unwrap();
             for _ in 0..5 {
                 tracker.track(frame).unwrap();
             }
@@ -65,7 +65,7 @@ fn tracking_frame(c: &mut Criterion) {
         }
         // An initialisation frame: full-ROI gradient + Hough + LS (both lanes) + refinement.
         let mut tracker =
-            LaneTracker::new(&cfg, Estimator::Kif, frame.width, frame.height).unwrap();
+            LaneTracker::new(&cfg, Estimator::Kif, frame.width(), frame.height()).unwrap();
         group.bench_function(BenchmarkId::new("init_frame", name), |b| {
             b.iter(|| {
                 tracker.reset();
@@ -80,9 +80,9 @@ fn tracking_frame(c: &mut Criterion) {
 /// Hough + LS (two lanes), KIF (two lanes, ≤ 150 points each), WRLS (paper N×N form and fast form).
 fn table1(c: &mut Criterion) {
     let frame = udacity_frame();
-    let (w, h) = (frame.width, frame.height);
+    let (w, h) = (frame.width(), frame.height());
     let cfg = TrackerConfig::outdoor().unwrap();
-    let image = GreyImage::new(&frame.data, w, h, w).unwrap();
+    let image = GreyImage::new(frame.data(), w, h, w).unwrap();
     let det = GradientDetector::new(GradientParams {
         min_edge_angle_deg: cfg.gradient.min_edge_angle_deg,
         max_edge_angle_deg: cfg.gradient.max_edge_angle_deg,

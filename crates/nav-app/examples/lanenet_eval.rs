@@ -36,7 +36,7 @@ fn main() {
         decode_image_file(&dir.join("image").join(&name), &mut frame).unwrap();
         decode_image_file(&dir.join("gt_instance_image").join(&name), &mut label).unwrap();
         let mut tracker =
-            LaneTracker::new(&cfg, Estimator::Kif, frame.width, frame.height).unwrap();
+            LaneTracker::new(&cfg, Estimator::Kif, frame.width(), frame.height()).unwrap();
         let report = tracker.track(&frame).unwrap();
         let top = tracker.roi_rows().0.div_ceil(10) * 10;
         let s = score_against_instance_label(&report, &label, top.max(160), 10);

@@ -59,6 +59,17 @@ pub enum NavError {
         /// Declared height, px.
         height: usize,
     },
+    /// A frame buffer could not take the size a source asked for (its `width × height` overflows,
+    /// or a buffer of the wrong length).
+    #[error("{name}: {source}")]
+    #[cfg(feature = "lane")]
+    FrameBuffer {
+        /// File, stream or device concerned.
+        name: String,
+        /// What the frame type refused.
+        #[source]
+        source: grey_frame::FrameError,
+    },
     /// A YUV4MPEG2 stream header is malformed.
     #[error("{name}: bad YUV4MPEG2 header: {reason}")]
     Y4mHeader {

@@ -114,9 +114,9 @@ proptest! {
         for _ in 0..=files.len() {
             match src.next_frame(&mut frame) {
                 Ok(Some(m)) => {
-                    prop_assert_eq!(frame.data.len(), frame.width * frame.height);
+                    prop_assert_eq!(frame.data().len(), frame.width() * frame.height());
                     prop_assert!((m.t_s - m.index as f64 / 25.0).abs() < 1e-12);
-                    got.push((m.index, frame.data.clone()));
+                    got.push((m.index, frame.data().to_vec()));
                 }
                 Ok(None) => break,
                 Err(e) => {
@@ -162,8 +162,8 @@ proptest! {
         let mut frame = GreyFrame::default();
         match decode_image_bytes("img.pgm", &bytes, &mut frame) {
             Ok(()) => {
-                prop_assert!(frame.width > 0 && frame.height > 0);
-                prop_assert_eq!(frame.data.len(), frame.width * frame.height);
+                prop_assert!(frame.width() > 0 && frame.height() > 0);
+                prop_assert_eq!(frame.data().len(), frame.width() * frame.height());
             }
             Err(e) => {
                 prop_assert!(
@@ -196,7 +196,7 @@ proptest! {
                 let mut frame = GreyFrame::default();
                 for _ in 0..=bytes.len() + 1 {
                     match src.next_frame(&mut frame) {
-                        Ok(Some(_)) => prop_assert_eq!(frame.data.len(), frame.width * frame.height),
+                        Ok(Some(_)) => prop_assert_eq!(frame.data().len(), frame.width() * frame.height()),
                         Ok(None) => break,
                         Err(e) => {
                             prop_assert!(e.to_string().contains(&name), "{}", e);

@@ -46,18 +46,18 @@ fn drain(bytes: &[u8]) -> Result<Drained, NavError> {
     let mut frame = GreyFrame::default();
     for _ in 0..bytes.len() + 4 {
         let r = src.next_frame(&mut frame);
-        d.max_capacity = d.max_capacity.max(frame.data.capacity());
+        d.max_capacity = d.max_capacity.max(frame.capacity());
         match r {
             Ok(Some(m)) => {
-                assert_eq!(frame.data.len(), frame.width * frame.height);
+                assert_eq!(frame.data().len(), frame.width() * frame.height());
                 assert_eq!(
-                    (frame.width, frame.height),
+                    (frame.width(), frame.height()),
                     (src.header().width, src.header().height)
                 );
                 if let Some((last, _)) = d.frames.last() {
                     assert!(m.index > *last, "indices increase");
                 }
-                d.frames.push((m.index, frame.data.clone()));
+                d.frames.push((m.index, frame.data().to_vec()));
             }
             Ok(None) => {
                 let lost: u64 = d.errors.iter().map(NavError::lost_frames).sum();
@@ -186,7 +186,7 @@ proptest! {
             let m = src.next_frame(&mut frame).unwrap().unwrap();
             prop_assert_eq!(m.index, i as u64);
             prop_assert!((m.t_s - i as f64 / fps_read).abs() < 1e-9);
-            prop_assert_eq!(&frame.data, want);
+            prop_assert_eq!(frame.data(), want);
         }
         prop_assert!(src.next_frame(&mut frame).unwrap().is_none());
         prop_assert_eq!(src.losses(), Default::default());
@@ -320,7 +320,7 @@ proptest! {
                 prop_assert!(src.header().fps.is_finite() && src.header().fps >= 0.0);
                 let mut frame = GreyFrame::default();
                 let _ = src.next_frame(&mut frame);
-                prop_assert!(frame.data.capacity() <= capacity_bound(bytes.len()));
+                prop_assert!(frame.capacity() <= capacity_bound(bytes.len()));
             }
             Err(e) => prop_assert!(
                 matches!(

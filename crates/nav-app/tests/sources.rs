@@ -27,7 +27,7 @@ fn drain(src: &mut dyn FrameSource) -> (Vec<(u64, Vec<u8>)>, Vec<NavError>) {
     let (mut ok, mut bad) = (Vec::new(), Vec::new());
     for _ in 0..100 {
         match src.next_frame(&mut frame) {
-            Ok(Some(m)) => ok.push((m.index, frame.data.clone())),
+            Ok(Some(m)) => ok.push((m.index, frame.data().to_vec())),
             Ok(None) => break,
             Err(e) if !e.is_fatal() => bad.push(e),
             Err(e) => {

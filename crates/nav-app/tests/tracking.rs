@@ -178,11 +178,7 @@ fn a_frame_of_the_wrong_size_is_a_typed_error() {
 fn blank_frames_report_initialising_without_coefficients() {
     let cfg = TrackerConfig::outdoor().unwrap();
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 64, 48).unwrap();
-    let frame = GreyFrame {
-        width: 64,
-        height: 48,
-        data: vec![128; 64 * 48],
-    };
+    let frame = GreyFrame::from_vec(64, 48, vec![128; 64 * 48]).unwrap();
     for _ in 0..3 {
         let r = tracker.track(&frame).unwrap();
         for lane in r.lanes {

@@ -91,7 +91,7 @@ impl BirdseyeView {
     ) {
         rgb.resize(SIZE_PX * SIZE_PX * 3, 0);
         for (px, &s) in rgb.chunks_exact_mut(3).zip(&self.source) {
-            let c = match frame.data.get(s as usize) {
+            let c = match frame.data().get(s as usize) {
                 Some(&g) if s != u32::MAX => [g, g, g],
                 _ => OFF_GROUND_RGB,
             };

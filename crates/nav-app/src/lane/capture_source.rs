@@ -549,15 +549,20 @@ mod device {
     impl FrameSource for CaptureSource {
         fn next_frame(&mut self, frame: &mut GreyFrame) -> Result<Option<FrameMeta>, NavError> {
             self.apply_due_controls()?;
-            frame.reshape(self.cap.width_px() as usize, self.cap.height_px() as usize);
-            match self.cap.next_frame(&mut frame.data) {
+            frame
+                .reshape(self.cap.width_px() as usize, self.cap.height_px() as usize)
+                .map_err(|source| NavError::FrameBuffer {
+                    name: self.device.clone(),
+                    source,
+                })?;
+            match self.cap.next_frame(frame.data_mut()) {
                 Ok(info) => {
                     self.gate.frame();
                     let meta = self
                         .timeline
                         .advance(info.timestamp_us, info.frames_missed_before);
-                    let sum: u64 = frame.data.iter().map(|&p| u64::from(p)).sum();
-                    let mean_grey = sum as f64 / frame.data.len().max(1) as f64;
+                    let sum: u64 = frame.data().iter().map(|&p| u64::from(p)).sum();
+                    let mean_grey = sum as f64 / frame.data().len().max(1) as f64;
                     self.monitor.shared.last.set(Some(DeviceFrameInfo {
                         sequence: info.sequence,
                         timestamp_us: info.timestamp_us,

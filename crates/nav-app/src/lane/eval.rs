@@ -154,8 +154,8 @@ pub fn run_tracker(
             slot => slot.insert(crate::LaneTracker::new(
                 cfg,
                 estimator,
-                frame.width,
-                frame.height,
+                frame.width(),
+                frame.height(),
             )?),
         };
         let report = t.track(&frame)?;
@@ -250,13 +250,13 @@ pub fn score_against_instance_label(
     first_row_px: usize,
     row_step_px: usize,
 ) -> LabelScore {
-    let (w, h) = (label.width, label.height);
+    let (w, h) = (label.width(), label.height());
     let tol = tusimple_tolerance_px(w);
     // Per instance grey level: mean column of its pixels in the lower 40 % of the frame (lanes
     // that end higher up are not ego lanes).
     let mut sums = [(0.0f64, 0u64); 256];
     for y in (h * 3 / 5)..h {
-        for (x, &v) in label.data[y * w..(y + 1) * w].iter().enumerate() {
+        for (x, &v) in label.data()[y * w..(y + 1) * w].iter().enumerate() {
             if v != 0 {
                 sums[usize::from(v)].0 += x as f64;
                 sums[usize::from(v)].1 += 1;
@@ -283,7 +283,7 @@ pub fn score_against_instance_label(
         let Some((level, _)) = ego else { continue };
         let mut y = first_row_px;
         while y < h {
-            let row = &label.data[y * w..(y + 1) * w];
+            let row = &label.data()[y * w..(y + 1) * w];
             let (mut sx, mut n) = (0.0, 0u32);
             for (x, &v) in row.iter().enumerate() {
                 if v == *level {
@@ -425,8 +425,8 @@ mod tests {
         let mut label = crate::GreyFrame::new(w, h);
         for y in 300..h {
             for (x, v) in [(400usize, 10u8), (900, 20), (100, 30)] {
-                label.data[y * w + x] = v;
-                label.data[y * w + x + 1] = v;
+                label.data_mut()[y * w + x] = v;
+                label.data_mut()[y * w + x + 1] = v;
             }
         }
         let lane = |side, a3: f64| LaneReport {

@@ -2,47 +2,11 @@
 
 use crate::NavError;
 
-/// An 8-bit grey frame owned by the caller and refilled by a [`FrameSource`].
-///
-/// `data` holds `width × height` bytes, row-major, no padding (row `y`, column `x` at
-/// `data[y * width + x]`). A source only reallocates `data` when the frame size changes, so a loop
-/// over a stream of constant size does not allocate.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct GreyFrame {
-    /// Width, px (columns).
-    pub width: usize,
-    /// Height, px (rows).
-    pub height: usize,
-    /// Pixels, `width × height` bytes, row-major.
-    pub data: Vec<u8>,
-}
-
-impl GreyFrame {
-    /// An all-black frame of the given size.
-    pub fn new(width: usize, height: usize) -> Self {
-        GreyFrame {
-            width,
-            height,
-            data: vec![0; width * height],
-        }
-    }
-
-    /// Set the size, reusing the buffer (allocates only when it grows).
-    pub fn reshape(&mut self, width: usize, height: usize) {
-        self.width = width;
-        self.height = height;
-        self.data.resize(width * height, 0);
-    }
-
-    /// Pixel at column `col_px`, row `row_px` (`None` outside the frame).
-    pub fn get(&self, col_px: usize, row_px: usize) -> Option<u8> {
-        if col_px < self.width && row_px < self.height {
-            self.data.get(row_px * self.width + col_px).copied()
-        } else {
-            None
-        }
-    }
-}
+/// The workspace's one grey frame (crate `grey-frame`): `width × height` bytes, row-major, its
+/// length checked by every way to change its size. A source refills the caller's frame and
+/// reallocates only when the size changes, so a loop over a stream of constant size does not
+/// allocate.
+pub use grey_frame::{FrameError, GreyFrame};
 
 /// What a source says about the frame it just delivered.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -438,12 +438,15 @@ pub fn track_label_set(
         for f in clip {
             let path = LabelSet::frame_path(dir, f);
             crate::sources::decode_image_file(&path, &mut frame)?;
-            if (frame.width, frame.height) != (set.width, set.height) {
+            if (frame.width(), frame.height()) != (set.width, set.height) {
                 return Err(NavError::Labels {
                     path: path.display().to_string(),
                     reason: format!(
                         "image is {}×{}, the set declares {}×{}",
-                        frame.width, frame.height, set.width, set.height
+                        frame.width(),
+                        frame.height(),
+                        set.width,
+                        set.height
                     ),
                 });
             }

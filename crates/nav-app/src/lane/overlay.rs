@@ -17,9 +17,9 @@ const COAST_RGB: [u8; 3] = [255, 140, 0];
 /// each lane's window borders, its points, and its parabola over the ROI rows (left red, right
 /// blue; orange while coasting).
 pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8>) {
-    let (w, h) = (frame.width, frame.height);
+    let (w, h) = (frame.width(), frame.height());
     rgb.resize(w * h * 3, 0);
-    for (px, &g) in rgb.chunks_exact_mut(3).zip(frame.data.iter()) {
+    for (px, &g) in rgb.chunks_exact_mut(3).zip(frame.data().iter()) {
         px.copy_from_slice(&[g, g, g]);
     }
     let mut put = |x: i64, y: i64, c: [u8; 3]| {

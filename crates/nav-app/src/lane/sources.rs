@@ -46,15 +46,24 @@ pub fn decode_image_bytes(name: &str, bytes: &[u8], frame: &mut GreyFrame) -> Re
             height: h,
         });
     }
-    frame.reshape(w, h);
+    frame
+        .reshape(w, h)
+        .map_err(|source| NavError::FrameBuffer {
+            name: name.to_owned(),
+            source,
+        })?;
     if img.color().has_color() {
         let rgb = img.into_rgb8();
-        for (y, p) in frame.data.iter_mut().zip(rgb.as_raw().chunks_exact(3)) {
+        for (y, p) in frame
+            .data_mut()
+            .iter_mut()
+            .zip(rgb.as_raw().chunks_exact(3))
+        {
             *y = bt848_capture::convert::luma_bt601(p[0], p[1], p[2]);
         }
     } else {
         // Grey (with or without alpha, 8 or 16 bit): its luma as it is.
-        frame.data.copy_from_slice(img.into_luma8().as_raw());
+        frame.data_mut().copy_from_slice(img.into_luma8().as_raw());
     }
     Ok(())
 }
@@ -173,7 +182,7 @@ impl FrameSource for ImageDirectory {
             }
             Err(e) => return Err(bad(e.to_string())),
         }
-        let size = (self.scratch.width, self.scratch.height);
+        let size = (self.scratch.width(), self.scratch.height());
         match self.size {
             None => self.size = Some(size),
             Some(first) if first != size => {

@@ -218,13 +218,17 @@ pub struct SceneRenderer {
     rng: ChaCha8Rng,
 }
 
+/// Largest side of a rendered frame, px: renderers clamp to it, so a frame of their size always
+/// fits (its area cannot overflow).
+pub const MAX_SIDE_PX: usize = 1 << 14;
+
 impl SceneRenderer {
-    /// Renderer for `spec` at `width × height` (≥ 32 × 32).
+    /// Renderer for `spec` at `width × height`, each clamped to 32…[`MAX_SIDE_PX`].
     pub fn new(spec: SceneSpec, width: usize, height: usize) -> Self {
         SceneRenderer {
             spec,
-            width: width.max(32),
-            height: height.max(32),
+            width: width.clamp(32, MAX_SIDE_PX),
+            height: height.clamp(32, MAX_SIDE_PX),
             rng: ChaCha8Rng::seed_from_u64(spec.seed),
         }
     }
@@ -276,7 +280,9 @@ impl SceneRenderer {
     /// Render `frame` into `out` (reshaped to the renderer's size).
     pub fn render(&mut self, frame: u64, out: &mut GreyFrame) {
         let (w, h) = (self.width, self.height);
-        out.reshape(w, h);
+        // Both sides are at most MAX_SIDE_PX (clamped in `new`): the reshape cannot fail.
+        let fits = out.reshape(w, h);
+        debug_assert!(fits.is_ok(), "{w}×{h} within MAX_SIDE_PX");
         let spec = self.spec;
         let truth = self.truth(frame);
         let (_, _, _, yh) = self.geometry(frame);
@@ -285,7 +291,7 @@ impl SceneRenderer {
         let speed_m = 0.8 * frame as f64;
         for y in 0..h {
             let yf = y as f64;
-            let row = &mut out.data[y * w..(y + 1) * w];
+            let row = &mut out.data_mut()[y * w..(y + 1) * w];
             if on_wall {
                 // A painted wall: smooth vertical shading, a door frame of vertical edges.
                 for (x, px) in row.iter_mut().enumerate() {
@@ -379,7 +385,7 @@ impl SceneRenderer {
         if spec.noise_sigma > 0.0
             && let Ok(normal) = Normal::new(0.0, spec.noise_sigma)
         {
-            for px in out.data.iter_mut() {
+            for px in out.data_mut().iter_mut() {
                 let n: f64 = normal.sample(&mut self.rng);
                 *px = (f64::from(*px) + n).round().clamp(0.0, 255.0) as u8;
             }
@@ -423,7 +429,7 @@ mod tests {
                     let (mut sw, mut sx) = (0.0, 0.0);
                     for x in (xt as usize).saturating_sub(8)..((xt as usize) + 9).min(320) {
                         let excess =
-                            (f64::from(frame.data[y * 320 + x]) - spec.ground_grey).max(0.0);
+                            (f64::from(frame.data()[y * 320 + x]) - spec.ground_grey).max(0.0);
                         sw += excess;
                         sx += excess * x as f64;
                     }

@@ -416,7 +416,7 @@ impl LaneTracker {
     /// Process one frame. Errors only for a frame of the wrong size or a component refusing
     /// its (validated) input; a lane that cannot be tracked is reported as such, not as an error.
     pub fn track(&mut self, frame: &GreyFrame) -> Result<TrackReport, NavError> {
-        self.track_pixels(&frame.data, frame.width, frame.height, frame.width)
+        self.track_pixels(frame.data(), frame.width(), frame.height(), frame.width())
     }
 
     /// [`LaneTracker::track`] on borrowed pixels: `width × height` grey pixels, row `y` starting at

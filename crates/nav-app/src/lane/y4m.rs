@@ -432,11 +432,33 @@ impl<R: BufRead> FrameSource for Y4mSource<R> {
         self.next_index += 1;
         let (w, h) = (self.header.width, self.header.height);
         let expected = self.header.frame_bytes();
-        let got = read_plane(&mut self.reader, &mut frame.data, w * h)
-            .map_err(|e| NavError::io(self.name.clone(), e))?;
+        // The plane is read into the frame's own buffer (taken out and put back, so its capacity
+        // is reused); the frame gets its size only when the whole plane is there.
+        let mut buf = std::mem::take(frame).into_vec();
+        let read = read_plane(&mut self.reader, &mut buf, w * h);
+        let got = match read {
+            Ok(got) if got == w * h => {
+                *frame =
+                    GreyFrame::from_vec(w, h, buf).map_err(|source| NavError::FrameBuffer {
+                        name: self.name.clone(),
+                        source,
+                    })?;
+                got
+            }
+            Ok(got) => {
+                // Leave the caller a valid (empty) frame rather than a partial one.
+                buf.clear();
+                *frame = GreyFrame::from_vec(0, 0, buf).unwrap_or_default();
+                got
+            }
+            Err(e) => {
+                buf.clear();
+                *frame = GreyFrame::from_vec(0, 0, buf).unwrap_or_default();
+                return Err(NavError::io(self.name.clone(), e));
+            }
+        };
         let mut total = got;
         if got == w * h {
-            (frame.width, frame.height) = (w, h);
             let chroma = (expected - got) as u64;
             let skipped = io::copy(&mut (&mut self.reader).take(chroma), &mut io::sink())
                 .map_err(|e| NavError::io(self.name.clone(), e))?;
@@ -444,7 +466,12 @@ impl<R: BufRead> FrameSource for Y4mSource<R> {
         }
         if total < expected {
             // Leave the caller a valid (empty) frame rather than a partial one.
-            frame.reshape(0, 0);
+            if got == w * h {
+                let buf = std::mem::take(frame).into_vec();
+                let mut buf = buf;
+                buf.clear();
+                *frame = GreyFrame::from_vec(0, 0, buf).unwrap_or_default();
+            }
             self.finished = true;
             self.losses.frames += 1;
             self.losses.bytes += total as u64;
@@ -619,11 +646,11 @@ mod tests {
         let mut src = Y4mSource::new(&s[..], "t").unwrap();
         let mut frame = GreyFrame::default();
         let m0 = src.next_frame(&mut frame).unwrap().unwrap();
-        assert_eq!((frame.width, frame.height), (4, 3));
-        assert_eq!(frame.data, f0);
+        assert_eq!((frame.width(), frame.height()), (4, 3));
+        assert_eq!(frame.data(), f0);
         assert_eq!(m0.index, 0);
         let m1 = src.next_frame(&mut frame).unwrap().unwrap();
-        assert_eq!(frame.data, f1);
+        assert_eq!(frame.data(), f1);
         assert_eq!(m1.index, 1);
         assert!((m1.t_s - 0.04).abs() < 1e-12);
         assert!(src.next_frame(&mut frame).unwrap().is_none());
@@ -642,10 +669,14 @@ mod tests {
             assert_eq!(src.header().chroma, Y4mChroma::C420, "chroma tag {c:?}");
             let mut frame = GreyFrame::default();
             src.next_frame(&mut frame).unwrap().unwrap();
-            assert_eq!(frame.data, (0..15).collect::<Vec<u8>>(), "chroma tag {c:?}");
+            assert_eq!(
+                frame.data(),
+                (0..15).collect::<Vec<u8>>(),
+                "chroma tag {c:?}"
+            );
             src.next_frame(&mut frame).unwrap().unwrap();
             assert_eq!(
-                frame.data,
+                frame.data(),
                 (50..65).collect::<Vec<u8>>(),
                 "chroma tag {c:?}"
             );
@@ -659,7 +690,7 @@ mod tests {
         let mut src = Y4mSource::new(&s[..], "t").unwrap();
         let mut frame = GreyFrame::default();
         src.next_frame(&mut frame).unwrap().unwrap();
-        assert_eq!(frame.data, vec![1, 2]);
+        assert_eq!(frame.data(), vec![1, 2]);
     }
 
     #[test]
@@ -781,8 +812,8 @@ mod tests {
         for _ in 0..1000 {
             match src.next_frame(&mut frame) {
                 Ok(Some(m)) => {
-                    assert_eq!(frame.data.len(), frame.width * frame.height);
-                    frames.push((m.index, frame.data[0]));
+                    assert_eq!(frame.data().len(), frame.width() * frame.height());
+                    frames.push((m.index, frame.data()[0]));
                 }
                 Ok(None) => return (frames, errors),
                 Err(e) => {
@@ -943,12 +974,11 @@ mod tests {
             matches!(err, NavError::ShortFrame { got: 1000, .. }),
             "{err}"
         );
-        assert!(
-            frame.data.capacity() <= 1 << 21,
-            "{}",
-            frame.data.capacity()
+        assert!(frame.capacity() <= 1 << 21, "{}", frame.capacity());
+        assert_eq!(
+            (frame.width(), frame.height(), frame.data().len()),
+            (0, 0, 0)
         );
-        assert_eq!((frame.width, frame.height, frame.data.len()), (0, 0, 0));
     }
 
     #[test]
@@ -959,7 +989,7 @@ mod tests {
         let mut frame = GreyFrame::default();
         src.next_frame(&mut frame).unwrap().unwrap();
         let m = src.next_frame(&mut frame).unwrap().unwrap();
-        assert_eq!((m.index, frame.data.clone()), (1, vec![3, 4]));
+        assert_eq!((m.index, frame.data()), (1, &[3u8, 4][..]));
 
         let mut changed = stream("YUV4MPEG2 W2 H1 Cmono", &[&[1, 2]]);
         changed.extend(stream("YUV4MPEG2 W3 H1 Cmono", &[&[3, 4, 5]]));
@@ -995,9 +1025,9 @@ mod tests {
             assert!((src.frame_rate_hz().unwrap() - 25.0).abs() < 1e-9);
             let mut frame = GreyFrame::default();
             src.next_frame(&mut frame).unwrap().unwrap();
-            assert_eq!(frame.data, grey);
+            assert_eq!(frame.data(), grey);
             src.next_frame(&mut frame).unwrap().unwrap();
-            assert_eq!(frame.data, grey, "grey RGB → Y is the identity");
+            assert_eq!(frame.data(), grey, "grey RGB → Y is the identity");
             assert!(src.next_frame(&mut frame).unwrap().is_none());
         }
     }

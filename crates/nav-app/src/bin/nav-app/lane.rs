@@ -346,25 +346,25 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         };
         last_index = meta.index;
         let t = match &mut tracker {
-            Some(t) if t.frame_size() == (frame.width, frame.height) => t,
+            Some(t) if t.frame_size() == (frame.width(), frame.height()) => t,
             slot => {
                 if let Some(old) = slot.as_ref() {
                     bail!(
                         "frame {}: size changed from {:?} to {}×{}",
                         meta.index,
                         old.frame_size(),
-                        frame.width,
-                        frame.height
+                        frame.width(),
+                        frame.height()
                     );
                 }
                 if let Some(cam) = &camera {
-                    cam.check_frame_size(frame.width, frame.height)?;
+                    cam.check_frame_size(frame.width(), frame.height())?;
                 }
                 slot.insert(LaneTracker::new(
                     &cfg,
                     estimator,
-                    frame.width,
-                    frame.height,
+                    frame.width(),
+                    frame.height(),
                 )?)
             }
         };
@@ -408,7 +408,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         }
         if let Some(sink) = overlay.as_mut() {
             render_overlay(&frame, t, &mut rgb);
-            sink.write(index, &rgb, frame.width, frame.height)?;
+            sink.write(index, &rgb, frame.width(), frame.height())?;
         }
         if let Some((dir, view, rgb)) = birdseye.as_mut() {
             view.render(&frame, t, &report, ego.flatten(), rgb);

@@ -124,8 +124,8 @@ impl RoadRenderer {
     /// `image_size_px`).
     ///
     /// # Errors
-    /// [`NavError::ConfigField`] if the camera file is invalid or gives a homography instead of
-    /// intrinsics and mounting.
+    /// [`NavError::ConfigField`] if the camera file is invalid, gives a homography instead of
+    /// intrinsics and mounting, or a side over [`super::MAX_SIDE_PX`].
     pub fn new(spec: RoadSpec, camera: &CameraConfig) -> Result<Self, NavError> {
         let model = camera.model()?;
         let Some(cam) = model.camera().copied() else {
@@ -136,6 +136,13 @@ impl RoadRenderer {
             });
         };
         let [width, height] = camera.image_size_px;
+        if width > super::MAX_SIDE_PX || height > super::MAX_SIDE_PX {
+            return Err(NavError::ConfigField {
+                field: "image_size_px",
+                value: format!("[{width}, {height}]"),
+                reason: format!("rendering takes sides up to {} px", super::MAX_SIDE_PX),
+            });
+        }
         Ok(Self {
             spec,
             camera: cam,
@@ -168,7 +175,9 @@ impl RoadRenderer {
     /// Render `frame` into `out` (reshaped to the camera's frame size).
     pub fn render(&mut self, frame: u64, out: &mut GreyFrame) {
         let (w, h) = (self.width, self.height);
-        out.reshape(w, h);
+        // Both sides are at most MAX_SIDE_PX (checked in `new`): the reshape cannot fail.
+        let fits = out.reshape(w, h);
+        debug_assert!(fits.is_ok(), "{w}×{h} within MAX_SIDE_PX");
         let road = ArcRoad {
             geometry: self.truth(frame),
         };
@@ -176,7 +185,7 @@ impl RoadRenderer {
         let half_mark = 0.5 * s.mark_width_m;
         let marks = [-0.5 * s.lane_width_m, 0.5 * s.lane_width_m];
         let Ok(hom) = self.camera.homography() else {
-            out.data.fill(s.wall_grey as u8);
+            out.data_mut().fill(s.wall_grey as u8);
             return;
         };
         for y in 0..h {
@@ -211,14 +220,14 @@ impl RoadRenderer {
                     *a = if sub == 0 { value } else { 0.5 * (*a + value) };
                 }
             }
-            for (px, a) in out.data[y * w..(y + 1) * w].iter_mut().zip(&self.row) {
+            for (px, a) in out.data_mut()[y * w..(y + 1) * w].iter_mut().zip(&self.row) {
                 *px = a.round().clamp(0.0, 255.0) as u8;
             }
         }
         if s.noise_sigma > 0.0
             && let Ok(normal) = Normal::new(0.0, s.noise_sigma)
         {
-            for px in out.data.iter_mut() {
+            for px in out.data_mut().iter_mut() {
                 let n: f64 = normal.sample(&mut self.rng);
                 *px = (f64::from(*px) + n).round().clamp(0.0, 255.0) as u8;
             }
@@ -267,7 +276,7 @@ mod tests {
                     let (mut sw, mut sx) = (0.0, 0.0);
                     for x in (u as usize).saturating_sub(10)..((u as usize) + 11).min(320) {
                         let excess =
-                            (f64::from(frame.data[y * 320 + x]) - spec.ground_grey).max(0.0);
+                            (f64::from(frame.data()[y * 320 + x]) - spec.ground_grey).max(0.0);
                         sw += excess;
                         sx += excess * x as f64;
                     }
