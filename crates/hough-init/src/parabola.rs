@@ -29,7 +29,22 @@ pub struct Parabola {
 }
 
 impl Parabola {
-    /// Column `x(y)` at row `row_px`, pixels.
+    /// From `[a1, a2, a3]` (the order every lane report and filter uses).
+    #[inline]
+    #[must_use]
+    pub const fn from_coeffs([a1, a2, a3]: [f64; 3]) -> Self {
+        Parabola { a1, a2, a3 }
+    }
+
+    /// `[a1, a2, a3]`.
+    #[inline]
+    #[must_use]
+    pub const fn coeffs(&self) -> [f64; 3] {
+        [self.a1, self.a2, self.a3]
+    }
+
+    /// Column `x(y)` at row `row_px`, pixels: the workspace's one evaluation of a lane parabola
+    /// in image pixels.
     #[inline]
     #[must_use]
     pub fn col_at_row(&self, row_px: f64) -> f64 {

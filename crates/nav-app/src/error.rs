@@ -226,14 +226,19 @@ pub enum NavError {
         /// Height received, px.
         got_h: usize,
     },
-    /// A component crate (gradient, Hough, filter) refused its input.
-    #[error("{stage}: {message}")]
-    Stage {
-        /// Which stage: `gradient`, `hough`, `kif`, `wrls`.
-        stage: &'static str,
-        /// The component's error, rendered.
-        message: String,
-    },
+    /// The gradient stage (crate `vision-gradient`) refused its input or parameters.
+    #[error("gradient: {0}")]
+    #[cfg(feature = "lane")]
+    Gradient(#[from] vision_gradient::GradientError),
+    /// The Hough + least-squares initialisation (crate `hough-init`) refused its parameters.
+    #[error("hough: {0}")]
+    #[cfg(feature = "lane")]
+    Hough(#[from] hough_init::HoughError),
+    /// The information filter (crate `info-filter`) refused its set-up (row normalisation,
+    /// process noise).
+    #[error("kif: {0}")]
+    #[cfg(feature = "lane")]
+    Kif(#[from] info_filter::KifError),
     /// Writing an overlay, a fixture or a report failed.
     #[error("{path}: cannot write: {message}")]
     Write {

@@ -332,8 +332,8 @@ pub struct LaneRates {
     pub mean_abs_error_px: f64,
 }
 
-fn eval_parabola([a1, a2, a3]: [f64; 3], y: f64) -> f64 {
-    (a1 * y + a2) * y + a3
+fn eval_parabola(coeffs: [f64; 3], y: f64) -> f64 {
+    hough_init::Parabola::from_coeffs(coeffs).col_at_row(y)
 }
 
 /// Score one frame's ego prediction against its labels under `rules`.

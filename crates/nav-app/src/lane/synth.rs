@@ -39,8 +39,7 @@ pub struct TruthLane {
 impl TruthLane {
     /// Column of the true mark centre at `row_px`.
     pub fn col_at_row(&self, row_px: f64) -> f64 {
-        let [a1, a2, a3] = self.coeffs;
-        (a1 * row_px + a2) * row_px + a3
+        hough_init::Parabola::from_coeffs(self.coeffs).col_at_row(row_px)
     }
 }
 

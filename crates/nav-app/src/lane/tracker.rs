@@ -1,7 +1,7 @@
 //! The tracking loop (paper Fig. 1): directional gradient → Hough + LS initialisation → KIF
 //! (or WRLS) recursion, per lane, with a state machine and sanity gates.
 
-use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, init_lane};
+use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, Parabola, init_lane};
 use info_filter::{ParabolaKif, ProcessNoise, RowNorm, ThetaCov};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
@@ -82,7 +82,7 @@ impl LaneReport {
     /// Column of the reported parabola at `row_px`, if there is one.
     pub fn col_at_row(&self, row_px: f64) -> Option<f64> {
         self.coeffs
-            .map(|[a1, a2, a3]| (a1 * row_px + a2) * row_px + a3)
+            .map(|c| Parabola::from_coeffs(c).col_at_row(row_px))
     }
 }
 
@@ -220,21 +220,8 @@ struct Candidate {
     band: u8,
 }
 
-/// `a1·y² + a2·y + a3`.
-#[inline]
-fn eval_parabola([a1, a2, a3]: [f64; 3], y: f64) -> f64 {
-    (a1 * y + a2) * y + a3
-}
-
 /// Largest window half-width accepted by the configuration, px.
 const MAX_WINDOW_HALF_WIDTH: usize = 200;
-
-fn stage(stage: &'static str, e: impl std::fmt::Display) -> NavError {
-    NavError::Stage {
-        stage,
-        message: e.to_string(),
-    }
-}
 
 impl LaneTracker {
     /// A tracker for `width × height` frames. Validates `cfg`.
@@ -267,8 +254,7 @@ impl LaneTracker {
             min_edge_angle_deg: g.min_edge_angle_deg,
             max_edge_angle_deg: g.max_edge_angle_deg,
             threshold,
-        })
-        .map_err(|e| stage("gradient", e))?;
+        })?;
         let roi = cfg.roi_rows(height);
         let capacity = width * (roi.1 - roi.0);
         let hough = HoughWorkspace::new(
@@ -279,20 +265,19 @@ impl LaneTracker {
                 rho_step_px: cfg.init.rho_step_px,
                 ..HoughParams::default()
             },
-        )
-        .map_err(|e| stage("hough", e))?;
+        )?;
         let init_params = LaneInitParams {
             band_px: cfg.init.band_half_width_px,
             min_points: cfg.init.min_points,
             refit_iterations: cfg.init.refit_iterations,
         };
-        init_params.validate().map_err(|e| stage("hough", e))?;
+        init_params.validate()?;
         let center = (roi.0 + roi.1 - 1) as f64 / 2.0;
         let scale = ((roi.1 - 1 - roi.0) as f64 / 2.0).max(1.0);
-        let row_norm = RowNorm::new(center, scale).map_err(|e| stage("kif", e))?;
+        let row_norm = RowNorm::new(center, scale)?;
         let f = &cfg.filter;
         let q_u = Matrix3::from_diagonal(&Vector3::from(f.q_sigma_px.map(|s| s * s)));
-        let q = ProcessNoise::new(&q_u).map_err(|e| stage("kif", e))?;
+        let q = ProcessNoise::new(&q_u)?;
         let p0 = ThetaCov::Normalised(Matrix3::from_diagonal(&Vector3::from(
             f.p0_sigma_px.map(|s| s * s),
         )));
@@ -319,7 +304,7 @@ impl LaneTracker {
             make_lane(Side::Right, EdgeClass::RightLane, AngleBand::new(-hi, -lo)),
         ];
         for lane in &lanes {
-            lane.band.validate().map_err(|e| stage("hough", e))?;
+            lane.band.validate()?;
         }
         Ok(LaneTracker {
             cfg: *cfg,
@@ -438,8 +423,7 @@ impl LaneTracker {
                 got_h: height,
             });
         }
-        let image = GreyImage::new(data, self.width, self.height, stride_px)
-            .map_err(|e| stage("gradient", e))?;
+        let image = GreyImage::new(data, self.width, self.height, stride_px)?;
         self.counters.frames += 1;
         for i in 0..2 {
             let lane = &mut self.lanes[i];
@@ -507,7 +491,7 @@ impl LaneTracker {
         let coeffs = filter.coeffs();
         for (row, span) in lane.spans.iter_mut().enumerate() {
             *span = if row >= top && row < bottom {
-                let x = eval_parabola(coeffs, row as f64);
+                let x = Parabola::from_coeffs(coeffs).col_at_row(row as f64);
                 if x.is_finite() && x.abs() < 1e6 {
                     let c = x.round() as i64;
                     ColSpan::clamped(c - w, c + w + 1, self.width)
@@ -519,8 +503,7 @@ impl LaneTracker {
             };
         }
         self.detector
-            .detect(image, Region::Spans(&lane.spans), &mut self.edges, None)
-            .map_err(|e| stage("gradient", e))?;
+            .detect(image, Region::Spans(&lane.spans), &mut self.edges, None)?;
         // Outlier rejection: the residuals r = x − x̂(y) of the window pixels are histogrammed
         // in three row bands; pixels farther than `inlier_half_width_px` from their band's
         // midhinge residual (mean of the quartiles) are dropped (clutter, noise, the edges of a shadow).
@@ -532,7 +515,8 @@ impl LaneTracker {
         let mut hist = [[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS];
         self.scratch.clear();
         for p in self.edges.iter_class(lane.class) {
-            let v = f64::from(p.col_px) - eval_parabola(coeffs, f64::from(p.row_px));
+            let v =
+                f64::from(p.col_px) - Parabola::from_coeffs(coeffs).col_at_row(f64::from(p.row_px));
             // Truncation of a non-negative value is floor: this rounds v to the nearest bin.
             let bin = ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w_us);
             let row = usize::from(p.row_px);
@@ -640,17 +624,15 @@ impl LaneTracker {
 
     fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), NavError> {
         let (top, bottom) = self.roi;
-        self.detector
-            .detect(
-                image,
-                Region::Rows {
-                    row_start_px: top,
-                    row_end_px: bottom,
-                },
-                &mut self.edges,
-                None,
-            )
-            .map_err(|e| stage("gradient", e))?;
+        self.detector.detect(
+            image,
+            Region::Rows {
+                row_start_px: top,
+                row_end_px: bottom,
+            },
+            &mut self.edges,
+            None,
+        )?;
         for i in 0..2 {
             if self.lanes[i].has_estimate() {
                 continue;

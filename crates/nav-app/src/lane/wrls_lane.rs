@@ -43,6 +43,6 @@ impl WrlsLane {
 
     pub(crate) fn col_at_row_px(&self, row_px: f64) -> f64 {
         let t = self.inner.estimate();
-        (t[0] * row_px + t[1]) * row_px + t[2]
+        hough_init::Parabola::from_coeffs([t[0], t[1], t[2]]).col_at_row(row_px)
     }
 }
