@@ -5,8 +5,10 @@
 
 use std::path::Path;
 
+use hough_init::{AngleBand, HoughError, HoughParams, LaneInitParams};
 use serde::{Deserialize, Serialize};
 use toml_config::TomlDoc;
+use vision_gradient::{GradientError, GradientParams, Threshold};
 
 use crate::NavError;
 
@@ -22,14 +24,15 @@ pub const INDOOR_TOML: &str = include_str!("../../../../configs/indoor.toml");
 #[serde(deny_unknown_fields)]
 pub struct GradientConfig {
     /// Threshold on the Sobel L1 magnitude `|gx| + |gy|`, grey levels (0..=2040; an ideal 45°
-    /// step of `h` grey levels gives `6h`). With the adaptive mode it is the floor.
+    /// step of `h` grey levels gives `6h`). With the adaptive mode it is the floor. (Ranges of
+    /// this section are `vision_gradient::GradientParams::validate`'s: see [`Self::params`].)
     pub magnitude_threshold: u16,
     /// Adaptive threshold: keep this fraction of the in-band pixels of the searched region (the
     /// `1 − f` quantile of their magnitudes, floored at `magnitude_threshold`), in (0, 1].
     /// 0 disables it (fixed threshold).
     pub adaptive_keep_fraction: f64,
     /// Edge directions kept: the angle of the edge line from the image horizontal must lie in
-    /// [`min_edge_angle_deg`, `max_edge_angle_deg`], degrees (0 < min < max < 90). The Hough
+    /// [`min_edge_angle_deg`, `max_edge_angle_deg`], degrees (0 ≤ min < max ≤ 90). The Hough
     /// search of each lane uses the matching band of line tilts from the vertical,
     /// `±[90 − max, 90 − min]`.
     pub min_edge_angle_deg: f64,
@@ -47,21 +50,126 @@ pub struct RoiConfig {
     pub bottom_row_fraction: f64,
 }
 
-/// Stage II: Hough + least-squares (re-)initialisation (see the `hough-init` crate).
+/// Stage II: Hough + least-squares (re-)initialisation (see the `hough-init` crate). The ranges
+/// are `hough_init::HoughParams::validate`'s and `hough_init::LaneInitParams::validate`'s (see
+/// [`Self::hough_params`], [`Self::lane_params`]): one check, in the crate that uses the value.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitConfig {
-    /// Hough angle resolution, degrees (> 0, ≤ 5).
+    /// Hough angle resolution, degrees ([0.01, 10]).
     pub theta_step_deg: f64,
-    /// Hough distance resolution, px (> 0, ≤ 10).
+    /// Hough distance resolution, px ([0.1, 50]).
     pub rho_step_px: f64,
-    /// Half-width of the band around the Hough line whose pixels are fitted by LS, px (> 0).
+    /// Half-width of the band around the Hough line whose pixels are fitted by LS, px ((0, 1000]).
     pub band_half_width_px: f64,
     /// Fewest pixels in the band for an initialisation to be accepted (≥ 3).
     pub min_points: usize,
     /// Refits of the LS parabola to the pixels within `band_half_width_px` of the previous fit
-    /// (follows a curved mark beyond the straight Hough band), 0..=5; 0 disables.
+    /// (follows a curved mark beyond the straight Hough band), 0..=10; 0 disables.
     pub refit_iterations: u32,
+}
+
+impl GradientConfig {
+    /// The `vision-gradient` parameters this section stands for (`adaptive_keep_fraction` 0 →
+    /// fixed threshold; any other value is the adaptive mode's keep fraction, which
+    /// `GradientParams::validate` checks).
+    pub fn params(&self) -> GradientParams {
+        let threshold = if self.adaptive_keep_fraction == 0.0 {
+            Threshold::Fixed {
+                min_magnitude: self.magnitude_threshold,
+            }
+        } else {
+            Threshold::Adaptive {
+                keep_fraction: self.adaptive_keep_fraction,
+                min_magnitude: self.magnitude_threshold,
+            }
+        };
+        GradientParams {
+            min_edge_angle_deg: self.min_edge_angle_deg,
+            max_edge_angle_deg: self.max_edge_angle_deg,
+            threshold,
+        }
+    }
+
+    /// The Hough θ bands of the left and right lanes that match the edge-angle band: line tilts
+    /// from the vertical `±[90 − max, 90 − min]`.
+    pub fn hough_bands(&self) -> [AngleBand; 2] {
+        let lo = 90.0 - self.max_edge_angle_deg;
+        let hi = 90.0 - self.min_edge_angle_deg;
+        [AngleBand::new(lo, hi), AngleBand::new(-hi, -lo)]
+    }
+}
+
+impl InitConfig {
+    /// The `hough-init` accumulator parameters (peak smoothing and sub-bin refinement on).
+    pub fn hough_params(&self) -> HoughParams {
+        HoughParams {
+            theta_step_deg: self.theta_step_deg,
+            rho_step_px: self.rho_step_px,
+            ..HoughParams::default()
+        }
+    }
+
+    /// The `hough-init` least-squares parameters.
+    pub fn lane_params(&self) -> LaneInitParams {
+        LaneInitParams {
+            band_px: self.band_half_width_px,
+            min_points: self.min_points,
+            refit_iterations: self.refit_iterations,
+        }
+    }
+}
+
+/// A `vision-gradient` parameter error as the configuration field it came from.
+fn gradient_field(e: GradientError) -> NavError {
+    match e {
+        GradientError::InvalidParam {
+            field,
+            value,
+            requirement,
+        } => field_err(
+            match field {
+                "min_edge_angle_deg" => "gradient.min_edge_angle_deg",
+                "max_edge_angle_deg" => "gradient.max_edge_angle_deg",
+                "threshold.keep_fraction" => "gradient.adaptive_keep_fraction",
+                _ => "gradient.magnitude_threshold",
+            },
+            value,
+            requirement,
+        ),
+        other => NavError::Gradient(other),
+    }
+}
+
+/// A `hough-init` parameter error as the configuration field it came from.
+fn init_field(e: HoughError) -> NavError {
+    match e {
+        HoughError::InvalidParam {
+            field,
+            value,
+            reason,
+        } => field_err(
+            match field {
+                "theta_step_deg" => "init.theta_step_deg",
+                "rho_step_px" => "init.rho_step_px",
+                "band_px" => "init.band_half_width_px",
+                "min_points" => "init.min_points",
+                _ => "init.refit_iterations",
+            },
+            value,
+            reason,
+        ),
+        HoughError::InvalidBand {
+            min_deg,
+            max_deg,
+            reason,
+        } => field_err(
+            "gradient.min_edge_angle_deg",
+            format!("(Hough band [{min_deg}, {max_deg}]°)"),
+            reason,
+        ),
+        other => NavError::Hough(other),
+    }
 }
 
 /// Stage III: windows of interest, point gathering, gates and re-initialisation.
@@ -208,31 +316,14 @@ impl TrackerConfig {
 
     /// Check every field's range; the error names the first offending field.
     pub fn validate(&self) -> Result<(), NavError> {
+        // Stage I and II: the component crates' own checks, named by the TOML key.
         let g = &self.gradient;
-        check(
-            g.magnitude_threshold <= 2040,
-            "gradient.magnitude_threshold",
-            g.magnitude_threshold,
-            "must be in 0..=2040 (largest Sobel L1 magnitude)",
-        )?;
-        check(
-            (0.0..=1.0).contains(&g.adaptive_keep_fraction),
-            "gradient.adaptive_keep_fraction",
-            g.adaptive_keep_fraction,
-            "must be in [0, 1] (0 = fixed threshold)",
-        )?;
-        check(
-            g.min_edge_angle_deg > 0.0 && g.min_edge_angle_deg < 90.0,
-            "gradient.min_edge_angle_deg",
-            g.min_edge_angle_deg,
-            "must be in (0, 90) degrees",
-        )?;
-        check(
-            g.max_edge_angle_deg > g.min_edge_angle_deg && g.max_edge_angle_deg < 90.0,
-            "gradient.max_edge_angle_deg",
-            g.max_edge_angle_deg,
-            "must be in (min_edge_angle_deg, 90) degrees",
-        )?;
+        g.params().validate().map_err(gradient_field)?;
+        for band in g.hough_bands() {
+            band.validate().map_err(init_field)?;
+        }
+        self.init.hough_params().validate().map_err(init_field)?;
+        self.init.lane_params().validate().map_err(init_field)?;
         let r = &self.roi;
         check(
             (0.0..1.0).contains(&r.top_row_fraction),
@@ -245,37 +336,6 @@ impl TrackerConfig {
             "roi.bottom_row_fraction",
             r.bottom_row_fraction,
             "must be in (top_row_fraction, 1]",
-        )?;
-        let i = &self.init;
-        check(
-            i.theta_step_deg > 0.0 && i.theta_step_deg <= 5.0,
-            "init.theta_step_deg",
-            i.theta_step_deg,
-            "must be in (0, 5] degrees",
-        )?;
-        check(
-            i.rho_step_px > 0.0 && i.rho_step_px <= 10.0,
-            "init.rho_step_px",
-            i.rho_step_px,
-            "must be in (0, 10] px",
-        )?;
-        check(
-            i.band_half_width_px > 0.0 && i.band_half_width_px.is_finite(),
-            "init.band_half_width_px",
-            i.band_half_width_px,
-            "must be finite and > 0 px",
-        )?;
-        check(
-            i.min_points >= 3,
-            "init.min_points",
-            i.min_points,
-            "must be ≥ 3",
-        )?;
-        check(
-            i.refit_iterations <= 5,
-            "init.refit_iterations",
-            i.refit_iterations,
-            "must be in 0..=5",
         )?;
         let t = &self.track;
         check(
@@ -449,7 +509,7 @@ mod tests {
                 c.gradient.adaptive_keep_fraction = -0.1
             }),
             ("gradient.min_edge_angle_deg", |c| {
-                c.gradient.min_edge_angle_deg = 0.0
+                c.gradient.min_edge_angle_deg = -1.0
             }),
             ("gradient.max_edge_angle_deg", |c| {
                 c.gradient.max_edge_angle_deg = 5.0
@@ -459,12 +519,12 @@ mod tests {
                 c.roi.bottom_row_fraction = 0.1
             }),
             ("init.theta_step_deg", |c| c.init.theta_step_deg = 0.0),
-            ("init.rho_step_px", |c| c.init.rho_step_px = 11.0),
+            ("init.rho_step_px", |c| c.init.rho_step_px = 51.0),
             ("init.band_half_width_px", |c| {
                 c.init.band_half_width_px = f64::INFINITY
             }),
             ("init.min_points", |c| c.init.min_points = 2),
-            ("init.refit_iterations", |c| c.init.refit_iterations = 6),
+            ("init.refit_iterations", |c| c.init.refit_iterations = 11),
             ("track.inlier_half_width_px", |c| {
                 c.track.inlier_half_width_px = 0.0
             }),
@@ -496,6 +556,58 @@ mod tests {
                 other => panic!("{field}: expected a field error, got {other:?}"),
             }
         }
+    }
+
+    #[test]
+    fn the_configuration_and_the_components_agree_on_every_stage_one_and_two_range() {
+        // A value the configuration accepts is one the tracker's components accept, and the
+        // other way round: the ranges are checked once, by the crates that use the values.
+        let values = [
+            -1.0, 0.0, 0.005, 0.01, 0.5, 5.0, 10.0, 10.5, 45.0, 50.0, 89.0, 90.0, 1e4,
+        ];
+        type Set = fn(&mut TrackerConfig, f64);
+        let fields: &[(&str, Set)] = &[
+            ("theta_step_deg", |c, v| c.init.theta_step_deg = v),
+            ("rho_step_px", |c, v| c.init.rho_step_px = v),
+            ("band_half_width_px", |c, v| c.init.band_half_width_px = v),
+            ("min_points", |c, v| c.init.min_points = v.max(0.0) as usize),
+            ("refit_iterations", |c, v| {
+                c.init.refit_iterations = v.max(0.0) as u32
+            }),
+            ("min_edge_angle_deg", |c, v| {
+                c.gradient.min_edge_angle_deg = v
+            }),
+            ("max_edge_angle_deg", |c, v| {
+                c.gradient.max_edge_angle_deg = v
+            }),
+            ("adaptive_keep_fraction", |c, v| {
+                c.gradient.adaptive_keep_fraction = v
+            }),
+        ];
+        let mut accepted = 0;
+        for (name, set) in fields {
+            for &v in &values {
+                let mut cfg = TrackerConfig::outdoor().unwrap();
+                set(&mut cfg, v);
+                let by_config = cfg.validate().is_ok();
+                let by_components = cfg.gradient.params().validate().is_ok()
+                    && cfg
+                        .gradient
+                        .hough_bands()
+                        .iter()
+                        .all(|b| b.validate().is_ok())
+                    && cfg.init.hough_params().validate().is_ok()
+                    && cfg.init.lane_params().validate().is_ok();
+                let tracker = crate::LaneTracker::new(&cfg, crate::Estimator::Kif, 320, 240);
+                assert_eq!(by_config, by_components, "{name} = {v}");
+                assert_eq!(by_config, tracker.is_ok(), "{name} = {v}: {tracker:?}");
+                accepted += usize::from(by_config);
+            }
+        }
+        assert!(
+            accepted > 20,
+            "the sweep must cover accepted values too ({accepted})"
+        );
     }
 
     #[test]

@@ -1,13 +1,11 @@
 //! The tracking loop (paper Fig. 1): directional gradient → Hough + LS initialisation → KIF
 //! (or WRLS) recursion, per lane, with a state machine and sanity gates.
 
-use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, Parabola, init_lane};
+use hough_init::{AngleBand, HoughWorkspace, LaneInitParams, Parabola, init_lane};
 use info_filter::{ParabolaKif, ProcessNoise, RowNorm, ThetaCov};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
-use vision_gradient::{
-    ColSpan, EdgeBuffer, EdgeClass, GradientDetector, GradientParams, GreyImage, Region, Threshold,
-};
+use vision_gradient::{ColSpan, EdgeBuffer, EdgeClass, GradientDetector, GreyImage, Region};
 
 use crate::{GreyFrame, NavError, TrackerConfig};
 
@@ -239,38 +237,11 @@ impl LaneTracker {
                 height,
             });
         }
-        let g = &cfg.gradient;
-        let threshold = if g.adaptive_keep_fraction > 0.0 {
-            Threshold::Adaptive {
-                keep_fraction: g.adaptive_keep_fraction,
-                min_magnitude: g.magnitude_threshold,
-            }
-        } else {
-            Threshold::Fixed {
-                min_magnitude: g.magnitude_threshold,
-            }
-        };
-        let detector = GradientDetector::new(GradientParams {
-            min_edge_angle_deg: g.min_edge_angle_deg,
-            max_edge_angle_deg: g.max_edge_angle_deg,
-            threshold,
-        })?;
+        let detector = GradientDetector::new(cfg.gradient.params())?;
         let roi = cfg.roi_rows(height);
         let capacity = width * (roi.1 - roi.0);
-        let hough = HoughWorkspace::new(
-            width,
-            height,
-            HoughParams {
-                theta_step_deg: cfg.init.theta_step_deg,
-                rho_step_px: cfg.init.rho_step_px,
-                ..HoughParams::default()
-            },
-        )?;
-        let init_params = LaneInitParams {
-            band_px: cfg.init.band_half_width_px,
-            min_points: cfg.init.min_points,
-            refit_iterations: cfg.init.refit_iterations,
-        };
+        let hough = HoughWorkspace::new(width, height, cfg.init.hough_params())?;
+        let init_params = cfg.init.lane_params();
         init_params.validate()?;
         let center = (roi.0 + roi.1 - 1) as f64 / 2.0;
         let scale = ((roi.1 - 1 - roi.0) as f64 / 2.0).max(1.0);
@@ -281,8 +252,7 @@ impl LaneTracker {
         let p0 = ThetaCov::Normalised(Matrix3::from_diagonal(&Vector3::from(
             f.p0_sigma_px.map(|s| s * s),
         )));
-        let lo = 90.0 - g.max_edge_angle_deg;
-        let hi = 90.0 - g.min_edge_angle_deg;
+        let [left_band, right_band] = cfg.gradient.hough_bands();
         let make_lane = |side, class, band| Lane {
             side,
             class,
@@ -300,8 +270,8 @@ impl LaneTracker {
             fresh: false,
         };
         let lanes = [
-            make_lane(Side::Left, EdgeClass::LeftLane, AngleBand::new(lo, hi)),
-            make_lane(Side::Right, EdgeClass::RightLane, AngleBand::new(-hi, -lo)),
+            make_lane(Side::Left, EdgeClass::LeftLane, left_band),
+            make_lane(Side::Right, EdgeClass::RightLane, right_band),
         ];
         for lane in &lanes {
             lane.band.validate()?;
