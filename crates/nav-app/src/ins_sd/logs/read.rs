@@ -1,0 +1,304 @@
+//! Reading the logs: the CSV reader (header check, located errors), the landmark table and the
+//! initial state (TOML), and the truth and solution files.
+
+use super::*;
+
+pub(super) fn io_err(path: &Path) -> impl Fn(std::io::Error) -> LogError + '_ {
+    move |source| LogError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// One parsed CSV line: the text and the start of each field.
+pub(super) struct Record {
+    pub(super) text: String,
+    pub(super) starts: Vec<usize>,
+    pub(super) line: usize,
+}
+
+/// A CSV file read line by line with its header checked.
+pub(super) struct CsvReader {
+    pub(super) path: PathBuf,
+    pub(super) lines: std::io::Lines<BufReader<File>>,
+    pub(super) line: usize,
+    pub(super) fields: usize,
+}
+
+impl CsvReader {
+    pub(super) fn open(path: &Path, header: &str) -> Result<Self, LogError> {
+        let file = File::open(path).map_err(io_err(path))?;
+        let mut r = Self {
+            path: path.to_path_buf(),
+            lines: BufReader::new(file).lines(),
+            line: 0,
+            fields: header.split(',').count(),
+        };
+        let Some(first) = r.next_raw()? else {
+            return Err(r.parse_err(1, 1, format!("empty file, expected the header `{header}`")));
+        };
+        for ((got, want), start) in first
+            .text
+            .split(',')
+            .zip(header.split(','))
+            .zip(&first.starts)
+        {
+            if got.trim() != want {
+                return Err(r.parse_err(
+                    first.line,
+                    start + 1,
+                    format!(
+                        "header field `{}`, expected `{want}` (header `{header}`)",
+                        got.trim()
+                    ),
+                ));
+            }
+        }
+        if first.starts.len() != r.fields {
+            return Err(r.parse_err(
+                first.line,
+                first.text.len() + 1,
+                format!(
+                    "header has {} fields, expected `{header}`",
+                    first.starts.len()
+                ),
+            ));
+        }
+        Ok(r)
+    }
+
+    pub(super) fn parse_err(&self, line: usize, column: usize, message: String) -> LogError {
+        LogError::Parse {
+            path: self.path.clone(),
+            line,
+            column,
+            message,
+        }
+    }
+
+    /// Next non-blank, non-comment line, split.
+    pub(super) fn next_raw(&mut self) -> Result<Option<Record>, LogError> {
+        for text in self.lines.by_ref() {
+            self.line += 1;
+            let text = text.map_err(|source| LogError::Io {
+                path: self.path.clone(),
+                source,
+            })?;
+            let t = text.trim_end_matches('\r');
+            if t.trim().is_empty() || t.trim_start().starts_with('#') {
+                continue;
+            }
+            let mut starts = vec![0];
+            starts.extend(t.match_indices(',').map(|(i, _)| i + 1));
+            return Ok(Some(Record {
+                text: t.to_string(),
+                starts,
+                line: self.line,
+            }));
+        }
+        Ok(None)
+    }
+
+    /// Next data record, with exactly the header's number of fields.
+    pub(super) fn next(&mut self) -> Result<Option<Record>, LogError> {
+        let Some(rec) = self.next_raw()? else {
+            return Ok(None);
+        };
+        if rec.starts.len() != self.fields {
+            return Err(self.parse_err(
+                rec.line,
+                rec.text.len() + 1,
+                format!(
+                    "expected {} fields, found {} (truncated or malformed line)",
+                    self.fields,
+                    rec.starts.len()
+                ),
+            ));
+        }
+        Ok(Some(rec))
+    }
+
+    pub(super) fn field<'a>(&self, rec: &'a Record, i: usize) -> &'a str {
+        let end = rec.starts.get(i + 1).map_or(rec.text.len(), |e| e - 1);
+        &rec.text[rec.starts[i]..end]
+    }
+
+    pub(super) fn f64(&self, rec: &Record, i: usize, name: &str) -> Result<f64, LogError> {
+        let s = self.field(rec, i).trim();
+        match s.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(self.parse_err(
+                rec.line,
+                rec.starts[i] + 1,
+                format!("field `{name}`: `{s}` is not a finite number"),
+            )),
+        }
+    }
+
+    pub(super) fn opt_f64(
+        &self,
+        rec: &Record,
+        i: usize,
+        name: &str,
+    ) -> Result<Option<f64>, LogError> {
+        if self.field(rec, i).trim().is_empty() {
+            Ok(None)
+        } else {
+            self.f64(rec, i, name).map(Some)
+        }
+    }
+
+    pub(super) fn u32(&self, rec: &Record, i: usize, name: &str) -> Result<u32, LogError> {
+        let s = self.field(rec, i).trim();
+        s.parse::<u32>().map_err(|_| {
+            self.parse_err(
+                rec.line,
+                rec.starts[i] + 1,
+                format!("field `{name}`: `{s}` is not a non-negative integer"),
+            )
+        })
+    }
+}
+
+/// The initial navigation state file.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialState {
+    /// Time of the state, s (the IMU log starts after it).
+    pub t_s: f64,
+    /// Geodetic latitude, rad.
+    pub lat_rad: f64,
+    /// Longitude, rad.
+    pub lon_rad: f64,
+    /// Height above the WGS-84 ellipsoid, m.
+    pub alt_m: f64,
+    /// NED velocity, m/s.
+    pub vel_ned_mps: [f64; 3],
+    /// Attitude body FRD → NED as a unit quaternion (w, x, y, z).
+    pub att_quat_wxyz: [f64; 4],
+}
+
+impl InitialState {
+    /// From a navigation state at time `t_s`.
+    pub fn new(t_s: f64, s: &NavState) -> Self {
+        let q = s.att_b_to_n.quaternion();
+        Self {
+            t_s,
+            lat_rad: s.pos.lat_rad,
+            lon_rad: s.pos.lon_rad,
+            alt_m: s.pos.alt_m,
+            vel_ned_mps: [s.vel_ned_mps.x, s.vel_ned_mps.y, s.vel_ned_mps.z],
+            att_quat_wxyz: [q.w, q.i, q.j, q.k],
+        }
+    }
+
+    /// The navigation state.
+    pub fn nav_state(&self) -> NavState {
+        let [w, x, y, z] = self.att_quat_wxyz;
+        NavState {
+            pos: Geodetic {
+                lat_rad: self.lat_rad,
+                lon_rad: self.lon_rad,
+                alt_m: self.alt_m,
+            },
+            vel_ned_mps: Vector3::from(self.vel_ned_mps),
+            att_b_to_n: UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z)),
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct LandmarkFile {
+    pub(super) landmarks: Vec<LandmarkEntry>,
+}
+
+pub(super) fn toml_err(path: &Path, e: toml_config::TomlError) -> LogError {
+    LogError::Parse {
+        path: path.to_path_buf(),
+        line: e.line.unwrap_or(1),
+        column: e.column.unwrap_or(1),
+        message: e.message,
+    }
+}
+
+/// Reads a landmark table file.
+///
+/// # Errors
+/// [`LogError::Io`], [`LogError::Parse`] (TOML errors with their line and column, through the
+/// workspace's one TOML loader `toml-config`; a duplicate id or a bad coordinate at the
+/// `[[landmarks]]` entry concerned).
+pub fn read_landmarks(path: &Path) -> Result<LandmarkTable, LogError> {
+    let text = std::fs::read_to_string(path).map_err(io_err(path))?;
+    let doc = TomlDoc::parse(path.display().to_string(), &text).map_err(|e| toml_err(path, e))?;
+    let file: LandmarkFile = doc.deserialize().map_err(|e| toml_err(path, e))?;
+    LandmarkTable::new(&file.landmarks).map_err(|e| {
+        // Locate the entry the table refused: the last one with a repeated id, or the one with
+        // the bad coordinate.
+        let id = match &e {
+            FilterError::DuplicateLandmark { id } => Some(*id),
+            FilterError::Sighting { landmark, .. } => Some(*landmark),
+            _ => None,
+        };
+        let at = id
+            .and_then(|id| file.landmarks.iter().rposition(|l| l.id == id))
+            .map_or_else(|| "landmarks".to_owned(), |i| format!("landmarks[{i}]"));
+        toml_err(path, doc.error_at(&at, e.to_string()))
+    })
+}
+
+/// Reads an initial-state file.
+///
+/// # Errors
+/// [`LogError::Io`], [`LogError::Parse`].
+pub fn read_initial(path: &Path) -> Result<InitialState, LogError> {
+    let text = std::fs::read_to_string(path).map_err(io_err(path))?;
+    let doc = TomlDoc::parse(path.display().to_string(), &text).map_err(|e| toml_err(path, e))?;
+    doc.deserialize().map_err(|e| toml_err(path, e))
+}
+
+/// Reads a navigation-state row (truth or the first columns of a solution).
+pub(super) fn read_nav(r: &CsvReader, rec: &Record) -> Result<(f64, NavState), LogError> {
+    let names = TRUTH_HEADER.split(',').collect::<Vec<_>>();
+    let mut v = [0.0; 11];
+    for (i, x) in v.iter_mut().enumerate() {
+        *x = r.f64(rec, i, names[i])?;
+    }
+    let s = NavState {
+        pos: Geodetic {
+            lat_rad: v[1],
+            lon_rad: v[2],
+            alt_m: v[3],
+        },
+        vel_ned_mps: Vector3::new(v[4], v[5], v[6]),
+        att_b_to_n: UnitQuaternion::new_normalize(Quaternion::new(v[7], v[8], v[9], v[10])),
+    };
+    Ok((v[0], s))
+}
+
+/// Reads a truth (or solution) file: (t, state) per row.
+///
+/// # Errors
+/// [`LogError::Io`], [`LogError::Parse`] naming the line and column.
+pub fn read_truth(path: &Path) -> Result<Vec<(f64, NavState)>, LogError> {
+    let mut r = CsvReader::open(path, TRUTH_HEADER)?;
+    let mut out = Vec::new();
+    while let Some(rec) = r.next()? {
+        out.push(read_nav(&r, &rec)?);
+    }
+    Ok(out)
+}
+
+/// Reads a solution file written by [`replay`] or [`export_run`]: (t, state) per row.
+///
+/// # Errors
+/// As [`read_truth`].
+pub fn read_solution(path: &Path) -> Result<Vec<(f64, NavState)>, LogError> {
+    let mut r = CsvReader::open(path, SOLUTION_HEADER)?;
+    let mut out = Vec::new();
+    while let Some(rec) = r.next()? {
+        out.push(read_nav(&r, &rec)?);
+        r.opt_f64(&rec, 14, "nis")?;
+    }
+    Ok(out)
+}
