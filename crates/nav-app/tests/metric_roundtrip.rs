@@ -94,11 +94,12 @@ fn straight_robot_road_offset_within_5_cm_and_heading_within_half_a_degree_on_ev
         r.total,
         "both lanes held on every frame"
     );
-    let (off, hdg, width) = (errors(&r, 0), errors(&r, 1), errors(&r, 3));
+    let (off, hdg, curv, width) = (errors(&r, 0), errors(&r, 1), errors(&r, 2), errors(&r, 3));
     eprintln!(
-        "robot_straight: max |error| offset {:.4} m, heading {:.3}°, width {:.4} m",
+        "robot_straight: max |error| offset {:.4} m, heading {:.3}°, curvature {:.4} /m, width {:.4} m",
         max_abs(&off),
         max_abs(&hdg).to_degrees(),
+        max_abs(&curv),
         max_abs(&width)
     );
     assert!(max_abs(&off) <= MAX_OFFSET_M, "offset {}", max_abs(&off));
@@ -111,9 +112,11 @@ fn straight_robot_road_offset_within_5_cm_and_heading_within_half_a_degree_on_ev
 }
 
 #[test]
-fn curved_robot_road_offset_within_5_cm_heading_within_the_model_error() {
-    // Curvature −0.1 → 0.1 /m: a circular arc is not an image parabola, so the heading carries
-    // the model error of lane-geometry's docs (≈ 0.1·|κ|·1 m here) on top of the tracking error.
+fn curved_robot_road_offset_within_5_cm_and_heading_within_half_a_degree_on_every_frame() {
+    // Curvature −0.1 → 0.1 /m. A circular arc is not an image parabola; lane-geometry removes
+    // that model error by fitting its forward model with the rows and weights the tracker used
+    // (`LaneTracker::lane_fit_rows`, crate docs step 5). The truth is the heading relative to
+    // the centre line's tangent at its point nearest the camera (`ArcRoad`).
     let spec = ROBOT_ROADS
         .iter()
         .find(|s| s.name == "robot_curve")
@@ -131,13 +134,13 @@ fn curved_robot_road_offset_within_5_cm_heading_within_the_model_error() {
         max_abs(&hdg).to_degrees(),
         max_abs(&curv)
     );
-    assert!(max_abs(&off) < 0.05, "offset {}", max_abs(&off));
+    assert!(max_abs(&off) <= MAX_OFFSET_M, "offset {}", max_abs(&off));
     assert!(
-        max_abs(&hdg) < 1.5f64.to_radians(),
+        max_abs(&hdg).to_degrees() <= MAX_HEADING_DEG,
         "heading {}°",
         max_abs(&hdg).to_degrees()
     );
-    assert!(max_abs(&curv) < 0.06, "curvature {}", max_abs(&curv));
+    assert!(max_abs(&curv) < 0.02, "curvature {}", max_abs(&curv));
 }
 
 /// Exact 95 % interval of a χ²(n)/n variable (the mean of `n` squared standard normals).
@@ -238,8 +241,9 @@ fn highway_road_through_the_highway_camera() {
         rms(&off),
         rms(&hdg).to_degrees()
     );
-    // Measured: offset max 0.12 m, heading max 1.3°, width max 0.035 m. At 6–13 m a pixel is
-    // 2–3.4 cm across the road, and the offset and heading at the car are extrapolated from there.
+    // The outdoor preset (the paper's edge pixels). Measured: offset max 0.12 m, heading max
+    // 1.1°, width max 0.035 m. At 6–13 m a pixel is 2–3.4 cm across the road, and the offset and
+    // heading at the car are extrapolated from there.
     assert!(max_abs(&off) < 0.2, "offset {}", max_abs(&off));
     assert!(
         max_abs(&hdg) < 2.0f64.to_radians(),

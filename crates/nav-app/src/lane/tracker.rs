@@ -3,6 +3,7 @@
 
 use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, init_lane};
 use info_filter::{ParabolaKif, PowerSums, ProcessNoise, RowNorm, ThetaCov};
+use lane_geometry::{FIT_SAMPLES, FitRows};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 use vision_gradient::{
@@ -149,6 +150,8 @@ struct Lane {
     weights: Vec<f64>,
     spans: Vec<ColSpan>,
     rows: [f64; 2],
+    /// Rows and weights of the points behind the last update or initialisation.
+    fit: FitRows,
     points_now: usize,
     initialised_now: bool,
     updated_now: bool,
@@ -286,6 +289,38 @@ fn mark_centre(row: &[u8], lo: u16, hi: u16, slope: f64) -> Option<(f64, f64)> {
     let c = swx / sw;
     let spread: f64 = (0..pixels.len()).map(|k| (k as f64 - c).powi(2)).sum();
     Some((a as f64 + c, spread / (sw * sw)))
+}
+
+/// [`LaneTracker::lane_fit_rows`] of `points` (with `weights`, or 1 each when `weights` is
+/// shorter) over `rows` `[first, last]`.
+fn fit_profile(points: &[(f32, f32)], weights: &[f64], rows: [f64; 2]) -> FitRows {
+    let mut sum_w = [0.0; FIT_SAMPLES];
+    let mut sum_wy = [0.0; FIT_SAMPLES];
+    let span = rows[1] - rows[0];
+    for (i, &(_, y)) in points.iter().enumerate() {
+        let w = weights.get(i).copied().unwrap_or(1.0);
+        let y = f64::from(y);
+        let t = if span > 0.0 {
+            (y - rows[0]) / span
+        } else {
+            0.0
+        };
+        let b = ((t * FIT_SAMPLES as f64).max(0.0) as usize).min(FIT_SAMPLES - 1);
+        sum_w[b] += w;
+        sum_wy[b] += w * y;
+    }
+    let mut fit = FitRows {
+        rows_px: [0.0; FIT_SAMPLES],
+        weights: sum_w,
+    };
+    for (b, r) in fit.rows_px.iter_mut().enumerate() {
+        *r = if sum_w[b] > 0.0 {
+            sum_wy[b] / sum_w[b]
+        } else {
+            rows[0] + span * (b as f64 + 0.5) / FIT_SAMPLES as f64
+        };
+    }
+    fit
 }
 
 /// Floor of the per-point σ the KIF is given, px: a scatter estimate below it (a noise-free
@@ -439,6 +474,7 @@ impl LaneTracker {
             weights: Vec::with_capacity(cfg.track.max_points_per_lane.max(capacity.min(1 << 16))),
             spans: vec![ColSpan::EMPTY; height],
             rows: [0.0, 0.0],
+            fit: FitRows::uniform(0.0, 0.0),
             points_now: 0,
             initialised_now: false,
             updated_now: false,
@@ -532,6 +568,16 @@ impl LaneTracker {
                 w.covariance_px().map(|p| p * (r * r))
             }
         }
+    }
+
+    /// How one lane's estimate was fitted on the last update or initialisation: the weighted
+    /// mean row and the summed weight of its points in each eighth of their rows (edge pixels
+    /// weigh 1, mark centres their relative precision). `lane-geometry` uses it to remove the
+    /// image-parabola model error ([`crate::camera::CameraModel::ego_lane`]). `None` when the
+    /// lane has no estimate.
+    pub fn lane_fit_rows(&self, side: Side) -> Option<FitRows> {
+        let lane = &self.lanes[side as usize];
+        lane.has_estimate().then_some(lane.fit)
     }
 
     /// Windows, points and report of one lane after the last frame (for overlays).
@@ -819,6 +865,7 @@ impl LaneTracker {
             hi = hi.max(f64::from(y));
         }
         lane.rows = [lo, hi];
+        lane.fit = fit_profile(&lane.points, &lane.weights, lane.rows);
         lane.points_now = lane.points.len();
         lane.state = LaneState::Tracking;
         lane.misses = 0;
@@ -915,6 +962,8 @@ impl LaneTracker {
             lane.state = LaneState::Tracking;
             lane.misses = 0;
             lane.rows = [init.rows_px.0, init.rows_px.1];
+            lane.weights.clear();
+            lane.fit = fit_profile(&lane.points, &lane.weights, lane.rows);
             lane.points_now = init.points_used;
             lane.initialised_now = true;
             self.counters.initialisations[i] += 1;
