@@ -138,6 +138,55 @@ impl PowerSums {
         Ok(s)
     }
 
+    /// Weighted power sums `Σw·u⁰ … Σw·u⁴`, `Σw·x·u⁰ … Σw·x·u²` (`count` is `Σw`): with
+    /// [`ParabolaKif::update_sums`] and `sigma2_px2 = s²` the measurement noise is
+    /// `R = s²·diag(1/w_i)` — points of unequal precision (e.g. sub-pixel mark centres whose
+    /// variance depends on the mark's width and contrast). Weights must be finite and > 0;
+    /// `points` and `weights` are paired up to the shorter of the two. No allocation.
+    ///
+    /// # Errors
+    /// [`KifError::NonFinitePoint`] (index of the point) for a NaN/∞ coordinate, and
+    /// [`KifError::InvalidVariance`] (`"weight"`) for a weight that is not finite and > 0.
+    pub fn from_weighted_points<P: PixelPoint>(
+        points: &[P],
+        weights: &[f64],
+        row_norm: &RowNorm,
+    ) -> Result<Self, KifError> {
+        let c = row_norm.center_row_px;
+        let inv_s = 1.0 / row_norm.scale_px;
+        let mut s = Self::default();
+        for (index, (p, &w)) in points.iter().zip(weights).enumerate() {
+            if !(w.is_finite() && w > 0.0) {
+                return Err(KifError::InvalidVariance {
+                    name: "weight",
+                    value: w,
+                });
+            }
+            let (x, y) = (p.col_px(), p.row_px());
+            if !x.is_finite() || !y.is_finite() {
+                return Err(KifError::NonFinitePoint {
+                    index,
+                    col_px: x,
+                    row_px: y,
+                });
+            }
+            let u = (y - c) * inv_s;
+            let (wu, u2) = (w * u, u * u);
+            s.count += w;
+            s.sum_u += wu;
+            s.sum_u2 += wu * u;
+            s.sum_u3 += wu * u2;
+            s.sum_u4 += w * u2 * u2;
+            s.sum_x += w * x;
+            s.sum_xu += wu * x;
+            s.sum_xu2 += wu * u * x;
+        }
+        if !s.is_finite() || !s.count.is_finite() {
+            return Err(KifError::PowerSumOverflow);
+        }
+        Ok(s)
+    }
+
     fn is_finite(&self) -> bool {
         [
             self.sum_u,

@@ -4,7 +4,8 @@
 #![allow(missing_docs)]
 
 use info_filter::{
-    InformationFilter, KifError, ParabolaKif, ProcessNoise, RowNorm, ThetaCov, TimeUpdateForm,
+    InformationFilter, KifError, ParabolaKif, PowerSums, ProcessNoise, RowNorm, ThetaCov,
+    TimeUpdateForm,
 };
 use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, SVector, SymmetricEigen, Vector3};
 use rand::{Rng, SeedableRng};
@@ -617,4 +618,57 @@ fn row_norm_config_rejects_unknown_fields_and_validates() {
     ));
     let form: TimeUpdateForm = serde_json::from_str(r#""plain""#).unwrap();
     assert_eq!(form, TimeUpdateForm::Plain);
+}
+
+#[test]
+fn weighted_power_sum_update_equals_dense_phi_r_inv_phi_t_with_diagonal_r() {
+    // R = s²·diag(1/w_i): the weighted sums give φR⁻¹φᵀ and φR⁻¹x of the dense form.
+    let mut rng = ChaCha8Rng::seed_from_u64(43);
+    let norm = RowNorm::new(120.0, 100.0).unwrap();
+    for _ in 0..30 {
+        let n = rng.random_range(3..=150);
+        let s2 = 10f64.powf(rng.random_range(-3.0..1.0));
+        let points = random_points(&mut rng, n, &Vector3::new(1e-3, -0.5, 200.0));
+        let weights: Vec<f64> = (0..n)
+            .map(|_| 10f64.powf(rng.random_range(-1.0..1.0)))
+            .collect();
+        let mut kif = ParabolaKif::new(
+            &Vector3::new(0.0, 0.0, 100.0),
+            &ThetaCov::Normalised(random_spd(&mut rng, 10.0)),
+            norm,
+        )
+        .unwrap();
+        let (y0, v0) = (
+            kif.information_normalised(),
+            kif.information_vector_normalised(),
+        );
+        let sums = PowerSums::from_weighted_points(&points, &weights, &norm).unwrap();
+        kif.update_sums(&sums, s2).unwrap();
+        let mut phi = DMatrix::zeros(3, n);
+        let mut x = DVector::zeros(n);
+        let mut r_inv = DMatrix::zeros(n, n);
+        for (i, &(col, row)) in points.iter().enumerate() {
+            let u = norm.normalise_row(row);
+            phi.set_column(i, &DVector::from_vec(vec![u * u, u, 1.0]));
+            x[i] = col;
+            r_inv[(i, i)] = weights[i] / s2;
+        }
+        let d_y = &phi * &r_inv * phi.transpose();
+        let d_yv = &phi * &r_inv * &x;
+        let got = to_d(&(kif.information_normalised() - y0));
+        assert!(rel(&got, &d_y) < 1e-12, "ΔY {:e}", rel(&got, &d_y));
+        let got_v = to_dv(&(kif.information_vector_normalised() - v0));
+        assert!(rel(&got_v, &dv(&d_yv)) < 1e-12);
+    }
+    // Unit weights are the unweighted sums; a bad weight is a typed error.
+    let pts = [(10.0f64, 50.0f64), (12.0, 80.0), (15.0, 110.0)];
+    let a = PowerSums::from_weighted_points(&pts, &[1.0; 3], &norm).unwrap();
+    let b = PowerSums::from_points(&pts, &norm).unwrap();
+    assert!((a.normal_matrix() - b.normal_matrix()).norm() < 1e-12);
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            PowerSums::from_weighted_points(&pts, &[1.0, bad, 1.0], &norm),
+            Err(KifError::InvalidVariance { name: "weight", .. })
+        ));
+    }
 }

@@ -4,8 +4,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use lane_geometry::{
-    ArcRoad, EgoGeometry, EgoLaneEstimator, GeometryError, Homography, Intrinsics, Mounting,
-    PinholeCamera,
+    ArcRoad, EgoGeometry, EgoLaneEstimator, FitRows, GeometryError, Homography, Intrinsics,
+    Mounting, PinholeCamera,
 };
 use nalgebra::{Matrix3, Matrix4, SMatrix, Vector3, Vector4};
 use rand::{Rng, SeedableRng};
@@ -498,5 +498,109 @@ fn bad_lane_input_is_an_error_not_a_panic() {
             rng.random_range(-1e4..1e4),
         ];
         let _ = ego.estimate(&l, &p, &ok, &p);
+    }
+}
+
+/// Rows `[far, near]` of a mark's image over a ground range, as `image_parabola` fits them.
+fn fitted_rows(h: &Homography, road: &ArcRoad, n_m: f64, s_range: (f64, f64)) -> FitRows {
+    let row_of = |s: f64| h.ground_to_image(road.point(s, n_m)).unwrap()[1];
+    FitRows::uniform(row_of(s_range.1), row_of(s_range.0))
+}
+
+#[test]
+fn the_forward_model_removes_the_image_parabola_model_error() {
+    // The same arcs as above, now told over which rows the parabolas were fitted (step 5):
+    // the model error of the image parabola is gone to within the forward model's sampling.
+    for (cam, near, far, range, w, cases) in [
+        (
+            robot_camera(0.0, 0.0),
+            0.55,
+            1.0,
+            (0.5, 1.1),
+            0.8,
+            vec![
+                (0.05, 0.05, 0.02),
+                (0.05, 0.05, 0.05),
+                (-0.1, -0.08, -0.08),
+                (0.0, 0.0, 0.1),
+            ],
+        ),
+        (
+            highway_camera(),
+            7.0,
+            20.0,
+            (6.0, 22.0),
+            3.7,
+            vec![(0.3, 0.02, 1.0 / 400.0), (-0.5, -0.01, -1.0 / 1000.0)],
+        ),
+    ] {
+        let h = cam.homography().unwrap();
+        let ego = EgoLaneEstimator::new(h, near, far).unwrap();
+        for (d, psi, kappa) in cases {
+            let r = road(d, psi, kappa, w);
+            let left = image_parabola(&h, &r, -0.5 * w, range);
+            let right = image_parabola(&h, &r, 0.5 * w, range);
+            let fit = [
+                fitted_rows(&h, &r, -0.5 * w, range),
+                fitted_rows(&h, &r, 0.5 * w, range),
+            ];
+            let plain = ego.geometry(&left, &right).unwrap();
+            let (g, j) = ego
+                .geometry_with_jacobian_fitted(&left, &right, &fit)
+                .unwrap();
+            let errs = [
+                g.lateral_offset_m - d,
+                g.heading_rad - psi,
+                g.curvature_per_m - kappa,
+                g.lane_width_m - w,
+            ];
+            eprintln!(
+                "κ {kappa}: heading error {:.2e} rad (uncorrected {:.2e}), curvature {:.2e} ({:.2e}), offset {:.2e} ({:.2e})",
+                errs[1],
+                plain.heading_rad - psi,
+                errs[2],
+                plain.curvature_per_m - kappa,
+                errs[0],
+                plain.lateral_offset_m - d
+            );
+            assert!(
+                errs[1].abs() < 0.1 * (plain.heading_rad - psi).abs() + 1e-6,
+                "{errs:?}"
+            );
+            assert!(errs[2].abs() < 0.05 * kappa.abs(), "{errs:?}");
+            assert!(
+                errs[0].abs() < 0.2 * (plain.lateral_offset_m - d).abs() + 1e-5,
+                "{errs:?}"
+            );
+            assert!(errs[3].abs() < 0.01 * w, "{errs:?}");
+            // The Jacobian of the corrected map against central differences.
+            let base = [left, right];
+            for c in 0..6 {
+                let step = [1e-7, 1e-5, 1e-3][c % 3];
+                let mut p = base;
+                let mut m = base;
+                p[c / 3][c % 3] += step;
+                m[c / 3][c % 3] -= step;
+                let gp = ego
+                    .geometry_with_jacobian_fitted(&p[0], &p[1], &fit)
+                    .unwrap()
+                    .0
+                    .to_vector();
+                let gm = ego
+                    .geometry_with_jacobian_fitted(&m[0], &m[1], &fit)
+                    .unwrap()
+                    .0
+                    .to_vector();
+                for row in 0..4 {
+                    let fd = (gp[row] - gm[row]) / (2.0 * step);
+                    let scale = j.row(row).iter().fold(0.0f64, |a, v| a.max(v.abs())) * 1e-6;
+                    assert!(
+                        (fd - j[(row, c)]).abs() <= 0.03 * fd.abs() + scale,
+                        "κ {kappa}: ∂{row}/∂{c}: FD {fd:e}, J {:e}",
+                        j[(row, c)]
+                    );
+                }
+            }
+        }
     }
 }

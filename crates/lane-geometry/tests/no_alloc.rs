@@ -2,7 +2,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use alloc_counter::allocations_in;
-use lane_geometry::{EgoLaneEstimator, Intrinsics, Mounting, PinholeCamera};
+use lane_geometry::{EgoLaneEstimator, FitRows, Intrinsics, Mounting, PinholeCamera};
 use nalgebra::{Matrix3, Vector3};
 
 #[global_allocator]
@@ -35,4 +35,20 @@ fn ego_lane_estimate_does_not_allocate() {
     });
     assert!(lane.unwrap().unwrap().geometry.lane_width_m > 0.0);
     assert_eq!(n, 0, "{n} allocations in 100 estimates");
+    // With the image-parabola model error removed (step 5).
+    let fit = [
+        FitRows::uniform(150.0, 230.0),
+        FitRows::uniform(150.0, 230.0),
+    ];
+    let (lane, n) = allocations_in(|| {
+        let mut last = None;
+        for k in 0..100 {
+            let dk = f64::from(k) * 0.1;
+            let left = [1e-4, -1.1, 300.0 + dk];
+            last = Some(ego.estimate_fitted(&left, &cov, &[-1e-4, 0.9, 20.0], &cov, &fit));
+        }
+        last
+    });
+    assert!(lane.unwrap().unwrap().geometry.lane_width_m > 0.0);
+    assert_eq!(n, 0, "{n} allocations in 100 fitted estimates");
 }

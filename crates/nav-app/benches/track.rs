@@ -63,6 +63,18 @@ fn tracking_frame(c: &mut Criterion) {
                 b.iter(|| black_box(tracker.track(black_box(frame)).unwrap()));
             });
         }
+        // The KIF with sub-pixel mark centres and the measured R (`track.mark_centres`).
+        let mut centres = cfg;
+        centres.track.mark_centres = true;
+        let mut tracker =
+            LaneTracker::new(&centres, Estimator::Kif, frame.width(), frame.height()).unwrap();
+        for _ in 0..5 {
+            tracker.track(frame).unwrap();
+        }
+        assert!(!tracker.track(frame).unwrap().full_gradient, "{name}");
+        group.bench_function(BenchmarkId::new("kif_mark_centres", name), |b| {
+            b.iter(|| black_box(tracker.track(black_box(frame)).unwrap()));
+        });
         // An initialisation frame: full-ROI gradient + Hough + LS (both lanes) + refinement.
         let mut tracker =
             LaneTracker::new(&cfg, Estimator::Kif, frame.width(), frame.height()).unwrap();

@@ -61,8 +61,10 @@ fn run_with(spec: &RoadSpec, cfg: &TrackerConfig, camera: &str) -> Run {
     }
 }
 
-/// Frames skipped at the start while the filters converge from their initialisation.
-const SETTLE_FRAMES: usize = 10;
+/// Frames skipped at the start while the filters converge from their Hough + LS
+/// initialisation (P0 = 4 px per coefficient): the first KIF updates are still pulling the
+/// initial fit, made from integer edge pixels, onto the sub-pixel mark centres.
+const SETTLE_FRAMES: usize = 5;
 
 fn errors(r: &Run, k: usize) -> Vec<f64> {
     r.frames
@@ -76,8 +78,12 @@ fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |a, e| a.max(e.abs()))
 }
 
+/// The tolerances at the robot scale, on every frame after the settle frames.
+const MAX_OFFSET_M: f64 = 0.05;
+const MAX_HEADING_DEG: f64 = 0.5;
+
 #[test]
-fn straight_robot_road_offset_within_5_cm_and_heading_within_half_a_degree_rms() {
+fn straight_robot_road_offset_within_5_cm_and_heading_within_half_a_degree_on_every_frame() {
     let spec = ROBOT_ROADS
         .iter()
         .find(|s| s.name == "robot_straight")
@@ -88,26 +94,17 @@ fn straight_robot_road_offset_within_5_cm_and_heading_within_half_a_degree_rms()
         r.total,
         "both lanes held on every frame"
     );
-    let (off, hdg, width) = (errors(&r, 0), errors(&r, 1), errors(&r, 3));
+    let (off, hdg, curv, width) = (errors(&r, 0), errors(&r, 1), errors(&r, 2), errors(&r, 3));
     eprintln!(
-        "robot_straight: max |error| offset {:.4} m, heading {:.3}°, width {:.4} m",
+        "robot_straight: max |error| offset {:.4} m, heading {:.3}°, curvature {:.4} /m, width {:.4} m",
         max_abs(&off),
         max_abs(&hdg).to_degrees(),
+        max_abs(&curv),
         max_abs(&width)
     );
-    // Measured: offset ≤ 4.4 mm; heading RMS 0.33°, max 0.70° (a 0.30° bias from the tracker's
-    // 0.2–0.35 px edge-pixel bias, see the σ test below, plus noise): within 0.5° in RMS, not on
-    // every frame.
-    let rms_hdg = (hdg.iter().map(|e| e * e).sum::<f64>() / hdg.len() as f64).sqrt();
-    eprintln!("robot_straight: heading RMS {:.3}°", rms_hdg.to_degrees());
-    assert!(max_abs(&off) < 0.05, "offset {}", max_abs(&off));
+    assert!(max_abs(&off) <= MAX_OFFSET_M, "offset {}", max_abs(&off));
     assert!(
-        rms_hdg < 0.5f64.to_radians(),
-        "heading RMS {}°",
-        rms_hdg.to_degrees()
-    );
-    assert!(
-        max_abs(&hdg) < 1.0f64.to_radians(),
+        max_abs(&hdg).to_degrees() <= MAX_HEADING_DEG,
         "heading {}°",
         max_abs(&hdg).to_degrees()
     );
@@ -115,9 +112,11 @@ fn straight_robot_road_offset_within_5_cm_and_heading_within_half_a_degree_rms()
 }
 
 #[test]
-fn curved_robot_road_offset_within_5_cm_heading_within_the_model_error() {
-    // Curvature −0.1 → 0.1 /m: a circular arc is not an image parabola, so the heading carries
-    // the model error of lane-geometry's docs (≈ 0.1·|κ|·1 m here) on top of the tracking error.
+fn curved_robot_road_offset_within_5_cm_and_heading_within_half_a_degree_on_every_frame() {
+    // Curvature −0.1 → 0.1 /m. A circular arc is not an image parabola; lane-geometry removes
+    // that model error by fitting its forward model with the rows and weights the tracker used
+    // (`LaneTracker::lane_fit_rows`, crate docs step 5). The truth is the heading relative to
+    // the centre line's tangent at its point nearest the camera (`ArcRoad`).
     let spec = ROBOT_ROADS
         .iter()
         .find(|s| s.name == "robot_curve")
@@ -135,40 +134,33 @@ fn curved_robot_road_offset_within_5_cm_heading_within_the_model_error() {
         max_abs(&hdg).to_degrees(),
         max_abs(&curv)
     );
-    assert!(max_abs(&off) < 0.05, "offset {}", max_abs(&off));
+    assert!(max_abs(&off) <= MAX_OFFSET_M, "offset {}", max_abs(&off));
     assert!(
-        max_abs(&hdg) < 1.5f64.to_radians(),
+        max_abs(&hdg).to_degrees() <= MAX_HEADING_DEG,
         "heading {}°",
         max_abs(&hdg).to_degrees()
     );
-    assert!(max_abs(&curv) < 0.06, "curvature {}", max_abs(&curv));
+    assert!(max_abs(&curv) < 0.02, "curvature {}", max_abs(&curv));
 }
 
-/// 95 % interval of a χ²(n)/n variable (Wilson–Hilferty).
+/// Exact 95 % interval of a χ²(n)/n variable (the mean of `n` squared standard normals).
 fn chi2_mean_interval(n: usize) -> (f64, f64) {
-    let n = n as f64;
-    let z = 1.959_964;
-    let c = 2.0 / (9.0 * n);
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    let chi2 = ChiSquared::new(n as f64).unwrap();
     (
-        (1.0 - c - z * c.sqrt()).powi(3),
-        (1.0 - c + z * c.sqrt()).powi(3),
+        chi2.inverse_cdf(0.025) / n as f64,
+        chi2.inverse_cdf(0.975) / n as f64,
     )
 }
 
 #[test]
-fn reported_sigma_matches_the_scatter_of_the_errors_and_bounds_their_bias() {
-    // 150 frames of the straight road swaying slowly. The errors of successive frames are
-    // correlated (the filter's memory), so every 5th frame is taken as an independent sample
-    // (lag-5 correlation ≈ 0). Measured (see the README): the normalised errors z = e/σ scatter
-    // a little LESS than σ says (centred mean square 0.5–0.6: σ is 1.3× the random scatter), but
-    // carry a bias of 1.2–1.6 σ, the image of a 0.2–0.35 px bias of the tracker's edge-pixel
-    // measurement of the marks, which the KIF's R = σ²·I model does not contain (pixel-level
-    // NEES of the lane coefficients 4.7–5.1 for 3 dof on a static straight road; bottom-row
-    // scatter 0.24 px against σ 0.31 px). The uncentred mean square is therefore 2–3, not 1:
-    // σ describes the random part of the error, not this bias. The test holds the two facts:
-    // σ is not over-confident about the scatter (centred mean square below the χ² interval's
-    // upper end), and the bias stays under 2 σ. (lane_width_m is not held to it: its centred
-    // mean square is 3.3, σ too small by 1.8× — reported, not explained yet.)
+fn reported_sigma_matches_the_errors() {
+    // 150 frames of the straight robot road swaying slowly. For lateral_offset_m, heading_rad
+    // and lane_width_m the normalised errors z = (estimate − truth)/σ must have an uncentred mean
+    // square inside the exact 95 % χ² interval: σ neither too small nor too large, and no bias
+    // beyond it. Every 5th frame after the settle frames is one sample; the test also checks that
+    // those samples are uncorrelated (lag-5 autocorrelation of z). With mark centres the KIF is
+    // dominated by each frame's measurement, so z is nearly white already at lag 1.
     let spec = RoadSpec {
         name: "robot_slow",
         frames: 150,
@@ -176,28 +168,52 @@ fn reported_sigma_matches_the_scatter_of_the_errors_and_bounds_their_bias() {
         ..ROBOT_ROADS[0]
     };
     let r = run(&spec, &robot_tracker_config());
-    for (k, name) in [(0, "lateral_offset_m"), (1, "heading_rad")] {
-        let z: Vec<f64> = r
+    let mut failures = Vec::new();
+    for (k, name) in [
+        (0, "lateral_offset_m"),
+        (1, "heading_rad"),
+        (3, "lane_width_m"),
+    ] {
+        let z_all: Vec<f64> = r
             .frames
             .iter()
             .skip(SETTLE_FRAMES)
-            .step_by(5)
             .map(|f| (f[k].1 - f[k].0) / f[k].2)
             .collect();
+        let zm = z_all.iter().sum::<f64>() / z_all.len() as f64;
+        let acf = |lag: usize| {
+            let c = |l: usize| {
+                z_all
+                    .iter()
+                    .zip(&z_all[l..])
+                    .map(|(a, b)| (a - zm) * (b - zm))
+                    .sum::<f64>()
+            };
+            c(lag) / c(0)
+        };
+        let z: Vec<f64> = z_all.iter().copied().step_by(5).collect();
         let n = z.len();
         let mean = z.iter().sum::<f64>() / n as f64;
-        let centred = z.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
         let ms = z.iter().map(|v| v * v).sum::<f64>() / n as f64;
-        let (lo, hi) = chi2_mean_interval(n - 1);
+        let (lo, hi) = chi2_mean_interval(n);
         eprintln!(
-            "{name}: {n} samples, mean z {mean:.2}, centred mean square {centred:.2} in [{lo:.2}, {hi:.2}], mean z² {ms:.2}"
+            "{name}: {n} samples, mean z {mean:.2}, mean z² {ms:.2} in [{lo:.2}, {hi:.2}]; autocorrelation lag 1 {:.2}, lag 5 {:.2}",
+            acf(1),
+            acf(5)
         );
-        assert!(
-            centred <= hi && centred > 0.25,
-            "{name}: centred mean square {centred:.2} vs the 95 % χ² interval [{lo:.2}, {hi:.2}]"
-        );
-        assert!(mean.abs() < 2.0, "{name}: bias {mean:.2} σ");
+        if acf(5).abs() > 0.3 {
+            failures.push(format!(
+                "{name}: lag-5 autocorrelation {:.2}: samples not independent",
+                acf(5)
+            ));
+        }
+        if !(lo..=hi).contains(&ms) {
+            failures.push(format!(
+                "{name}: mean z² {ms:.2} outside [{lo:.2}, {hi:.2}]"
+            ));
+        }
     }
+    assert!(failures.is_empty(), "{failures:?}");
 }
 
 #[test]
@@ -225,8 +241,9 @@ fn highway_road_through_the_highway_camera() {
         rms(&off),
         rms(&hdg).to_degrees()
     );
-    // Measured: offset max 0.12 m, heading max 1.3°, width max 0.035 m. At 6–13 m a pixel is
-    // 2–3.4 cm across the road, and the offset and heading at the car are extrapolated from there.
+    // The outdoor preset (the paper's edge pixels). Measured: offset max 0.12 m, heading max
+    // 1.1°, width max 0.035 m. At 6–13 m a pixel is 2–3.4 cm across the road, and the offset and
+    // heading at the car are extrapolated from there.
     assert!(max_abs(&off) < 0.2, "offset {}", max_abs(&off));
     assert!(
         max_abs(&hdg) < 2.0f64.to_radians(),

@@ -38,7 +38,7 @@
 //! are refused and every out-of-range field is named.
 
 use lane_geometry::{
-    EgoLaneEstimator, GeometryError, Homography, Intrinsics, Mounting, PinholeCamera,
+    EgoLaneEstimator, FitRows, GeometryError, Homography, Intrinsics, Mounting, PinholeCamera,
 };
 use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
@@ -337,22 +337,35 @@ impl CameraModel {
         let (lc, rc) = (l.coeffs?, r.coeffs?);
         let lp = tracker.lane_covariance_px(Side::Left)?;
         let rp = tracker.lane_covariance_px(Side::Right)?;
-        self.ego_lane_from(&lc, &lp, &rc, &rp)
+        let fit = [
+            tracker.lane_fit_rows(Side::Left)?,
+            tracker.lane_fit_rows(Side::Right)?,
+        ];
+        self.ego_lane_from(&lc, &lp, &rc, &rp, Some(&fit))
     }
 
     /// The ego lane from two lanes' coefficients `[a1, a2, a3]` (px) and covariances (pixel
-    /// parameterisation); `None` if the geometry is undefined for them.
+    /// parameterisation); `None` if the geometry is undefined for them. With `fit` (how each
+    /// lane was fitted, [`LaneTracker::lane_fit_rows`], left then right) the image-parabola
+    /// model error is removed (`lane_geometry::EgoLaneEstimator::estimate_fitted`).
     pub fn ego_lane_from(
         &self,
         left_px: &[f64; 3],
         left_cov_px: &Matrix3<f64>,
         right_px: &[f64; 3],
         right_cov_px: &Matrix3<f64>,
+        fit: Option<&[FitRows; 2]>,
     ) -> Option<EgoLaneReport> {
-        let e = self
-            .ego
-            .estimate(left_px, left_cov_px, right_px, right_cov_px)
-            .ok()?;
+        let e = match fit {
+            Some(rows) => {
+                self.ego
+                    .estimate_fitted(left_px, left_cov_px, right_px, right_cov_px, rows)
+            }
+            None => self
+                .ego
+                .estimate(left_px, left_cov_px, right_px, right_cov_px),
+        }
+        .ok()?;
         Some(EgoLaneReport {
             lateral_offset_m: e.geometry.lateral_offset_m,
             lateral_offset_m_sigma: e.sigma.lateral_offset_m,
@@ -461,8 +474,8 @@ mod tests {
         // The look-ahead rows come from the homography alone, so they agree too.
         let cov = Matrix3::from_diagonal(&nalgebra::Vector3::new(1e-9, 1e-4, 0.5));
         let (l, r) = ([2e-4, -1.2, 300.0], [2e-4, 0.9, 10.0]);
-        let a = modelled.ego_lane_from(&l, &cov, &r, &cov).unwrap();
-        let b = measured.ego_lane_from(&l, &cov, &r, &cov).unwrap();
+        let a = modelled.ego_lane_from(&l, &cov, &r, &cov, None).unwrap();
+        let b = measured.ego_lane_from(&l, &cov, &r, &cov, None).unwrap();
         assert!(
             (a.lateral_offset_m - b.lateral_offset_m).abs() < 1e-6,
             "{a:?} {b:?}"

@@ -193,6 +193,12 @@ pub struct TrackConfig {
     /// Left and right lanes must stay at least this far apart at the middle and bottom ROI rows
     /// (and in order at the top row), px (≥ 0).
     pub min_lane_separation_px: f64,
+    /// `true`: measure one sub-pixel mark centre per row (or the sub-pixel position of a single
+    /// step edge) and give the KIF the measured point scatter as `R` (an addition beyond the
+    /// paper, crate docs "Mark centres"); `false` (default when absent): the paper's integer
+    /// edge pixels with `R = filter.r_sigma_px²·I`.
+    #[serde(default)]
+    pub mark_centres: bool,
 }
 
 /// Filter noise models (KIF and WRLS).
@@ -208,7 +214,8 @@ pub struct FilterConfig {
     /// Random-walk standard deviation per frame of `(b1, b2, b3)`, px/frame (each > 0). Q = diag(σ²).
     pub q_sigma_px: [f64; 3],
     /// Standard deviation of one pixel measurement (column of an edge pixel about the lane), px (> 0).
-    /// R = σ²·I.
+    /// R = σ²·I; with `track.mark_centres` the KIF estimates R from the points instead and uses
+    /// this only for frames with fewer than 8 points.
     pub r_sigma_px: f64,
     /// Initial standard deviation of `(b1, b2, b3)` after an initialisation, px (each > 0).
     pub p0_sigma_px: [f64; 3],
