@@ -152,7 +152,9 @@ pub use lane::tracker::{
     Estimator, LaneReport, LaneState, LaneTracker, LaneView, Side, TrackReport, TrackerCounters,
 };
 #[cfg(feature = "lane")]
-pub use lane::{birdseye, camera, capture_source, eval, labelled, overlay, sources, synth, y4m};
+pub use lane::{
+    birdseye, camera, capture_source, eval, frame_loop, labelled, overlay, sources, synth, y4m,
+};
 
 // The INS half (feature `ins`): the closed loop, its runs, statistics and the log replay.
 #[cfg(feature = "ins")]

@@ -126,49 +126,38 @@ pub struct RunOutcome {
     pub counters: crate::TrackerCounters,
 }
 
-/// Run a fresh tracker (built on the first frame's size) over `source`, at most `max_frames`.
-/// Fatal source errors and tracker errors end the run with that error.
+/// Run a fresh tracker (built on the first frame's size) over `source`, at most `max_frames`,
+/// through the one frame loop ([`crate::frame_loop`]). Fatal source errors and tracker errors
+/// end the run with that error.
 pub fn run_tracker(
     source: &mut dyn crate::FrameSource,
     cfg: &crate::TrackerConfig,
     estimator: crate::Estimator,
     max_frames: Option<u64>,
 ) -> Result<RunOutcome, crate::NavError> {
-    let mut frame = crate::GreyFrame::default();
-    let mut tracker: Option<crate::LaneTracker> = None;
+    let mut lanes = crate::frame_loop::FrameLoop::new(*cfg, estimator);
     let mut reports = Vec::new();
     let mut bad_frames = Vec::new();
     let mut n = 0u64;
     while max_frames.is_none_or(|m| n < m) {
-        let meta = match source.next_frame(&mut frame) {
-            Ok(Some(m)) => m,
-            Ok(None) => break,
-            Err(e) if !e.is_fatal() => {
+        let tracked = match lanes.step(source)? {
+            crate::frame_loop::Step::Tracked(t) => t,
+            crate::frame_loop::Step::Skipped(e) => {
                 bad_frames.push(e.to_string());
                 continue;
             }
-            Err(e) => return Err(e),
+            crate::frame_loop::Step::End => break,
         };
-        let t = match &mut tracker {
-            Some(t) => t,
-            slot => slot.insert(crate::LaneTracker::new(
-                cfg,
-                estimator,
-                frame.width(),
-                frame.height(),
-            )?),
-        };
-        let report = t.track(&frame)?;
-        let i = usize::try_from(meta.index).unwrap_or(usize::MAX);
+        let i = usize::try_from(tracked.meta.index).unwrap_or(usize::MAX);
         if reports.len() <= i {
             reports.resize(i + 1, None);
         }
         if let Some(slot) = reports.get_mut(i) {
-            *slot = Some(report);
+            *slot = Some(tracked.report);
         }
         n += 1;
     }
-    let counters = tracker.as_ref().map(|t| *t.counters()).unwrap_or_default();
+    let counters = lanes.tracker().map(|t| *t.counters()).unwrap_or_default();
     Ok(RunOutcome {
         reports,
         bad_frames,

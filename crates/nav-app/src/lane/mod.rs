@@ -16,6 +16,7 @@ pub mod capture_source;
 pub mod config;
 pub mod eval;
 pub mod frame;
+pub mod frame_loop;
 pub mod labelled;
 pub mod overlay;
 pub mod sources;

@@ -15,13 +15,11 @@ use nav_app::capture_source::{
     self, CaptureMonitor, DeviceFrameInfo, DeviceOptions, DeviceSetup, DeviceStats,
     parse_control_spec,
 };
+use nav_app::frame_loop::{FrameLoop, Step, Tracked};
 use nav_app::overlay::{OverlaySink, render_overlay};
 use nav_app::sources::open_input;
 use nav_app::y4m::Y4mSource;
-use nav_app::{
-    Estimator, FrameSource, GreyFrame, LaneReport, LaneState, LaneTracker, NavError, Side,
-    TrackerConfig,
-};
+use nav_app::{Estimator, FrameSource, LaneReport, LaneState, NavError, Side, TrackerConfig};
 use serde::Serialize;
 
 /// The bundled sample: first 30 frames of udacity's solidWhiteRight, 320×240 grey.
@@ -312,9 +310,8 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         Some(p) => Some(OverlaySink::open(p, fps_out)?),
         None => None,
     };
-    let mut frame = GreyFrame::default();
     let mut rgb = Vec::new();
-    let mut tracker: Option<LaneTracker> = None;
+    let mut lanes = FrameLoop::new(cfg, estimator);
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
     let mut loop_base = 0u64;
@@ -323,9 +320,15 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
     let started = Instant::now();
     let mut last_states = [LaneState::Initialising; 2];
     while args.max_frames.is_none_or(|m| stats.frames < m) {
-        let meta = match source.next_frame(&mut frame) {
-            Ok(Some(m)) => m,
-            Ok(None) => {
+        let Tracked {
+            meta,
+            frame,
+            tracker: t,
+            report,
+            track_time: dt,
+        } = match lanes.step(&mut source)? {
+            Step::Tracked(tracked) => tracked,
+            Step::End => {
                 if args.repeat
                     && stats.frames > 0
                     && args.input.as_ref().is_some_and(|p| p.as_os_str() != "-")
@@ -336,41 +339,19 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 }
                 break;
             }
-            Err(e) if !e.is_fatal() => {
+            Step::Skipped(e) => {
                 stats.lost_frames += e.lost_frames();
                 stats.skipped_bytes += e.skipped_bytes();
                 eprintln!("nav-app: warning: {e}");
                 continue;
             }
-            Err(e) => return Err(e.into()),
         };
+        if stats.frames == 0
+            && let Some(cam) = &camera
+        {
+            cam.check_frame_size(frame.width(), frame.height())?;
+        }
         last_index = meta.index;
-        let t = match &mut tracker {
-            Some(t) if t.frame_size() == (frame.width(), frame.height()) => t,
-            slot => {
-                if let Some(old) = slot.as_ref() {
-                    bail!(
-                        "frame {}: size changed from {:?} to {}×{}",
-                        meta.index,
-                        old.frame_size(),
-                        frame.width(),
-                        frame.height()
-                    );
-                }
-                if let Some(cam) = &camera {
-                    cam.check_frame_size(frame.width(), frame.height())?;
-                }
-                slot.insert(LaneTracker::new(
-                    &cfg,
-                    estimator,
-                    frame.width(),
-                    frame.height(),
-                )?)
-            }
-        };
-        let t0 = Instant::now();
-        let report = t.track(&frame)?;
-        let dt = t0.elapsed();
         track_time += dt;
         stats.frames += 1;
         let index = loop_base + meta.index;
@@ -407,11 +388,11 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 .context("cannot write JSON to stdout")?;
         }
         if let Some(sink) = overlay.as_mut() {
-            render_overlay(&frame, t, &mut rgb);
+            render_overlay(frame, t, &mut rgb);
             sink.write(index, &rgb, frame.width(), frame.height())?;
         }
         if let Some((dir, view, rgb)) = birdseye.as_mut() {
-            view.render(&frame, t, &report, ego.flatten(), rgb);
+            view.render(frame, t, &report, ego.flatten(), rgb);
             let path = dir.join(format!("birdseye_{index:06}.png"));
             image::save_buffer(
                 &path,
@@ -447,7 +428,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
              {wall:.2} s; tracking {per_frame_us:.1} µs/frame ({:.0} frames/s)",
             1e6 / per_frame_us.max(1e-9)
         );
-        if let Some(t) = &tracker {
+        if let Some(t) = lanes.tracker() {
             let c = t.counters();
             eprintln!(
                 "nav-app: initialisations left {} right {}; gated jumps {:?}; gated crossings {:?}",
