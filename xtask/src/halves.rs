@@ -69,7 +69,7 @@ pub fn run() -> Result<()> {
         tree.lines().count()
     );
     // The INS half alone, and with the Monte Carlo library (rayon, plotters) but no binary.
-    for half in ["lane", "ins", "monte-carlo"] {
+    for half in ["lane", "eval", "ins", "monte-carlo"] {
         eprintln!("halves: clippy -p nav-app --no-default-features --features {half}");
         let status = Command::new(&cargo)
             .current_dir(&root)

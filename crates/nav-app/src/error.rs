@@ -40,7 +40,7 @@ pub enum NavError {
         /// The directory.
         path: String,
     },
-    /// A labelled set (`labels.json`, see [`crate::labelled`]) is malformed or does not match its
+    /// A labelled set (`labels.json`, see `nav_app::labelled`, feature `eval`) is malformed or does not match its
     /// frames.
     #[error("{path}: bad lane labels: {reason}")]
     Labels {

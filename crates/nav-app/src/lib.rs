@@ -106,7 +106,7 @@
 //! homography) turns the two lanes' parabolas and their KIF covariances
 //! ([`LaneTracker::lane_covariance_px`]) into the ego lane's lateral offset, heading, curvature
 //! and width with standard deviations (`lane-geometry` crate); [`birdseye`] draws the ground
-//! from above; [`synth::road`] renders a road from known 3-D geometry for the round-trip tests.
+//! from above; `synth::road` (feature `eval`) renders a road from known 3-D geometry for the round-trip tests.
 //!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field
@@ -152,9 +152,11 @@ pub use lane::tracker::{
     Estimator, LaneReport, LaneState, LaneTracker, LaneView, Side, TrackReport, TrackerCounters,
 };
 #[cfg(feature = "lane")]
-pub use lane::{
-    birdseye, camera, capture_source, eval, frame_loop, labelled, overlay, sources, synth, y4m,
-};
+pub use lane::{birdseye, camera, capture_source, frame_loop, overlay, sources, y4m};
+// Evaluation and synthesis (feature `eval`): rendered sequences with ground truth, scoring, the
+// real labelled sets.
+#[cfg(feature = "eval")]
+pub use lane::{eval, labelled, synth};
 
 // The INS half (feature `ins`): the closed loop, its runs, statistics and the log replay.
 #[cfg(feature = "ins")]

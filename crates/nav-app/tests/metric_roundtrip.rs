@@ -1,7 +1,7 @@
 //! Lanes in metres, end to end: a road rendered from known 3-D geometry through the robot camera
 //! → tracker (KIF) → ego lane in metres, scored against the truth; and the reported σ checked
 //! against the actual errors.
-#![cfg(feature = "lane")]
+#![cfg(feature = "eval")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nav_app::camera::CameraConfig;

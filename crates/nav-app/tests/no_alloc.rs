@@ -1,6 +1,6 @@
 //! The per-frame tracking path does not allocate (issue 4 §1): counted with the `alloc-counter`
 //! global allocator, which counts allocations made by the measuring thread only.
-#![cfg(feature = "lane")]
+#![cfg(feature = "eval")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use alloc_counter::allocations_in;

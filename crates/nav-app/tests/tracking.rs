@@ -1,6 +1,6 @@
 //! Tracking behaviour on rendered sequences with exact ground truth, and on the real udacity
 //! fixture.
-#![cfg(feature = "lane")]
+#![cfg(feature = "eval")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nav_app::eval::{continuity, run_tracker, score_sequence};

@@ -1,6 +1,6 @@
 //! The one frame loop: next frame from a [`FrameSource`] → tracker (built on the first frame's
 //! size) → the caller's handling of the report. The `nav-app` binary (JSON, overlays, capture
-//! counters) and the evaluation ([`crate::eval::run_tracker`]) both drive it, so what a frame
+//! counters) and the evaluation (`nav_app::eval::run_tracker`, feature `eval`) both drive it, so what a frame
 //! error does, when the tracker is built and what a size change means are decided once.
 //!
 //! ```no_run
