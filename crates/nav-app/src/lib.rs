@@ -113,7 +113,9 @@
 //! carries its unit.
 //!
 //! ## Example
+//! (The renderer is `nav_app::synth`, feature `eval`.)
 //! ```
+//! # #[cfg(feature = "eval")] {
 //! use nav_app::synth::{SceneRenderer, SCENES};
 //! use nav_app::{Estimator, GreyFrame, LaneState, LaneTracker, TrackerConfig};
 //!
@@ -131,6 +133,7 @@
 //!         assert!((x - gt.col_at_row(220.0)).abs() < 2.0);
 //!     }
 //! }
+//! # }
 //! # Ok::<(), nav_app::NavError>(())
 //! ```
 
