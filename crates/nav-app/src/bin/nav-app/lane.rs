@@ -29,6 +29,9 @@ const SAMPLE_NAME: &str = "bundled sample (udacity solidWhiteRight, 30 frames, M
 
 /// Shown at the end of `--help`.
 const AFTER_HELP: &str = "\
+With neither --input nor --device, nav-app tracks the bundled sample (30 real highway frames,
+udacity solidWhiteRight, MIT) with configs/default.toml.
+
 Damaged input: an undecodable image of a directory, a YUV4MPEG2 stream damaged where a FRAME
 header should be (the reader skips to the next FRAME marker) or a short last frame is reported,
 counted and skipped. The last stderr line says how many frames were tracked and lost and how many
@@ -63,7 +66,9 @@ enum EstimatorArg {
     after_help = AFTER_HELP
 )]
 struct Args {
-    /// Image (PNG/JPEG/PGM), directory of images, .y4m file, or `-` for a YUV4MPEG2 stream on stdin.
+    /// Image (PNG/JPEG/PGM), directory of images, .y4m file, or `-` for a YUV4MPEG2 stream on stdin
+    /// [default, with neither --input nor --device: the bundled 30-frame sample, udacity
+    /// solidWhiteRight, MIT].
     #[arg(long, value_name = "PATH", conflicts_with = "device")]
     input: Option<PathBuf>,
     /// Capture device (e.g. /dev/video0).
