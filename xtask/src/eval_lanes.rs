@@ -1,5 +1,6 @@
-//! `cargo xtask eval-lanes`: the lane tracker on real labelled frames (`fixtures/real/*/`), scored
-//! with the TuSimple and Aly rules of `nav_app::labelled`, per set and overall, ego lanes.
+//! `cargo xtask eval-lanes`: the lane tracker on real labelled frames (every set under the data
+//! root, `--data DIR`, default `../shared/data/lanes`: third-party, never in the repository), scored
+//! with the TuSimple and Aly rules of `lane_eval::labelled`, per set and overall, ego lanes.
 //!
 //! Every set is split once and for all: the first 70 % of its frames (in set order) are the
 //! **development** part, the rest the **held-out** part; the tracker's defaults may be tuned on the
@@ -16,11 +17,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use nav_app::labelled::{
+use lane_eval::labelled::{
     EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, ScoringRules,
     score_frame, track_label_set,
 };
-use nav_app::{Estimator, TrackerConfig};
+use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
 
 use crate::paths::workspace_root;
@@ -28,9 +29,10 @@ use crate::paths::workspace_root;
 /// Arguments of `cargo xtask eval-lanes`.
 #[derive(clap::Args, Debug)]
 pub struct EvalLanesArgs {
-    /// Directory of labelled sets (one sub-directory per set with a `labels.json`).
-    #[arg(long, default_value = "fixtures/real")]
-    sets: PathBuf,
+    /// Data root of labelled sets (one sub-directory per set with a `labels.json`); relative
+    /// paths are taken from the workspace root. Third-party data, never in the repository.
+    #[arg(long = "data", alias = "sets", default_value = "../shared/data/lanes")]
+    data: PathBuf,
     /// Configurations scored beside the default: preset names or TOML files.
     #[arg(long = "config", default_values_t = ["outdoor".to_owned(), "indoor".to_owned()])]
     configs: Vec<String>,
@@ -235,7 +237,15 @@ fn run_peer(root: &Path, set_dir: &Path, out: &Path) -> Result<Option<Vec<(u64, 
 /// Run `cargo xtask eval-lanes`.
 pub fn run(args: EvalLanesArgs) -> Result<()> {
     let root = workspace_root();
-    let sets_dir = resolve(&root, &args.sets);
+    let sets_dir = resolve(&root, &args.data);
+    if !sets_dir.is_dir() {
+        bail!(
+            "{}: missing the labelled lane sets (third-party evaluation data, not in the \
+             repository): put the shared data root beside the checkout as ../shared/data, or \
+             pass --data DIR",
+            sets_dir.display()
+        );
+    }
     let out = resolve(&root, &args.out);
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
     let sets = find_sets(&sets_dir)?;
@@ -244,7 +254,7 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
     let mut configs: Vec<(String, TrackerConfig)> =
         vec![(DEFAULT_NAME.to_owned(), TrackerConfig::default_preset()?)];
     for c in &args.configs {
-        configs.push((c.clone(), TrackerConfig::load(c)?));
+        configs.push((c.clone(), lane_io::config::load_tracker_config(c)?));
     }
 
     let mut summaries = Vec::new();

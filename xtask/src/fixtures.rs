@@ -6,9 +6,9 @@ use std::io::BufWriter;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use nav_app::GreyFrame;
-use nav_app::synth::{SCENES, SceneRenderer};
-use nav_app::y4m::{Y4mChroma, Y4mWriter};
+use lane_eval::synth::{SCENES, SceneRenderer};
+use lane_io::y4m::{Y4mChroma, Y4mWriter};
+use lane_tracker::GreyFrame;
 
 use crate::paths::workspace_root;
 

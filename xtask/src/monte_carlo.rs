@@ -4,7 +4,7 @@
 //! configs/paper.toml` (and for `scenarios`, `--dir configs/mismatch --matched
 //! configs/paper.toml`) and `--out-root target/monte-carlo`, each only where the arguments do
 //! not name it. Everything else is passed through unchanged; the Monte Carlo itself (driver,
-//! statistics, reports, figures) is the library `nav_app::ins_sd::monte_carlo`.
+//! statistics, reports, figures) is the library `ins_monte_carlo` (crate `ins-monte-carlo`).
 
 use std::ffi::OsString;
 use std::process::Command;
@@ -74,8 +74,6 @@ pub fn run(args: MonteCarloArgs) -> Result<()> {
             "-p",
             "nav-app",
             "--no-default-features",
-            "--features",
-            "cli",
         ])
         .status()
         .context("cannot run cargo build -p nav-app")?;

@@ -121,8 +121,6 @@ pub fn run(args: PythonArgs) -> Result<()> {
             "-p",
             "nav-app",
             "--no-default-features",
-            "--features",
-            "cli",
         ]),
         "cargo build -p nav-app (the binary the Python results are compared with)",
     )?;

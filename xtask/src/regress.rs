@@ -13,10 +13,10 @@ use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use nav_app::eval::{ContinuityScore, SequenceScore, continuity, run_tracker, score_sequence};
-use nav_app::synth::SequenceTruth;
-use nav_app::y4m::Y4mSource;
-use nav_app::{Estimator, TrackerConfig};
+use lane_eval::eval::{ContinuityScore, SequenceScore, continuity, run_tracker, score_sequence};
+use lane_eval::synth::SequenceTruth;
+use lane_io::y4m::Y4mSource;
+use lane_tracker::{Estimator, TrackerConfig};
 
 use crate::paths::workspace_root;
 
@@ -61,23 +61,15 @@ fn read_text(path: &Path) -> Result<Option<String>> {
     })?))
 }
 
-/// Real (unlabelled) sequences: the committed 30-frame copy, and the whole 221-frame clip when
-/// `../shared/data` is beside the checkout.
-fn real_sequences(root: &Path) -> Vec<(String, PathBuf)> {
-    let mut v = vec![(
-        "udacity_first30".to_owned(),
-        root.join("fixtures/udacity/solidWhiteRight-first30.y4m"),
-    )];
-    let full = root.join("../shared/data/udacity/solidWhiteRight-320x240-gray.y4m");
-    if full.exists() {
-        v.push(("udacity_full221".to_owned(), full));
-    } else {
-        println!(
-            "regress: note: {} absent, skipping the full udacity clip",
-            full.display()
-        );
-    }
-    v
+/// Real (unlabelled) sequences, read from the data root (`lane_eval::data`: `../shared/data`
+/// beside the checkout, or `$ITA_NAV_DATA`; third-party, never in the repository): the udacity
+/// clip's first 30 frames and all 221. A missing clip is an error naming it.
+fn real_sequences() -> Result<Vec<(String, PathBuf, Option<u64>)>> {
+    let clip = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP)?;
+    Ok(vec![
+        ("udacity_first30".to_owned(), clip.clone(), Some(30)),
+        ("udacity_full221".to_owned(), clip, None),
+    ])
 }
 
 pub fn run(args: RegressArgs) -> Result<()> {
@@ -123,7 +115,7 @@ pub fn run(args: RegressArgs) -> Result<()> {
                 .with_context(|| format!("cannot read {}", truth_path.display()))?,
         )
         .with_context(|| format!("cannot parse {}", truth_path.display()))?;
-        let cfg = TrackerConfig::load(&truth.config)?;
+        let cfg = lane_io::config::load_tracker_config(&truth.config)?;
         let mut source = open_y4m(y4m)?;
         let outcome = run_tracker(&mut source, &cfg, estimator, None)?;
         for bad in &outcome.bad_frames {
@@ -151,10 +143,10 @@ pub fn run(args: RegressArgs) -> Result<()> {
         "{:22} {:>8} {:>8} {:>8} {:>10} {:>8} {:>5}  acceptance",
         "real sequence", "frames", "both tr", "both rep", "median Δx", "max Δx", "inits"
     );
-    for (name, path) in real_sequences(&root) {
+    for (name, path, max_frames) in real_sequences()? {
         let cfg = TrackerConfig::outdoor()?;
         let mut source = open_y4m(&path)?;
-        let outcome = run_tracker(&mut source, &cfg, estimator, None)?;
+        let outcome = run_tracker(&mut source, &cfg, estimator, max_frames)?;
         let c = continuity(&outcome.reports, 239.0);
         let accept = c.frames_both_reported == c.frames
             && c.median_bottom_change_px <= ACCEPT_MEDIAN_CHANGE_PX;

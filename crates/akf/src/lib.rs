@@ -41,8 +41,8 @@
 //!   per-state floors ([`project_diagonal`]). Clipping raises the estimate, so time averages of the
 //!   projected Q̂ are biased upwards; the raw symmetrised estimate stays available.
 //! * Q̂ is noise over one *update interval*. The INS filter predicts in 100 steps of 0.01 s between
-//!   1 s updates; converting Q̂ to the per-step Q_d is the caller's choice, see [`interval`]
-//!   (Q_d ≈ Q̂/n, or the exact inverse of Q_T = Σ Φ Q_d Φᵀ).
+//!   1 s updates; it predicts once per interval with (Φ_T, Q_T) (crate `ins-sd-filter`, module
+//!   `interval`), so Q̂ is used as Q_T unchanged and no conversion to a per-step Q_d is needed.
 //!
 //! ### What the tests measured (toy 1-D constant velocity, both states measured, q = 0.5 m²/s³)
 //!
@@ -122,7 +122,6 @@
 mod adaptive;
 mod consistency;
 mod error;
-pub mod interval;
 mod kf;
 mod linalg;
 mod sage_husa;

@@ -1,5 +1,6 @@
-//! Real geometry: the labelled TuSimple-style frames in `tests/fixtures/lanenet` (copied from
-//! MaybeShewill-CV/lanenet-lane-detection, Apache-2.0, see the README there). The labelled
+//! Real geometry: the labelled TuSimple-style frames of MaybeShewill-CV/lanenet-lane-detection
+//! (Apache-2.0), read from the data root beside the checkout (`../shared/data/lanenet`, or
+//! `$ITA_NAV_DATA/lanenet`): third-party, never copied into the repository. The labelled
 //! pixels of all lanes of one slope sign are one side's candidate set, and the fitted parabola
 //! is scored against the ego lane's per-row centre line.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -9,10 +10,22 @@ use std::path::Path;
 
 use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, Point, init_lane};
 
-const DATA: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/tests/fixtures/lanenet/gt_instance_image"
-);
+/// `lanenet/gt_instance_image` under the data root; panics naming what is missing.
+fn data_dir() -> std::path::PathBuf {
+    let root = std::env::var_os("ITA_NAV_DATA").map_or_else(
+        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
+        std::path::PathBuf::from,
+    );
+    let dir = root.join("lanenet/gt_instance_image");
+    assert!(
+        dir.is_dir(),
+        "{}: missing evaluation data `lanenet/gt_instance_image` (third-party, not in the \
+         repository: put the shared data root beside the checkout as ../shared/data, or name it \
+         with ITA_NAV_DATA)",
+        dir.display()
+    );
+    dir
+}
 
 /// Pixels per instance grey level.
 fn instances(path: &Path) -> (u32, u32, BTreeMap<u8, Vec<Point>>) {
@@ -47,7 +60,7 @@ fn centre_line(points: &[Point]) -> BTreeMap<i64, f64> {
 #[test]
 fn labelled_ego_lanes_are_initialised_within_tusimple_tolerance() {
     for frame in 0..6 {
-        let (w, h, lanes) = instances(&Path::new(DATA).join(format!("{frame:04}.png")));
+        let (w, h, lanes) = instances(&data_dir().join(format!("{frame:04}.png")));
         let mut ws = HoughWorkspace::new(w as usize, h as usize, HoughParams::default()).unwrap();
         // (centre line, lowest row, chord dx/dy) per instance.
         let lines: Vec<(BTreeMap<i64, f64>, i64, f64)> = lanes

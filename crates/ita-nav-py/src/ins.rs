@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use ins_errors::strapdown::NavState;
-use nav_app::ins_sd::{Mode, Sample, Scenario, logs};
+use ins_sim::{Mode, Sample, Scenario, logs};
 
 use crate::NavError;
 
@@ -71,7 +71,7 @@ fn nav_dict<'py>(py: Python<'py>, s: &NavState) -> PyResult<Bound<'py, PyDict>> 
 
 /// The online INS/SD filter: `InsSdFilter(landmarks, initial, config=None, filter="kf",
 /// gate=None)` with a landmark table and an initial state in the TOML formats of
-/// `nav_app::ins_sd::logs` (what `export_run` writes), the filter settings of a scenario file
+/// `ins_sim::logs` (what `export_run` writes), the filter settings of a scenario file
 /// (`None`: the paper's), `filter` `"kf"` or `"akf"`, and an optional χ² gate probability per
 /// sighting.
 #[pyclass(module = "ita_nav")]
@@ -226,7 +226,7 @@ pub fn run_flight<'py>(
     let mode = mode_of(filter)?;
     let mut out = vec![Sample::default(); scenario.samples_per_run()];
     let outcome = py
-        .detach(|| nav_app::ins_sd::run(&scenario, mode, seed, &mut out))
+        .detach(|| ins_sim::run(&scenario, mode, seed, &mut out))
         .map_err(err)?;
     out.truncate(outcome.samples_written);
     let col3 = |f: fn(&Sample) -> [f64; 3]| -> Vec<Vec<f64>> {
@@ -266,8 +266,9 @@ pub fn run_flight<'py>(
 }
 
 /// The Monte Carlo of the paper (or of any scenario): `runs` flights per filter (default: the
-/// scenario's), run `i` seeded with `run_seed(seed, mode, i)` exactly as `cargo xtask monte-carlo`
-/// does (so the same runs), folded in run order by the same statistics (`nav_app::ins_sd::stats`).
+/// scenario's), run `i` seeded with `run_seed(seed, i)` exactly as `cargo xtask monte-carlo`
+/// does (so the same runs, through the same run loop `ins_sim::runs::run_range` and its exclusion
+/// rule), folded in run order by the same statistics (`ins_sim::stats`).
 /// Returns `{"runs", "seed", "t_s", "modes": {name: {"runs_used", "excluded", "rms_pos_3d_m",
 /// "rms_pos_h_m", "rms_pos_d_m", "mean_nees", "mean_nis", "final_rms_pos_3d_m",
 /// "final_rms_pos_h_m", "final_rms_pos_d_m", "final_pos_3d_m"}}}` with the per-second series as numpy
@@ -282,38 +283,34 @@ pub fn monte_carlo<'py>(
     seed: Option<u64>,
     filters: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use nav_app::ins_sd::stats::{ModeStats, RunSummary, first_non_finite, qi};
+    use ins_sim::runs::{closed_loop, run_range};
+    use ins_sim::stats::{Exclusion, ModeStats, RunSummary, qi};
     let scenario = load_scenario(config)?;
     let runs = runs.unwrap_or(scenario.monte_carlo.runs as u64);
     let seed = seed.unwrap_or(scenario.monte_carlo.seed);
     let names = filters.unwrap_or_else(|| vec!["standalone".into(), "kf".into(), "akf".into()]);
     let modes: Vec<Mode> = names.iter().map(|n| mode_of(n)).collect::<PyResult<_>>()?;
     let n = scenario.samples_per_run();
-    type Folded = (ModeStats, Vec<RunSummary>, Vec<(u64, f64, String)>);
-    let folded: Vec<Folded> = py.detach(|| {
-        let mut out = vec![Sample::default(); n];
-        modes
-            .iter()
-            .map(|&mode| {
-                let mut st = ModeStats::new(mode, n);
-                let (mut kept, mut excluded) = (Vec::new(), Vec::new());
-                for i in 0..runs {
-                    let s = nav_app::ins_sd::run_seed(seed, mode, i);
-                    match nav_app::ins_sd::run(&scenario, mode, s, &mut out) {
-                        Err(e) => excluded.push((i, f64::NAN, e.to_string())),
-                        Ok(_) => match first_non_finite(&out) {
-                            Some((t, what)) => excluded.push((i, t, format!("non-finite {what}"))),
-                            None => {
-                                st.push_run(&out);
-                                kept.push(RunSummary::of(mode, i, &out));
-                            }
-                        },
-                    }
-                }
-                (st, kept, excluded)
-            })
-            .collect()
-    });
+    type Folded = (ModeStats, Vec<RunSummary>, Vec<Exclusion>);
+    // The one Monte Carlo run loop (`ins_sim::runs::run_range`): the same seeds and the same
+    // exclusion rule as the Monte Carlo driver.
+    let folded: Vec<Folded> = py
+        .detach(|| {
+            let runner = closed_loop(&scenario, seed);
+            let mut out = vec![Sample::default(); n];
+            modes
+                .iter()
+                .map(|&mode| {
+                    let mut st = ModeStats::new(mode, n);
+                    let (mut kept, mut excluded) = (Vec::new(), Vec::new());
+                    run_range(&runner, mode, 0..runs, &mut out, |i, out, verdict| {
+                        verdict.fold(i, out, &mut st, &mut kept, &mut excluded);
+                    })?;
+                    Ok((st, kept, excluded))
+                })
+                .collect::<Result<Vec<_>, ins_sim::RunError>>()
+        })
+        .map_err(err)?;
     let d = PyDict::new(py);
     d.set_item("runs", runs)?;
     d.set_item("seed", seed)?;
@@ -332,11 +329,11 @@ pub fn monte_carlo<'py>(
         m.set_item("runs_used", st.runs_used)?;
         let ex: Vec<Bound<'py, PyDict>> = excluded
             .iter()
-            .map(|(i, t, why)| {
+            .map(|x| {
                 let e = PyDict::new(py);
-                e.set_item("run_index", i)?;
-                e.set_item("t_s", t)?;
-                e.set_item("reason", why)?;
+                e.set_item("run_index", x.run_index)?;
+                e.set_item("t_s", x.t_s.unwrap_or(f64::NAN))?;
+                e.set_item("reason", &x.reason)?;
                 Ok(e)
             })
             .collect::<PyResult<_>>()?;

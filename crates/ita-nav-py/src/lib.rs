@@ -1,11 +1,11 @@
 //! # ita_nav — the lane tracker and the INS/SD filter from Python
 //!
 //! A Python extension module (PyO3, built by maturin) over the library crates, not over the binary:
-//! [`nav_app::LaneTracker`] (directional gradient → Hough + least squares → Kalman information
+//! [`lane_tracker::LaneTracker`] (directional gradient → Hough + least squares → Kalman information
 //! filter, the lane paper's Fig. 1) on numpy frames, with the lane covariance and, given a camera,
 //! the ego lane in metres; and (module `ins`) the online INS/SD filter `InsSdFilter`
 //! (`ins-sd-filter`), `export_run`, `run_flight` and `monte_carlo` (the same runs and statistics,
-//! `nav_app::ins_sd::stats`, as `cargo xtask monte-carlo`).
+//! `ins_sim::stats`, as `cargo xtask monte-carlo`).
 //!
 //! ```python
 //! import numpy as np, ita_nav
@@ -41,8 +41,8 @@ use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use nav_app::camera::{CameraConfig, CameraModel};
-use nav_app::{Estimator, LaneReport, LaneTracker as RustTracker, NavError as RustNavError, Side};
+use lane_tracker::camera::CameraModel;
+use lane_tracker::{Estimator, LaneReport, LaneTracker as RustTracker, Side};
 
 pyo3::create_exception!(
     ita_nav,
@@ -51,20 +51,20 @@ pyo3::create_exception!(
     "A configuration, frame or tracking error from the Rust library (the message names the field, file or frame)."
 );
 
-fn nav_err(e: RustNavError) -> PyErr {
+fn nav_err(e: impl std::fmt::Display) -> PyErr {
     NavError::new_err(e.to_string())
 }
 
 /// The lane tracker (one per video stream). Frames must keep the size of the first one.
 #[pyclass(module = "ita_nav")]
 struct LaneTracker {
-    config: nav_app::TrackerConfig,
+    config: lane_tracker::TrackerConfig,
     estimator: Estimator,
     camera: Option<CameraModel>,
     tracker: Option<RustTracker>,
     grey: Vec<u8>,
     last_track_us: f64,
-    last_ego: Option<nav_app::camera::EgoLaneReport>,
+    last_ego: Option<lane_tracker::camera::EgoLaneReport>,
 }
 
 impl LaneTracker {
@@ -95,7 +95,7 @@ impl LaneTracker {
         data: Option<&[u8]>,
         width: usize,
         height: usize,
-    ) -> PyResult<nav_app::TrackReport> {
+    ) -> PyResult<lane_tracker::TrackReport> {
         // Split borrows: the grey buffer and the tracker are separate fields.
         self.tracker_for(width, height)?;
         let LaneTracker {
@@ -135,8 +135,8 @@ fn lane_dict<'py>(py: Python<'py>, l: &LaneReport) -> PyResult<Bound<'py, PyDict
     d.set_item(
         "side",
         match l.side {
-            nav_app::Side::Left => "left",
-            nav_app::Side::Right => "right",
+            lane_tracker::Side::Left => "left",
+            lane_tracker::Side::Right => "right",
         },
     )?;
     d.set_item("state", l.state.name())?;
@@ -157,11 +157,12 @@ impl LaneTracker {
     #[new]
     #[pyo3(signature = (config=None, estimator="kif", camera=None))]
     fn new(config: Option<&str>, estimator: &str, camera: Option<&str>) -> PyResult<Self> {
-        let config = nav_app::TrackerConfig::load(config.unwrap_or("default")).map_err(nav_err)?;
+        let config =
+            lane_io::config::load_tracker_config(config.unwrap_or("default")).map_err(nav_err)?;
         let camera = match camera {
             Some(c) => Some(
-                CameraConfig::load(c)
-                    .and_then(|c| c.model())
+                lane_io::config::load_camera_config(c)
+                    .and_then(|c| Ok(c.model()?))
                     .map_err(nav_err)?,
             ),
             None => None,
@@ -333,10 +334,10 @@ impl LaneTracker {
 /// one still image. An unreadable input or a corrupt frame raises `NavError`.
 #[pyfunction]
 fn read_frames<'py>(py: Python<'py>, path: &str) -> PyResult<Vec<Bound<'py, numpy::PyArray2<u8>>>> {
-    use nav_app::FrameSource;
+    use lane_io::FrameSource;
     let mut src =
-        nav_app::sources::open_input(std::path::Path::new(path), 25.0).map_err(nav_err)?;
-    let mut frame = nav_app::GreyFrame::default();
+        lane_io::sources::open_input(std::path::Path::new(path), 25.0).map_err(nav_err)?;
+    let mut frame = lane_tracker::GreyFrame::default();
     let mut out = Vec::new();
     while src.next_frame(&mut frame).map_err(nav_err)?.is_some() {
         let a = numpy::PyArray1::from_slice(py, frame.data());
@@ -350,7 +351,7 @@ fn read_frames<'py>(py: Python<'py>, path: &str) -> PyResult<Vec<Bound<'py, nump
 fn ita_nav(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("NavError", m.py().get_type::<NavError>())?;
-    m.add("DEFAULT_CONFIG_TOML", nav_app::DEFAULT_TOML)?;
+    m.add("DEFAULT_CONFIG_TOML", lane_tracker::DEFAULT_TOML)?;
     m.add_class::<LaneTracker>()?;
     m.add_function(wrap_pyfunction!(read_frames, m)?)?;
     m.add_class::<ins::InsSdFilter>()?;

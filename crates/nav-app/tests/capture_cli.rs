@@ -1,6 +1,5 @@
 //! `nav-app --device` without a capture device: the flags, errors, exit codes and the JSON summary.
 //! (The real-driver behaviour is tested in a VM by `cargo xtask vivid`.)
-#![cfg(feature = "cli")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::process::{Command, Output};

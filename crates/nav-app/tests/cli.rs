@@ -1,5 +1,4 @@
 //! The `nav-app` binary end to end: JSON schema, overlays, bad input and exit codes.
-#![cfg(feature = "cli")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::{Path, PathBuf};
@@ -49,12 +48,12 @@ fn json_output(o: &Output) -> (Vec<serde_json::Value>, serde_json::Value) {
 }
 
 #[test]
-fn with_no_input_it_runs_on_the_bundled_sample() {
+fn with_no_input_it_runs_on_the_rendered_sample() {
     let o = nav_app(&["--max-frames", "5"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let e = stderr(&o);
     assert!(
-        e.contains("bundled sample") && e.contains("5 frames"),
+        e.contains("rendered sample") && e.contains("5 frames"),
         "{e}"
     );
     assert!(o.stdout.is_empty(), "human output goes to stderr");
@@ -446,8 +445,8 @@ fn a_missing_input_names_the_file_and_its_os_error_once() {
 
 #[test]
 fn ins_replays_exported_logs_prints_truth_errors_and_names_bad_lines() {
-    use nav_app::ins_sd::logs::{self, names};
-    use nav_app::ins_sd::{Mode, Scenario};
+    use ins_sim::logs::{self, names};
+    use ins_sim::{Mode, Scenario};
     let dir = scratch("ins-replay");
     let sc = Scenario::paper_default().truncated(20.0).unwrap();
     let (_, records) = logs::export_run(&sc, Mode::Kf, 7, &dir).unwrap();

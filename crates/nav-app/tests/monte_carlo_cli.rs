@@ -1,13 +1,12 @@
 //! The Monte Carlo through the product binary, as a cluster would run it: shards written by
 //! separate `nav-app monte-carlo --shard i/n` processes and merged by `nav-app monte-carlo
 //! merge` equal one run over all indices; a missing scenario file is an error, not a fall-back.
-#![cfg(feature = "cli")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use nav_app::ins_sd::stats::{self, Stats};
+use ins_sim::stats::{self, Stats};
 
 fn nav_app(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_nav-app"))
@@ -92,13 +91,13 @@ fn three_shard_processes_merged_equal_one_run() {
     ok(&o);
 
     let (single, all) = (read_stats(&one), read_stats(&merged));
-    assert_eq!(all.shards.len(), 3);
+    assert_eq!(all.shards().len(), 3);
     assert!(stats::missing_ranges(&all).is_empty());
-    assert_eq!(all.runs_total, single.runs_total);
-    for (m, s) in all.modes.iter().zip(&single.modes) {
+    assert_eq!(all.runs_total(), single.runs_total());
+    for (m, s) in all.modes().iter().zip(single.modes()) {
         assert_eq!(
-            (&m.mode, m.runs_used, m.epochs),
-            (&s.mode, s.runs_used, s.epochs)
+            (m.mode, m.runs_used, m.steps),
+            (s.mode, s.runs_used, s.steps)
         );
         for (bm, bs) in m.bins.iter().zip(&s.bins) {
             for (x, y) in bm.iter().zip(bs) {

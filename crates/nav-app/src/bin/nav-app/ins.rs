@@ -11,7 +11,7 @@ use clap::Parser;
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app ins",
-    about = "Replays IMU and sighting logs through the INS/SD filter (formats: nav_app::ins_sd::logs)",
+    about = "Replays IMU and sighting logs through the INS/SD filter (formats: ins_sim::logs)",
     after_help = "All of --imu, --sightings, --landmarks, --init and --out are required (there is no \
                   bundled flight; `nav-app monte-carlo --export-logs DIR` writes one). \
                   --config defaults to configs/paper.toml.\n\n\
@@ -50,7 +50,7 @@ struct InsArgs {
 }
 
 fn run_ins(args: &InsArgs) -> Result<()> {
-    use nav_app::ins_sd::{Mode, Scenario, logs};
+    use ins_sim::{Mode, Scenario, logs};
     let text = std::fs::read_to_string(&args.config)
         .with_context(|| format!("reading {}", args.config.display()))?;
     let scenario = Scenario::from_toml_str(&text)

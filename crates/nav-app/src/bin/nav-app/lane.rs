@@ -1,36 +1,37 @@
 //! `nav-app [--input …]`: the lane tracker over one frame loop (files, directories, YUV4MPEG2
 //! streams, live capture), with the per-frame JSON, overlays and the metric ego lane.
 
-use std::io::{BufWriter, Cursor, Write};
+use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use bt848_capture::{InputSelect, PixelFormat, VideoStd};
 use clap::{Parser, ValueEnum};
-use nav_app::birdseye::BirdseyeView;
-use nav_app::camera::{CameraConfig, CameraModel, EgoLaneReport};
-use nav_app::capture_source::{
+use lane_eval::synth::{SCENES, SceneSource};
+use lane_io::birdseye::BirdseyeView;
+use lane_io::capture::{InputSelect, PixelFormat, VideoStd};
+use lane_io::capture_source::{
     self, CaptureMonitor, DeviceFrameInfo, DeviceOptions, DeviceSetup, DeviceStats,
     parse_control_spec,
 };
-use nav_app::frame_loop::{FrameLoop, Step, Tracked};
-use nav_app::overlay::{OverlaySink, render_overlay};
-use nav_app::sources::open_input;
-use nav_app::y4m::Y4mSource;
-use nav_app::{Estimator, FrameSource, LaneReport, LaneState, NavError, Side, TrackerConfig};
+use lane_io::frame_loop::{FrameLoop, Step, Tracked};
+use lane_io::overlay::{OverlaySink, render_overlay};
+use lane_io::sources::open_input;
+use lane_io::{FrameSource, LaneIoError};
+use lane_tracker::camera::{CameraModel, EgoLaneReport};
+use lane_tracker::{Estimator, LaneReport, LaneState, Side};
 use serde::Serialize;
 
-/// The bundled sample: first 30 frames of udacity's solidWhiteRight, 320×240 grey.
-const SAMPLE_Y4M: &[u8] =
-    include_bytes!("../../../../../fixtures/udacity/solidWhiteRight-first30.y4m");
-const SAMPLE_NAME: &str = "bundled sample (udacity solidWhiteRight, 30 frames, MIT)";
+/// The default input: a scene the project renders itself (`lane_eval::synth`, deterministic), a
+/// curved road with dashed marks, 320×240.
+const SAMPLE_SCENE: &str = "curve_left_dashed";
+const SAMPLE_NAME: &str = "rendered sample (scene curve_left_dashed, 320×240)";
 
 /// Shown at the end of `--help`.
 const AFTER_HELP: &str = "\
-With neither --input nor --device, nav-app tracks the bundled sample (30 real highway frames,
-udacity solidWhiteRight, MIT) with configs/default.toml.
+With neither --input nor --device, nav-app tracks a rendered sample (the project's own synthetic
+scene curve_left_dashed, 320×240, deterministic) with configs/default.toml.
 
 Damaged input: an undecodable image of a directory, a YUV4MPEG2 stream damaged where a FRAME
 header should be (the reader skips to the next FRAME marker) or a short last frame is reported,
@@ -146,11 +147,11 @@ struct DeviceArgs {
 
 fn parse_std(s: &str) -> Result<VideoStd, String> {
     s.parse()
-        .map_err(|e: bt848_capture::CaptureError| e.to_string())
+        .map_err(|e: lane_io::capture::CaptureError| e.to_string())
 }
 
 fn parse_wh(s: &str) -> Result<(u32, u32), String> {
-    bt848_capture::parse_size(s).map_err(|e| e.to_string())
+    lane_io::capture::parse_size(s).map_err(|e| e.to_string())
 }
 
 fn device_options(d: &DeviceArgs) -> Result<DeviceOptions> {
@@ -243,7 +244,7 @@ struct SummaryBody<'a> {
 struct RunStats {
     /// Frames tracked.
     frames: u64,
-    /// Frames of the input lost to damage (not delivered): see `NavError::lost_frames`.
+    /// Frames of the input lost to damage (not delivered): see `LaneIoError::lost_frames`.
     lost_frames: u64,
     /// Bytes of a stream skipped while resynchronising (and of short last frames).
     skipped_bytes: u64,
@@ -255,10 +256,14 @@ const EXIT_FRAMES_LOST: u8 = 5;
 fn open_source(args: &Args) -> Result<Box<dyn FrameSource>> {
     match &args.input {
         Some(p) => Ok(open_input(p, args.dir_fps)?),
-        None => Ok(Box::new(Y4mSource::new(
-            Cursor::new(SAMPLE_Y4M),
-            SAMPLE_NAME,
-        )?)),
+        None => {
+            let spec = SCENES
+                .iter()
+                .find(|s| s.name == SAMPLE_SCENE)
+                .copied()
+                .context("the rendered sample scene is missing from lane_eval::synth::SCENES")?;
+            Ok(Box::new(SceneSource::new(spec, 320, 240)))
+        }
     }
 }
 
@@ -274,9 +279,9 @@ fn lane_text(r: &LaneReport) -> String {
 /// Run the tracker, counting frames in `stats`. With `--device` the capture monitor is left in
 /// `monitor` (also when the run fails) for the summary.
 fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) -> Result<()> {
-    let cfg = TrackerConfig::load(&args.config)?;
+    let cfg = lane_io::config::load_tracker_config(&args.config)?;
     let camera: Option<CameraModel> = match &args.camera {
-        Some(c) => Some(CameraConfig::load(c)?.model()?),
+        Some(c) => Some(lane_io::config::load_camera_config(c)?.model()?),
         None => None,
     };
     let mut birdseye = match (&args.birdseye, &camera) {
@@ -399,14 +404,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         if let Some((dir, view, rgb)) = birdseye.as_mut() {
             view.render(frame, t, &report, ego.flatten(), rgb);
             let path = dir.join(format!("birdseye_{index:06}.png"));
-            image::save_buffer(
-                &path,
-                rgb,
-                view.width_px() as u32,
-                view.height_px() as u32,
-                image::ExtendedColorType::Rgb8,
-            )
-            .with_context(|| format!("cannot write {}", path.display()))?;
+            view.write_png(&path, rgb)?;
         }
         let states = [report.lanes[0].state, report.lanes[1].state];
         if !quiet && (states != last_states || stats.frames % 100 == 1) {
@@ -450,7 +448,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
 }
 
 /// The chain of an error as one line, each message once: a cause whose text its parent already
-/// shows (a `NavError::Io` renders its OS error and also returns it as its source) is left out.
+/// shows (a `LaneIoError::Io` renders its OS error and also returns it as its source) is left out.
 fn error_line(e: &anyhow::Error) -> String {
     let mut line = String::new();
     for cause in e.chain() {
@@ -468,9 +466,9 @@ fn error_line(e: &anyhow::Error) -> String {
 
 /// The documented exit code and `exit` name of a failed run.
 fn failure_kind(e: &anyhow::Error) -> (u8, &'static str) {
-    match e.downcast_ref::<NavError>() {
-        Some(NavError::DeviceGone { .. }) => (3, "device-gone"),
-        Some(NavError::CaptureTimeout { .. }) => (4, "timeout"),
+    match e.downcast_ref::<LaneIoError>() {
+        Some(LaneIoError::DeviceGone { .. }) => (3, "device-gone"),
+        Some(LaneIoError::CaptureTimeout { .. }) => (4, "timeout"),
         _ => (1, "error"),
     }
 }

@@ -1,7 +1,7 @@
 //! `nav-app`: the product binary — the lane tracker at the terminal (`lane.rs`), the INS/SD log
 //! replay (`nav-app ins`, `ins.rs`) and the INS/SD paper's Monte Carlo (`nav-app monte-carlo`,
 //! `monte_carlo.rs`). Each is a thin layer of argument parsing and printing over the library
-//! (`nav_app::lane`, `nav_app::ins_sd`, `nav_app::ins_sd::monte_carlo`).
+//! (`nav_app::lane`, crates `ins-sim` and `ins-monte-carlo`).
 //!
 //! ```text
 //! nav-app [--input PATH | --device PATH] [--config outdoor|indoor|FILE.toml] [--estimator kif|wrls]
@@ -34,7 +34,7 @@
 //! `nav-app ins --imu imu.csv --sightings sightings.csv --landmarks landmarks.toml --init
 //! initial.toml [--config configs/paper.toml] [--filter kf|akf] [--gate P] --out solution.csv
 //! [--truth truth.csv]` replays logs through the online filter (`ins_sd_filter`); the formats are
-//! in `nav_app::ins_sd::logs`, and `nav-app monte-carlo --export-logs DIR` writes a
+//! in `ins_sim::logs`, and `nav-app monte-carlo --export-logs DIR` writes a
 //! simulated run in them.
 //!
 //! ## The INS/SD Monte Carlo
@@ -42,7 +42,7 @@
 //! [--threads T] [--shard i/n] [--duration S] [--filters LIST] [--sweep KEY=V1,…]
 //! [--export-logs DIR]`, `nav-app monte-carlo merge DIR… [--out DIR] [--allow-partial]` and
 //! `nav-app monte-carlo scenarios [--dir configs/mismatch] [--matched configs/paper.toml]`:
-//! see `nav_app::ins_sd::monte_carlo` (outputs, statistics, shards on a cluster). The scenario
+//! see `ins_monte_carlo` (outputs, statistics, shards on a cluster). The scenario
 //! file is required to exist (`configs/paper.toml` in the current directory unless `--config`).
 //!
 //! Hidden test flags (for `cargo xtask vivid`, not in `--help`): `--format FOURCC` (only this

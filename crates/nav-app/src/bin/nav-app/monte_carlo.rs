@@ -1,5 +1,5 @@
 //! `nav-app monte-carlo`: the INS/SD paper's Monte Carlo from the product binary — argument
-//! parsing, the progress bar and the printed lines over `nav_app::ins_sd::monte_carlo`.
+//! parsing, the progress bar and the printed lines over `ins_monte_carlo`.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -8,10 +8,8 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use nav_app::ins_sd::Mode;
-use nav_app::ins_sd::monte_carlo::{
-    self as mc, Progress, RunOptions, report, scenarios, stats, sweep,
-};
+use ins_monte_carlo::{self as mc, Progress, RunOptions, report, scenarios, stats, sweep};
+use ins_sim::Mode;
 
 const AFTER_HELP: &str = "\
 With no options: the scenario configs/paper.toml in the current directory (an error if it is not
@@ -78,7 +76,7 @@ struct RunArgs {
     #[arg(long, value_name = "SECONDS")]
     duration: Option<f64>,
     /// Also write run 0 of the KF and the AKF as IMU/sighting/truth logs into DIR/kf and
-    /// DIR/akf, for `nav-app ins` (formats: nav_app::ins_sd::logs).
+    /// DIR/akf, for `nav-app ins` (formats: ins_sim::logs).
     #[arg(long, value_name = "DIR")]
     export_logs: Option<PathBuf>,
     /// Configurations to simulate, comma-separated, on the same flights (common random
@@ -227,7 +225,7 @@ fn simulate(a: &RunArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let (lo, hi) = stats::shard_range(r.runs, r.shard.index, r.shard.count);
+    let (lo, hi) = stats::shard_range(r.runs, r.shard.index, r.shard.count)?;
     eprintln!(
         "monte-carlo: {} runs{} × {} configurations × {} s, seed {}, {} thread(s), scenario {}",
         hi - lo,
@@ -264,13 +262,13 @@ fn simulate(a: &RunArgs) -> Result<()> {
 }
 
 fn print_done(out: &Path, st: &stats::Stats, full: bool) {
-    let (epochs, per_core, per_wall) = report::throughput(st);
+    let (steps, per_core, per_wall) = report::throughput(st);
     println!(
-        "monte-carlo: {epochs} epochs in {:.2} s wall: {per_core:.0} epochs/s per core, {per_wall:.0} epochs/s aggregate",
-        st.wall_s
+        "monte-carlo: {steps} INS steps in {:.2} s wall: {per_core:.0} steps/s per core, {per_wall:.0} steps/s aggregate",
+        st.wall_s()
     );
     if full {
-        for m in &st.modes {
+        for m in st.modes() {
             if let Some(last) = m.bins.last() {
                 println!(
                     "monte-carlo: {:<10} final 3-D RMS {:.1} m, horizontal RMS {:.1} m ({} runs used)",
@@ -281,10 +279,10 @@ fn print_done(out: &Path, st: &stats::Stats, full: bool) {
                 );
             }
         }
-        if !st.exclusions.is_empty() {
+        if !st.exclusions().is_empty() {
             println!(
                 "monte-carlo: {} run(s) excluded (see summary.md)",
-                st.exclusions.len()
+                st.exclusions().len()
             );
         }
         println!("monte-carlo: wrote {}", out.join("summary.md").display());
@@ -301,7 +299,8 @@ fn merge(a: &MergeArgs) -> Result<()> {
     let out = a.out.clone().unwrap_or_else(|| {
         a.out_root.join(format!(
             "merged-seed{}-runs{}",
-            merged.seed, merged.runs_total
+            merged.seed(),
+            merged.runs_total()
         ))
     });
     mc::write_outputs(&out, &merged, true)?;

@@ -1,0 +1,186 @@
+//! Writing the logs: navigation and solution rows, and the export of a simulated run
+//! ([`export_run`]) through a [`RunObserver`] that records what the closed loop sees.
+
+use super::*;
+
+pub(super) fn write_nav<W: Write + ?Sized>(
+    w: &mut W,
+    t_s: f64,
+    s: &NavState,
+) -> std::io::Result<()> {
+    let q = s.att_b_to_n.quaternion();
+    write!(
+        w,
+        "{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+        t_s,
+        s.pos.lat_rad,
+        s.pos.lon_rad,
+        s.pos.alt_m,
+        s.vel_ned_mps.x,
+        s.vel_ned_mps.y,
+        s.vel_ned_mps.z,
+        q.w,
+        q.i,
+        q.j,
+        q.k
+    )
+}
+
+/// Writes the solution row of the filter after an epoch at `t_s`.
+pub(super) fn write_solution<W: Write + ?Sized>(
+    w: &mut W,
+    t_s: f64,
+    filter: &InsSdFilter,
+) -> std::io::Result<()> {
+    write_nav(w, t_s, &filter.navigation_solution())?;
+    let sigma = |i: usize| filter.covariance().map_or(f64::NAN, |p| p[(i, i)].sqrt());
+    let r = filter.last_report();
+    let nis = r.nis.map(|v| format!("{v:e}")).unwrap_or_default();
+    writeln!(
+        w,
+        ",{:e},{:e},{:e},{nis},{},{}",
+        sigma(0),
+        sigma(1),
+        sigma(2),
+        r.used,
+        r.rejected
+    )
+}
+
+/// The observer that writes a simulated run as logs.
+pub(super) struct LogWriter {
+    pub(super) dir: PathBuf,
+    pub(super) imu: BufWriter<File>,
+    pub(super) sightings: BufWriter<File>,
+    pub(super) truth: BufWriter<File>,
+    pub(super) solution: BufWriter<File>,
+    pub(super) step_s: f64,
+    pub(super) initial: Option<InitialState>,
+    pub(super) error: Option<LogError>,
+}
+
+impl LogWriter {
+    pub(super) fn create(dir: &Path, step_s: f64) -> Result<Self, LogError> {
+        std::fs::create_dir_all(dir).map_err(io_err(dir))?;
+        let open = |name: &str, header: &str| -> Result<BufWriter<File>, LogError> {
+            let path = dir.join(name);
+            let mut w = BufWriter::new(File::create(&path).map_err(io_err(&path))?);
+            writeln!(w, "{header}").map_err(io_err(&path))?;
+            Ok(w)
+        };
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            imu: open(names::IMU, IMU_HEADER)?,
+            sightings: open(names::SIGHTINGS, SIGHTINGS_HEADER)?,
+            truth: open(names::TRUTH, TRUTH_HEADER)?,
+            solution: open(names::SOLUTION, SOLUTION_HEADER)?,
+            step_s,
+            initial: None,
+            error: None,
+        })
+    }
+
+    pub(super) fn keep(&mut self, name: &str, r: std::io::Result<()>) {
+        if let (Err(source), None) = (r, &self.error) {
+            self.error = Some(LogError::Io {
+                path: self.dir.join(name),
+                source,
+            });
+        }
+    }
+}
+
+impl RunObserver for LogWriter {
+    fn start(&mut self, initial: &NavState) {
+        self.initial = Some(InitialState::new(0.0, initial));
+    }
+
+    fn imu(&mut self, t_s: f64, f: &Vector3<f64>, w: &Vector3<f64>) {
+        let (dv, dth) = (f * self.step_s, w * self.step_s);
+        let r = writeln!(
+            self.imu,
+            "{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            t_s, dv.x, dv.y, dv.z, dth.x, dth.y, dth.z
+        );
+        self.keep(names::IMU, r);
+    }
+
+    fn epoch(&mut self, t_s: f64, sightings: &[Sighting], filter: &InsSdFilter) {
+        for s in sightings {
+            let r = writeln!(
+                self.sightings,
+                "{:e},{},{:e},{:e}",
+                t_s, s.landmark_id, s.w_m, s.h_m
+            );
+            self.keep(names::SIGHTINGS, r);
+        }
+        let r = write_solution(&mut self.solution, t_s, filter);
+        self.keep(names::SOLUTION, r);
+    }
+
+    fn truth(&mut self, t_s: f64, truth: &NavState) {
+        let r = write_nav(&mut self.truth, t_s, truth).and_then(|_| writeln!(self.truth));
+        self.keep(names::TRUTH, r);
+    }
+}
+
+pub(super) fn ser_err(path: &Path) -> impl Fn(toml::ser::Error) -> LogError + '_ {
+    move |e| LogError::Io {
+        path: path.to_path_buf(),
+        source: std::io::Error::other(e.to_string()),
+    }
+}
+
+pub(super) fn write_text(path: &Path, text: &str) -> Result<(), LogError> {
+    std::fs::write(path, text).map_err(io_err(path))
+}
+
+/// Simulates run `seed` of `scenario` in `mode` (a filter mode) and writes its logs into `dir`
+/// ([`names`]): IMU, sightings, truth, landmark table, initial state, the scenario, and the
+/// simulated filter's own solution. Returns the run's outcome and 1 Hz records.
+///
+/// # Errors
+/// [`LogError::Run`] when the simulation fails, [`LogError::Io`] when a file cannot be written.
+pub fn export_run(
+    scenario: &Scenario,
+    mode: Mode,
+    seed: u64,
+    dir: &Path,
+) -> Result<(SimRunOutcome, Vec<Sample>), LogError> {
+    let mut w = LogWriter::create(dir, scenario.trajectory.step_s)?;
+    let mut out = vec![Sample::default(); scenario.samples_per_run()];
+    let outcome = engine::run_observed(scenario, mode, seed, &mut out, &mut w)?;
+    if let Some(e) = w.error.take() {
+        return Err(e);
+    }
+    for (name, buf) in [
+        (names::IMU, &mut w.imu),
+        (names::SIGHTINGS, &mut w.sightings),
+        (names::TRUTH, &mut w.truth),
+        (names::SOLUTION, &mut w.solution),
+    ] {
+        buf.flush().map_err(io_err(&dir.join(name)))?;
+    }
+    let landmarks = LandmarkFile {
+        landmarks: engine::landmark_entries(scenario),
+    };
+    write_text(
+        &dir.join(names::LANDMARKS),
+        &format!(
+            "# Landmark table (WGS-84): id, latitude/longitude in degrees, height above the ellipsoid in m.\n{}",
+            toml::to_string(&landmarks).map_err(ser_err(&dir.join(names::LANDMARKS)))?
+        ),
+    )?;
+    if let Some(init) = &w.initial {
+        write_text(
+            &dir.join(names::INITIAL),
+            &format!(
+                "# Initial INS state: time s, latitude/longitude rad, height m, NED velocity m/s, body FRD -> NED quaternion (w, x, y, z).\n{}",
+                toml::to_string(init).map_err(ser_err(&dir.join(names::INITIAL)))?
+            ),
+        )?;
+    }
+    let path = dir.join(names::SCENARIO);
+    write_text(&path, &scenario.to_toml_string().map_err(ser_err(&path))?)?;
+    Ok((outcome, out))
+}

@@ -1,0 +1,259 @@
+//! Log replay: a simulated run exported as logs (`logs::export_run`) and replayed through the
+//! online filter (`logs::replay`, what `nav-app ins` runs) gives the simulated filter's solution
+//! to round-off; its errors against the exported truth are the Monte Carlo's records; malformed
+//! or truncated logs are errors naming file, line and column.
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::path::{Path, PathBuf};
+
+use ins_errors::error_model;
+use ins_sim::logs::{self, LogError, ReplayInputs, names};
+use ins_sim::{Mode, Scenario, run_seed};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ita-nav-replay-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
+    let text = std::fs::read_to_string(dir.join(names::SCENARIO)).unwrap();
+    let sc = Scenario::from_toml_str(&text).unwrap();
+    ReplayInputs {
+        imu: dir.join(names::IMU),
+        sightings: dir.join(names::SIGHTINGS),
+        landmarks: dir.join(names::LANDMARKS),
+        initial: dir.join(names::INITIAL),
+        config: sc.online_filter_config(mode),
+    }
+}
+
+fn replay_to(dir: &Path, inp: &ReplayInputs) -> Result<logs::ReplaySummary, LogError> {
+    let out_path = dir.join("solution_replayed.csv");
+    let mut out = std::io::BufWriter::new(std::fs::File::create(&out_path).unwrap());
+    logs::replay(inp, &mut out, &out_path)
+}
+
+#[test]
+fn replay_of_an_export_reproduces_the_run() {
+    // 260 s: open loop to 195 s, then feedback. KF and AKF (the AKF adapts from 11 s on).
+    let sc = Scenario::paper_default().truncated(260.0).unwrap();
+    for mode in [Mode::Kf, Mode::Akf] {
+        let dir = temp_dir(mode.name());
+        let seed = run_seed(sc.monte_carlo.seed, 3);
+        let (outcome, records) = logs::export_run(&sc, mode, seed, &dir).unwrap();
+        assert_eq!(outcome.samples_written, 261);
+        let inp = inputs(&dir, mode);
+        let summary = replay_to(&dir, &inp).unwrap();
+        assert_eq!(summary.imu_samples, 26_000);
+        assert_eq!(summary.epochs, 260);
+        assert_eq!(summary.sightings_used, 780);
+        let simulated = logs::read_solution(&dir.join(names::SOLUTION)).unwrap();
+        let replayed = logs::read_solution(&dir.join("solution_replayed.csv")).unwrap();
+        assert_eq!(simulated.len(), 260);
+        assert_eq!(replayed.len(), simulated.len());
+        let (mut dp, mut dpsi) = (0.0_f64, 0.0_f64);
+        for ((ta, a), (tb, b)) in simulated.iter().zip(&replayed) {
+            assert_eq!(ta, tb);
+            let d = error_model::error_state(a, b);
+            dp = dp.max(d.fixed_rows::<3>(0).norm());
+            dpsi = dpsi.max(d.fixed_rows::<3>(6).norm());
+        }
+        println!(
+            "{}: replay − simulation, max over 260 epochs: position {dp:.2e} m, attitude {dpsi:.2e} rad",
+            mode.name()
+        );
+        // Round-off: the IMU samples go through Δv = f·T_s and back Δv/T_s, the quaternion
+        // through its text form (measured: 0 m and ≤ 4e-18 rad).
+        assert!(dp < 1e-9, "position differs by {dp} m");
+        assert!(dpsi < 1e-15, "attitude differs by {dpsi} rad");
+        // With --truth: the errors of the replayed solution are the Monte Carlo's records (in
+        // feedback x̂ = 0 after each reset, so the navigation output is the INS itself).
+        let c = logs::compare_with_truth(&dir.join(names::TRUTH), &summary.solution).unwrap();
+        assert_eq!(c.matched, 260);
+        assert_eq!(c.last_t_s, 260.0);
+        for i in 0..3 {
+            let r = records[260].pos_err_ned_m[i];
+            assert!(
+                (c.last_pos_err_ned_m[i] - r).abs() < 1e-6,
+                "{}: axis {i}: {} vs {r}",
+                mode.name(),
+                c.last_pos_err_ned_m[i]
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+fn expect_parse(r: Result<logs::ReplaySummary, LogError>, file: &Path, line: usize, column: usize) {
+    match r {
+        Err(LogError::Parse {
+            path,
+            line: l,
+            column: c,
+            message,
+        }) => {
+            assert_eq!(path, file, "{message}");
+            assert_eq!((l, c), (line, column), "{message}");
+            let shown = format!(
+                "{}",
+                LogError::Parse {
+                    path,
+                    line: l,
+                    column: c,
+                    message
+                }
+            );
+            assert!(
+                shown.starts_with(&format!("{}:{line}:{column}: ", file.display())),
+                "{shown}"
+            );
+        }
+        other => panic!(
+            "expected a parse error at {}:{line}:{column}, got {other:?}",
+            file.display()
+        ),
+    }
+}
+
+#[test]
+fn malformed_and_truncated_logs_name_file_line_and_column() {
+    let sc = Scenario::paper_default().truncated(5.0).unwrap();
+    let dir = temp_dir("malformed");
+    logs::export_run(&sc, Mode::Kf, 1, &dir).unwrap();
+    let inp = inputs(&dir, Mode::Kf);
+    let imu_text = std::fs::read_to_string(&inp.imu).unwrap();
+    let lines: Vec<&str> = imu_text.lines().collect();
+
+    // A bad number in the third field of line 5 (the 4th sample).
+    let mut bad: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
+    let fields: Vec<&str> = lines[4].split(',').collect();
+    let col = fields[0].len() + fields[1].len() + 2 + 1;
+    bad[4] = format!(
+        "{},{},1.2.3,{}",
+        fields[0],
+        fields[1],
+        fields[3..].join(",")
+    );
+    let path = dir.join("imu_bad.csv");
+    std::fs::write(&path, bad.join("\n")).unwrap();
+    expect_parse(
+        replay_to(
+            &dir,
+            &ReplayInputs {
+                imu: path.clone(),
+                ..inp.clone()
+            },
+        ),
+        &path,
+        5,
+        col,
+    );
+
+    // Truncated in the middle of line 300: fewer fields than the header.
+    let cut = lines[..299].join("\n") + "\n" + &lines[299][..lines[299].len() / 3];
+    let path = dir.join("imu_cut.csv");
+    std::fs::write(&path, &cut).unwrap();
+    let last = cut.lines().last().unwrap().len();
+    expect_parse(
+        replay_to(
+            &dir,
+            &ReplayInputs {
+                imu: path.clone(),
+                ..inp.clone()
+            },
+        ),
+        &path,
+        300,
+        last + 1,
+    );
+
+    // A wrong header names its field.
+    let path = dir.join("imu_header.csv");
+    std::fs::write(&path, imu_text.replacen("dv_y_mps", "dvy", 1)).unwrap();
+    expect_parse(
+        replay_to(
+            &dir,
+            &ReplayInputs {
+                imu: path.clone(),
+                ..inp.clone()
+            },
+        ),
+        &path,
+        1,
+        "t_s,dv_x_mps,".len() + 1,
+    );
+
+    // A sighting of a landmark that is not in the table: the filter's error, with the line.
+    let s_text = std::fs::read_to_string(&inp.sightings).unwrap();
+    let mut s_lines: Vec<String> = s_text.lines().map(str::to_string).collect();
+    let row4 = s_lines[4].clone();
+    let f: Vec<&str> = row4.split(',').collect();
+    s_lines[4] = format!("{},{},{},{}", f[0], 7, f[2], f[3]);
+    let path = dir.join("sightings_bad.csv");
+    std::fs::write(&path, s_lines.join("\n")).unwrap();
+    match replay_to(
+        &dir,
+        &ReplayInputs {
+            sightings: path.clone(),
+            ..inp.clone()
+        },
+    ) {
+        Err(LogError::Filter {
+            path: p,
+            line,
+            source,
+        }) => {
+            assert_eq!(p, path);
+            // Line 5 is the first row of epoch 2 (lines 5–7): the error names the epoch's line.
+            assert_eq!(line, 5, "{source}");
+            assert!(
+                source.to_string().contains("unknown landmark id 7"),
+                "{source}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+
+    // A non-integer landmark id is a parse error at its column.
+    s_lines[4] = format!("{},{},{},{}", f[0], "x1", f[2], f[3]);
+    std::fs::write(&path, s_lines.join("\n")).unwrap();
+    expect_parse(
+        replay_to(
+            &dir,
+            &ReplayInputs {
+                sightings: path.clone(),
+                ..inp.clone()
+            },
+        ),
+        &path,
+        5,
+        f[0].len() + 2,
+    );
+
+    // The landmark table: an unknown key, reported with its TOML line.
+    let path = dir.join("landmarks_bad.toml");
+    let lm = std::fs::read_to_string(&inp.landmarks).unwrap();
+    std::fs::write(&path, lm.replacen("alt_m", "height_m", 1)).unwrap();
+    match replay_to(
+        &dir,
+        &ReplayInputs {
+            landmarks: path.clone(),
+            ..inp.clone()
+        },
+    ) {
+        Err(LogError::Parse {
+            path: p,
+            line,
+            message,
+            ..
+        }) => {
+            assert_eq!(p, path);
+            assert!(line > 1, "{line}");
+            assert!(message.contains("height_m"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

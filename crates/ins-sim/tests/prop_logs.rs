@@ -1,0 +1,297 @@
+//! Property tests of the INS/SD log readers (`ins_sim::logs`): IMU and sightings CSV,
+//! landmark table and initial state TOML. Mutated files (flipped bytes, truncation, inserted
+//! bytes, NaN/∞/huge or empty fields, duplicated or deleted lines) never panic and either replay
+//! or fail with an error naming the file, a line inside it and a column; valid files round-trip.
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use ins_sim::logs::{self, InitialState, LogError, ReplayInputs, names};
+use ins_sim::{Mode, Scenario};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngSeed};
+
+fn config() -> Config {
+    Config {
+        cases: 48,
+        failure_persistence: None,
+        rng_seed: RngSeed::Fixed(0x6c6f_6773),
+        ..Config::default()
+    }
+}
+
+/// A 6 s flight of the paper's scenario, exported once: the valid logs every case mutates.
+fn exported() -> &'static (PathBuf, Scenario) {
+    static DIR: OnceLock<(PathBuf, Scenario)> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let d = std::env::temp_dir().join(format!("ita-nav-prop-logs-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        let sc = Scenario::paper_default().truncated(6.0).unwrap();
+        logs::export_run(&sc, Mode::Kf, 11, &d).unwrap();
+        (d, sc)
+    })
+}
+
+#[derive(Debug, Clone)]
+enum Mutation {
+    FlipByte {
+        at: usize,
+        bit: u8,
+    },
+    Truncate {
+        at: usize,
+    },
+    Insert {
+        at: usize,
+        bytes: Vec<u8>,
+    },
+    Field {
+        line: usize,
+        field: usize,
+        value: &'static str,
+    },
+    DuplicateLine {
+        line: usize,
+    },
+    DeleteLine {
+        line: usize,
+    },
+}
+
+fn mutation() -> impl Strategy<Value = Mutation> {
+    prop_oneof![
+        (any::<usize>(), 0u8..8).prop_map(|(at, bit)| Mutation::FlipByte { at, bit }),
+        any::<usize>().prop_map(|at| Mutation::Truncate { at }),
+        (
+            any::<usize>(),
+            proptest::collection::vec(any::<u8>(), 1..12)
+        )
+            .prop_map(|(at, bytes)| Mutation::Insert { at, bytes }),
+        (
+            any::<usize>(),
+            0usize..8,
+            prop_oneof![
+                Just("nan"),
+                Just("inf"),
+                Just("-inf"),
+                Just("1e400"),
+                Just(""),
+                Just("x"),
+                Just("-1"),
+                Just("4294967296"),
+                Just("1e-320"),
+            ]
+        )
+            .prop_map(|(line, field, value)| Mutation::Field { line, field, value }),
+        any::<usize>().prop_map(|line| Mutation::DuplicateLine { line }),
+        any::<usize>().prop_map(|line| Mutation::DeleteLine { line }),
+    ]
+}
+
+fn apply(text: &[u8], m: &Mutation) -> Vec<u8> {
+    let mut v = text.to_vec();
+    let n = v.len().max(1);
+    match m {
+        Mutation::FlipByte { at, bit } => {
+            let i = at % n;
+            if i < v.len() {
+                v[i] ^= 1 << bit;
+            }
+        }
+        Mutation::Truncate { at } => v.truncate(at % n),
+        Mutation::Insert { at, bytes } => {
+            let i = at % n;
+            v.splice(i..i, bytes.iter().copied());
+        }
+        Mutation::Field { line, field, value } => {
+            let s = String::from_utf8_lossy(text).into_owned();
+            let mut lines: Vec<String> = s.lines().map(str::to_owned).collect();
+            let i = line % lines.len().max(1);
+            if let Some(l) = lines.get_mut(i) {
+                let mut fields: Vec<String> = l.split(',').map(str::to_owned).collect();
+                let f = field % fields.len();
+                fields[f] = (*value).to_owned();
+                *l = fields.join(",");
+            }
+            v = (lines.join("\n") + "\n").into_bytes();
+        }
+        Mutation::DuplicateLine { line } | Mutation::DeleteLine { line } => {
+            let s = String::from_utf8_lossy(text).into_owned();
+            let mut lines: Vec<String> = s.lines().map(str::to_owned).collect();
+            let i = line % lines.len().max(1);
+            if i < lines.len() {
+                if matches!(m, Mutation::DuplicateLine { .. }) {
+                    let l = lines[i].clone();
+                    lines.insert(i, l);
+                } else {
+                    lines.remove(i);
+                }
+            }
+            v = (lines.join("\n") + "\n").into_bytes();
+        }
+    }
+    v
+}
+
+/// The error names a file the replay reads (the mutated one, or — when damage in one file
+/// surfaces where another is applied — that one) and a line inside it (and, for a parse error,
+/// a column), once, at the start of its message.
+fn check_located(e: &LogError, inputs: &[PathBuf]) -> Result<(), TestCaseError> {
+    let shown = e.to_string();
+    let (p, line, column) = match e {
+        LogError::Parse {
+            path, line, column, ..
+        } => (path, Some(*line), Some(*column)),
+        LogError::Filter { path, line, .. } => (path, Some(*line), None),
+        LogError::Io { path, .. } => (path, None, None),
+        other => {
+            return Err(TestCaseError::fail(format!(
+                "unexpected error kind: {other}"
+            )));
+        }
+    };
+    prop_assert!(inputs.contains(p), "{shown}");
+    prop_assert!(shown.starts_with(&p.display().to_string()), "{shown}");
+    if let Some(line) = line {
+        let text = std::fs::read(p).unwrap();
+        let lines = text.split(|&b| b == b'\n').count() + 1;
+        prop_assert!(
+            line >= 1 && line <= lines,
+            "line {} of {}: {}",
+            line,
+            lines,
+            shown
+        );
+    }
+    if let Some(column) = column {
+        prop_assert!(column >= 1, "{shown}");
+    }
+    Ok(())
+}
+
+/// Replay with one of the files replaced by `bytes`; returns the files it read and the result.
+fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Result<(), LogError>) {
+    let (dir, sc) = exported();
+    std::fs::create_dir_all(case_dir).unwrap();
+    let mut inputs = ReplayInputs {
+        imu: dir.join(names::IMU),
+        sightings: dir.join(names::SIGHTINGS),
+        landmarks: dir.join(names::LANDMARKS),
+        initial: dir.join(names::INITIAL),
+        config: sc.online_filter_config(Mode::Kf),
+    };
+    let path = case_dir.join(which);
+    std::fs::write(&path, bytes).unwrap();
+    match which {
+        names::IMU => inputs.imu = path,
+        names::SIGHTINGS => inputs.sightings = path,
+        names::LANDMARKS => inputs.landmarks = path,
+        _ => inputs.initial = path,
+    }
+    let out = case_dir.join("solution.csv");
+    let mut w = std::io::BufWriter::new(std::fs::File::create(&out).unwrap());
+    let read = vec![
+        inputs.imu.clone(),
+        inputs.sightings.clone(),
+        inputs.landmarks.clone(),
+        inputs.initial.clone(),
+    ];
+    (read, logs::replay(&inputs, &mut w, &out).map(|_| ()))
+}
+
+fn case_dir(tag: &str) -> PathBuf {
+    exported().0.join(format!("case-{tag}"))
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn mutated_imu_logs_replay_or_name_file_line_and_column(m in mutation()) {
+        let text = std::fs::read(exported().0.join(names::IMU)).unwrap();
+        let bad = apply(&text, &m);
+        let (read, r) = replay_with(names::IMU, &bad, &case_dir("imu"));
+        if let Err(e) = r {
+            check_located(&e, &read)?;
+        }
+    }
+
+    #[test]
+    fn mutated_sighting_logs_replay_or_name_file_line_and_column(m in mutation()) {
+        let text = std::fs::read(exported().0.join(names::SIGHTINGS)).unwrap();
+        let bad = apply(&text, &m);
+        let (read, r) = replay_with(names::SIGHTINGS, &bad, &case_dir("sightings"));
+        if let Err(e) = r {
+            check_located(&e, &read)?;
+        }
+    }
+
+    #[test]
+    fn mutated_landmark_tables_load_or_name_file_line_and_column(m in mutation()) {
+        let text = std::fs::read(exported().0.join(names::LANDMARKS)).unwrap();
+        let bad = apply(&text, &m);
+        let dir = case_dir("landmarks");
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(names::LANDMARKS);
+        std::fs::write(&path, &bad).unwrap();
+        if let Err(e) = logs::read_landmarks(&path) {
+            check_located(&e, std::slice::from_ref(&path))?;
+        }
+    }
+
+    #[test]
+    fn mutated_initial_states_load_or_name_file_line_and_column(m in mutation()) {
+        let text = std::fs::read(exported().0.join(names::INITIAL)).unwrap();
+        let bad = apply(&text, &m);
+        let dir = case_dir("initial");
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(names::INITIAL);
+        std::fs::write(&path, &bad).unwrap();
+        if let Err(e) = logs::read_initial(&path) {
+            check_located(&e, std::slice::from_ref(&path))?;
+        }
+    }
+
+    #[test]
+    fn initial_states_round_trip(
+        t in -1e6f64..1e6, lat in -1.5f64..1.5, lon in -3.1f64..3.1, alt in -1e3f64..1e5,
+        v in proptest::array::uniform3(-300f64..300.0), q in proptest::array::uniform4(-1f64..1.0),
+    ) {
+        let s = InitialState { t_s: t, lat_rad: lat, lon_rad: lon, alt_m: alt, vel_ned_mps: v, att_quat_wxyz: q };
+        let dir = case_dir("roundtrip");
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(names::INITIAL);
+        std::fs::write(&path, toml::to_string(&s).unwrap()).unwrap();
+        prop_assert_eq!(logs::read_initial(&path).unwrap(), s);
+    }
+}
+
+#[test]
+fn a_duplicate_landmark_is_located_at_its_entry() {
+    let (dir, _) = exported();
+    let text = std::fs::read_to_string(dir.join(names::LANDMARKS)).unwrap();
+    let first = text.find("[[landmarks]]").unwrap();
+    let entry_end = text[first + 1..]
+        .find("[[landmarks]]")
+        .map_or(text.len(), |i| i + first + 1);
+    let doubled = format!("{text}\n{}", &text[first..entry_end]);
+    let d = case_dir("duplicate");
+    std::fs::create_dir_all(&d).unwrap();
+    let path = d.join(names::LANDMARKS);
+    std::fs::write(&path, &doubled).unwrap();
+    let e = logs::read_landmarks(&path).unwrap_err();
+    let LogError::Parse { line, .. } = &e else {
+        panic!("{e}")
+    };
+    let appended_at = text.lines().count() + 2;
+    assert!(
+        *line >= appended_at,
+        "located at line {line}, entry appended at {appended_at}: {e}"
+    );
+    assert!(
+        e.to_string().contains("twice") || e.to_string().to_lowercase().contains("duplicate"),
+        "{e}"
+    );
+}

@@ -1,0 +1,210 @@
+//! One tracking frame (gradient in the windows + point gathering + KIF, two lanes) and the
+//! paper's Table 1 stages, one thread.
+//!
+//! `cargo bench -p nav-app --bench track -- --warm-up-time 1 --measurement-time 3`
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::hint::black_box;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, init_lane};
+use info_filter::{ParabolaKif, ProcessNoise, RowNorm, ThetaCov};
+use lane_eval::synth::{SCENES, SceneRenderer};
+use lane_io::FrameSource;
+use lane_io::y4m::Y4mSource;
+use lane_tracker::{Estimator, GreyFrame, LaneTracker, Side, TrackerConfig};
+use nalgebra::{Matrix3, Vector3};
+use vision_gradient::{EdgeBuffer, EdgeClass, GradientDetector, GradientParams, GreyImage, Region};
+use wrls::{WrlsFast, WrlsPaper};
+
+fn udacity_frame() -> GreyFrame {
+    let path = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).unwrap();
+    let mut src = Y4mSource::new(
+        std::io::BufReader::new(std::fs::File::open(&path).unwrap()),
+        &path.display().to_string(),
+    )
+    .unwrap();
+    let mut frame = GreyFrame::default();
+    for _ in 0..10 {
+        src.next_frame(&mut frame).unwrap().unwrap();
+    }
+    frame
+}
+
+fn synthetic_frame(w: usize, h: usize) -> GreyFrame {
+    let mut r = SceneRenderer::new(SCENES[0], w, h);
+    let mut frame = GreyFrame::default();
+    r.render(3, &mut frame);
+    frame
+}
+
+fn tracking_frame(c: &mut Criterion) {
+    let cfg = TrackerConfig::outdoor().unwrap();
+    let mut group = c.benchmark_group("tracking_frame");
+    let cases = [
+        ("udacity_320x240", udacity_frame()),
+        ("synthetic_320x240", synthetic_frame(320, 240)),
+        ("synthetic_640x480", synthetic_frame(640, 480)),
+    ];
+    for (name, frame) in &cases {
+        for (est_name, est) in [("kif", Estimator::Kif), ("wrls", Estimator::Wrls)] {
+            let mut tracker = LaneTracker::new(&cfg, est, frame.width(), frame.height()).unwrap();
+            for _ in 0..5 {
+                tracker.track(frame).unwrap();
+            }
+            let r = tracker.track(frame).unwrap();
+            assert!(
+                !r.full_gradient,
+                "{name}: steady state must be a tracking frame"
+            );
+            group.bench_function(BenchmarkId::new(est_name, name), |b| {
+                b.iter(|| black_box(tracker.track(black_box(frame)).unwrap()));
+            });
+        }
+        // The KIF with sub-pixel mark centres and the measured R (`track.mark_centres`).
+        let mut centres = cfg;
+        centres.track.mark_centres = true;
+        let mut tracker =
+            LaneTracker::new(&centres, Estimator::Kif, frame.width(), frame.height()).unwrap();
+        for _ in 0..5 {
+            tracker.track(frame).unwrap();
+        }
+        assert!(!tracker.track(frame).unwrap().full_gradient, "{name}");
+        group.bench_function(BenchmarkId::new("kif_mark_centres", name), |b| {
+            b.iter(|| black_box(tracker.track(black_box(frame)).unwrap()));
+        });
+        // An initialisation frame: full-ROI gradient + Hough + LS (both lanes) + refinement.
+        let mut tracker =
+            LaneTracker::new(&cfg, Estimator::Kif, frame.width(), frame.height()).unwrap();
+        group.bench_function(BenchmarkId::new("init_frame", name), |b| {
+            b.iter(|| {
+                tracker.reset();
+                black_box(tracker.track(black_box(frame)).unwrap())
+            });
+        });
+    }
+    group.finish();
+}
+
+/// The paper's Table 1, per frame, on the udacity frame: directional gradient (full frame),
+/// Hough + LS (two lanes), KIF (two lanes, ≤ 150 points each), WRLS (paper N×N form and fast form).
+fn table1(c: &mut Criterion) {
+    let frame = udacity_frame();
+    let (w, h) = (frame.width(), frame.height());
+    let cfg = TrackerConfig::outdoor().unwrap();
+    let image = GreyImage::new(frame.data(), w, h, w).unwrap();
+    let det = GradientDetector::new(GradientParams {
+        min_edge_angle_deg: cfg.gradient.min_edge_angle_deg,
+        max_edge_angle_deg: cfg.gradient.max_edge_angle_deg,
+        threshold: vision_gradient::Threshold::Fixed {
+            min_magnitude: cfg.gradient.magnitude_threshold,
+        },
+    })
+    .unwrap();
+    let mut edges = EdgeBuffer::with_capacity(w * h);
+    let (top, bottom) = cfg.roi_rows(h);
+    let mut group = c.benchmark_group("table1");
+    group.bench_function("directional_gradient_full_frame", |b| {
+        b.iter(|| black_box(det.detect(&image, Region::Full, &mut edges, None).unwrap()));
+    });
+    det.detect(
+        &image,
+        Region::Rows {
+            row_start_px: top,
+            row_end_px: bottom,
+        },
+        &mut edges,
+        None,
+    )
+    .unwrap();
+    let pts = |class| -> Vec<(f32, f32)> {
+        edges
+            .iter_class(class)
+            .map(|p| (f32::from(p.col_px), f32::from(p.row_px)))
+            .collect()
+    };
+    let (left, right) = (pts(EdgeClass::LeftLane), pts(EdgeClass::RightLane));
+    let mut ws = HoughWorkspace::new(
+        w,
+        h,
+        HoughParams {
+            theta_step_deg: 1.0,
+            ..HoughParams::default()
+        },
+    )
+    .unwrap();
+    let ip = LaneInitParams {
+        band_px: 4.0,
+        min_points: 25,
+        refit_iterations: 2,
+    };
+    let (lb, rb) = (AngleBand::new(10.0, 75.0), AngleBand::new(-75.0, -10.0));
+    group.bench_function("hough_ls_two_lanes", |b| {
+        b.iter(|| {
+            black_box(init_lane(&left, &lb, &mut ws, &ip).unwrap());
+            black_box(init_lane(&right, &rb, &mut ws, &ip).unwrap());
+        });
+    });
+    let l_init = init_lane(&left, &lb, &mut ws, &ip).unwrap().parabola;
+    let r_init = init_lane(&right, &rb, &mut ws, &ip).unwrap().parabola;
+    // ≤ 150 points per lane, as the tracker gathers them.
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+    for _ in 0..3 {
+        tracker.track(&frame).unwrap();
+    }
+    let lp: Vec<(f32, f32)> = tracker.lane_view(Side::Left).points.to_vec();
+    let rp: Vec<(f32, f32)> = tracker.lane_view(Side::Right).points.to_vec();
+    let rn = RowNorm::new(
+        0.5 * (top + bottom - 1) as f64,
+        0.5 * (bottom - 1 - top) as f64,
+    )
+    .unwrap();
+    let p0 = ThetaCov::Normalised(Matrix3::identity() * 16.0);
+    let th = |p: hough_init::Parabola| Vector3::new(p.a1, p.a2, p.a3);
+    let q = ProcessNoise::new(&Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 2.25))).unwrap();
+    let mut kl = ParabolaKif::new(&th(l_init), &p0, rn).unwrap();
+    let mut kr = ParabolaKif::new(&th(r_init), &p0, rn).unwrap();
+    group.bench_function(
+        BenchmarkId::new("kif_two_lanes", format!("{}+{}pts", lp.len(), rp.len())),
+        |b| {
+            b.iter(|| {
+                kl.predict(&q).unwrap();
+                kl.update(black_box(&lp), 4.0).unwrap();
+                kr.predict(&q).unwrap();
+                kr.update(black_box(&rp), 4.0).unwrap();
+            });
+        },
+    );
+    let mut wl = WrlsPaper::new(&th(l_init), &p0, 0.7, rn, 150).unwrap();
+    let mut wr = WrlsPaper::new(&th(r_init), &p0, 0.7, rn, 150).unwrap();
+    group.bench_function(
+        BenchmarkId::new(
+            "wrls_paper_nxn_two_lanes",
+            format!("{}+{}pts", lp.len(), rp.len()),
+        ),
+        |b| {
+            b.iter(|| {
+                wl.update(black_box(&lp)).unwrap();
+                wr.update(black_box(&rp)).unwrap();
+            });
+        },
+    );
+    let mut fl = WrlsFast::new(&th(l_init), &p0, 0.7, rn).unwrap();
+    let mut fr = WrlsFast::new(&th(r_init), &p0, 0.7, rn).unwrap();
+    group.bench_function(
+        BenchmarkId::new(
+            "wrls_fast_two_lanes",
+            format!("{}+{}pts", lp.len(), rp.len()),
+        ),
+        |b| {
+            b.iter(|| {
+                fl.update(black_box(&lp)).unwrap();
+                fr.update(black_box(&rp)).unwrap();
+            });
+        },
+    );
+    group.finish();
+}
+
+criterion_group!(benches, tracking_frame, table1);
+criterion_main!(benches);

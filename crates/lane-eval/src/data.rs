@@ -1,0 +1,38 @@
+//! Where the third-party evaluation data lives. It is never part of the repository (it is not ours
+//! to redistribute): it is read from a data root, `../shared/data` beside the checkout by default
+//! or the directory named by the environment variable `ITA_NAV_DATA`, and a missing file is an
+//! error that says what is missing and where it was looked for.
+
+use std::path::{Path, PathBuf};
+
+use crate::EvalError;
+
+/// Environment variable naming the data root (instead of `../shared/data` beside the checkout).
+pub const DATA_ENV: &str = "ITA_NAV_DATA";
+
+/// The real udacity clip (221 frames, 320×240 grey YUV4MPEG2), relative to the data root.
+pub const UDACITY_CLIP: &str = "udacity/solidWhiteRight-320x240-gray.y4m";
+
+/// The labelled real lane sets, relative to the data root.
+pub const LANE_SETS: &str = "lanes";
+
+/// The data root: `$ITA_NAV_DATA`, else `<workspace>/../shared/data`.
+pub fn data_root() -> PathBuf {
+    match std::env::var_os(DATA_ENV) {
+        Some(dir) => PathBuf::from(dir),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
+    }
+}
+
+/// `relative` under the data root, or [`EvalError::MissingData`] naming it.
+pub fn data_file(relative: &str) -> Result<PathBuf, EvalError> {
+    let path = data_root().join(relative);
+    if path.exists() {
+        Ok(path)
+    } else {
+        Err(EvalError::MissingData {
+            path: path.display().to_string(),
+            what: relative.to_owned(),
+        })
+    }
+}

@@ -1,0 +1,88 @@
+//! The per-frame tracking path does not allocate (issue 4 §1): counted with the `alloc-counter`
+//! global allocator, which counts allocations made by the measuring thread only.
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use alloc_counter::allocations_in;
+use lane_eval::synth::{SCENES, SceneRenderer};
+use lane_tracker::{Estimator, GreyFrame, LaneTracker};
+
+#[global_allocator]
+static ALLOC: alloc_counter::CountingAllocator = alloc_counter::CountingAllocator::new();
+
+fn allocations_while_tracking(estimator: Estimator, scene: &str) -> (u64, u64) {
+    let spec = SCENES.iter().find(|s| s.name == scene).copied().unwrap();
+    let cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
+    let mut renderer = SceneRenderer::new(spec, 320, 240);
+    let mut tracker = LaneTracker::new(&cfg, estimator, 320, 240).unwrap();
+    let mut frame = GreyFrame::default();
+    let mut frames = 0;
+    let mut allocs = 0;
+    for i in 0..spec.frames {
+        renderer.render(i, &mut frame); // rendering may allocate (RNG, truth); not counted
+        let (report, n) = allocations_in(|| tracker.track(&frame));
+        report.unwrap();
+        allocs += n;
+        frames += 1;
+    }
+    (allocs, frames)
+}
+
+#[test]
+fn kif_tracking_and_reinitialisation_frames_do_not_allocate() {
+    // wall_recovery covers tracking, coasting, loss and Hough + LS re-initialisation.
+    for scene in ["straight_solid", "wall_recovery", "noise"] {
+        let (allocs, frames) = allocations_while_tracking(Estimator::Kif, scene);
+        assert!(frames > 20);
+        assert_eq!(
+            allocs, 0,
+            "{scene}: {allocs} allocations in {frames} frames"
+        );
+    }
+}
+
+#[test]
+fn wrls_tracking_frames_do_not_allocate() {
+    let (allocs, frames) = allocations_while_tracking(Estimator::Wrls, "wall_recovery");
+    assert!(frames > 20);
+    assert_eq!(allocs, 0, "{allocs} allocations in {frames} frames");
+}
+
+#[test]
+fn the_metric_step_does_not_allocate() {
+    // Tracking plus the ego lane in metres (covariances from the tracker, lane-geometry's
+    // estimate) on every frame of a sequence with loss and re-initialisation.
+    let camera = lane_tracker::camera::CameraConfig::preset("robot")
+        .expect("a preset")
+        .unwrap()
+        .model()
+        .unwrap();
+    let spec = SCENES
+        .iter()
+        .find(|s| s.name == "wall_recovery")
+        .copied()
+        .unwrap();
+    let cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
+    let mut renderer = SceneRenderer::new(spec, 320, 240);
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
+    let mut frame = GreyFrame::default();
+    let (mut allocs, mut with_ego) = (0, 0);
+    for i in 0..spec.frames {
+        renderer.render(i, &mut frame);
+        let (ego, n) = allocations_in(|| {
+            let report = tracker.track(&frame).unwrap();
+            camera.ego_lane(&tracker, &report)
+        });
+        allocs += n;
+        with_ego += u32::from(ego.is_some());
+    }
+    assert!(with_ego > 15, "{with_ego}");
+    assert_eq!(allocs, 0, "{allocs} allocations");
+}
+
+#[test]
+fn the_counter_sees_an_allocation() {
+    // Guards the guard: an allocation on the counting thread is counted.
+    let (v, allocations) = allocations_in(|| Vec::<u8>::with_capacity(17));
+    drop(v);
+    assert_eq!(allocations, 1);
+}

@@ -1,0 +1,649 @@
+//! Tracker configuration: TOML files and the `indoor` / `outdoor` presets.
+//!
+//! Every field carries its unit in its name or its doc. Unknown fields are refused
+//! (`deny_unknown_fields`) and [`TrackerConfig::validate`] names the first field out of range.
+
+use hough_init::{AngleBand, HoughError, HoughParams, LaneInitParams};
+use serde::{Deserialize, Serialize};
+use toml_config::TomlDoc;
+use vision_gradient::{GradientError, GradientParams, Threshold};
+
+use crate::TrackerError;
+
+/// The default configuration (`nav-app` with no `--config`), as shipped in `configs/default.toml`.
+pub const DEFAULT_TOML: &str = include_str!("../../../configs/default.toml");
+/// The `outdoor` preset (highway, strong light/shadow contrast), as shipped in `configs/outdoor.toml`.
+pub const OUTDOOR_TOML: &str = include_str!("../../../configs/outdoor.toml");
+/// The `indoor` preset (corridor floor lines, low contrast), as shipped in `configs/indoor.toml`.
+pub const INDOOR_TOML: &str = include_str!("../../../configs/indoor.toml");
+
+/// Stage I: directional gradient (3×3 Sobel; see the `vision-gradient` crate).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GradientConfig {
+    /// Threshold on the Sobel L1 magnitude `|gx| + |gy|`, grey levels (0..=2040; an ideal 45°
+    /// step of `h` grey levels gives `6h`). With the adaptive mode it is the floor. (Ranges of
+    /// this section are `vision_gradient::GradientParams::validate`'s: see [`Self::params`].)
+    pub magnitude_threshold: u16,
+    /// Adaptive threshold: keep this fraction of the in-band pixels of the searched region (the
+    /// `1 − f` quantile of their magnitudes, floored at `magnitude_threshold`), in (0, 1].
+    /// 0 disables it (fixed threshold).
+    pub adaptive_keep_fraction: f64,
+    /// Edge directions kept: the angle of the edge line from the image horizontal must lie in
+    /// [`min_edge_angle_deg`, `max_edge_angle_deg`], degrees (0 ≤ min < max ≤ 90). The Hough
+    /// search of each lane uses the matching band of line tilts from the vertical,
+    /// `±[90 − max, 90 − min]`.
+    pub min_edge_angle_deg: f64,
+    /// Upper limit of the edge-line angle band, degrees.
+    pub max_edge_angle_deg: f64,
+}
+
+/// Region of interest: the rows where lanes are looked for (the sky is not lane).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoiConfig {
+    /// First row of the ROI as a fraction of the image height (0 = top row), dimensionless in [0, 1).
+    pub top_row_fraction: f64,
+    /// One past the last ROI row as a fraction of the height (1 = down to the bottom row), in (top, 1].
+    pub bottom_row_fraction: f64,
+}
+
+/// Stage II: Hough + least-squares (re-)initialisation (see the `hough-init` crate). The ranges
+/// are `hough_init::HoughParams::validate`'s and `hough_init::LaneInitParams::validate`'s (see
+/// [`Self::hough_params`], [`Self::lane_params`]): one check, in the crate that uses the value.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitConfig {
+    /// Hough angle resolution, degrees ([0.01, 10]).
+    pub theta_step_deg: f64,
+    /// Hough distance resolution, px ([0.1, 50]).
+    pub rho_step_px: f64,
+    /// Half-width of the band around the Hough line whose pixels are fitted by LS, px ((0, 1000]).
+    pub band_half_width_px: f64,
+    /// Fewest pixels in the band for an initialisation to be accepted (≥ 3).
+    pub min_points: usize,
+    /// Refits of the LS parabola to the pixels within `band_half_width_px` of the previous fit
+    /// (follows a curved mark beyond the straight Hough band), 0..=10; 0 disables.
+    pub refit_iterations: u32,
+}
+
+impl GradientConfig {
+    /// The `vision-gradient` parameters this section stands for (`adaptive_keep_fraction` 0 →
+    /// fixed threshold; any other value is the adaptive mode's keep fraction, which
+    /// `GradientParams::validate` checks).
+    pub fn params(&self) -> GradientParams {
+        let threshold = if self.adaptive_keep_fraction == 0.0 {
+            Threshold::Fixed {
+                min_magnitude: self.magnitude_threshold,
+            }
+        } else {
+            Threshold::Adaptive {
+                keep_fraction: self.adaptive_keep_fraction,
+                min_magnitude: self.magnitude_threshold,
+            }
+        };
+        GradientParams {
+            min_edge_angle_deg: self.min_edge_angle_deg,
+            max_edge_angle_deg: self.max_edge_angle_deg,
+            threshold,
+        }
+    }
+
+    /// The Hough θ bands of the left and right lanes that match the edge-angle band: line tilts
+    /// from the vertical `±[90 − max, 90 − min]`.
+    pub fn hough_bands(&self) -> [AngleBand; 2] {
+        let lo = 90.0 - self.max_edge_angle_deg;
+        let hi = 90.0 - self.min_edge_angle_deg;
+        [AngleBand::new(lo, hi), AngleBand::new(-hi, -lo)]
+    }
+}
+
+impl InitConfig {
+    /// The `hough-init` accumulator parameters (peak smoothing and sub-bin refinement on).
+    pub fn hough_params(&self) -> HoughParams {
+        HoughParams {
+            theta_step_deg: self.theta_step_deg,
+            rho_step_px: self.rho_step_px,
+            ..HoughParams::default()
+        }
+    }
+
+    /// The `hough-init` least-squares parameters.
+    pub fn lane_params(&self) -> LaneInitParams {
+        LaneInitParams {
+            band_px: self.band_half_width_px,
+            min_points: self.min_points,
+            refit_iterations: self.refit_iterations,
+        }
+    }
+}
+
+/// A `vision-gradient` parameter error as the configuration field it came from.
+fn gradient_field(e: GradientError) -> TrackerError {
+    match e {
+        GradientError::InvalidParam {
+            field,
+            value,
+            requirement,
+        } => field_err(
+            match field {
+                "min_edge_angle_deg" => "gradient.min_edge_angle_deg",
+                "max_edge_angle_deg" => "gradient.max_edge_angle_deg",
+                "threshold.keep_fraction" => "gradient.adaptive_keep_fraction",
+                _ => "gradient.magnitude_threshold",
+            },
+            value,
+            requirement,
+        ),
+        other => TrackerError::Gradient(other),
+    }
+}
+
+/// A `hough-init` parameter error as the configuration field it came from.
+fn init_field(e: HoughError) -> TrackerError {
+    match e {
+        HoughError::InvalidParam {
+            field,
+            value,
+            reason,
+        } => field_err(
+            match field {
+                "theta_step_deg" => "init.theta_step_deg",
+                "rho_step_px" => "init.rho_step_px",
+                "band_px" => "init.band_half_width_px",
+                "min_points" => "init.min_points",
+                _ => "init.refit_iterations",
+            },
+            value,
+            reason,
+        ),
+        HoughError::InvalidBand {
+            min_deg,
+            max_deg,
+            reason,
+        } => field_err(
+            "gradient.min_edge_angle_deg",
+            format!("(Hough band [{min_deg}, {max_deg}]°)"),
+            reason,
+        ),
+        other => TrackerError::Hough(other),
+    }
+}
+
+/// Stage III: windows of interest, point gathering, gates and re-initialisation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackConfig {
+    /// Half-width of the window of interest around the predicted parabola, px (> 0), at every row.
+    pub window_half_width_px: usize,
+    /// Most points per lane per frame fed to the filter, spread over the rows (paper: 150), 3..=1000.
+    pub max_points_per_lane: usize,
+    /// Inside the window, pixels farther than this from the midhinge residual (mean of the quartiles) of their third of
+    /// the ROI rows are dropped as clutter before the update, px (> 0).
+    pub inlier_half_width_px: f64,
+    /// A tracked lane with fewer points than this in a frame misses that frame (≥ 3).
+    pub reinit_min_points: usize,
+    /// Consecutive missed frames after which a lane is declared lost and re-initialised (≥ 1).
+    pub lost_after_frames: u32,
+    /// Gate: an update moving the lane by more than this (px, at the top or bottom ROI row) from
+    /// its prediction is rejected (> 0; counts as a missed frame).
+    pub max_jump_px: f64,
+    /// Left and right lanes must stay at least this far apart at the middle and bottom ROI rows
+    /// (and in order at the top row), px (≥ 0).
+    pub min_lane_separation_px: f64,
+    /// `true`: measure one sub-pixel mark centre per row (or the sub-pixel position of a single
+    /// step edge) and give the KIF the measured point scatter as `R` (an addition beyond the
+    /// paper, crate docs "Mark centres"); `false` (default when absent): the paper's integer
+    /// edge pixels with `R = filter.r_sigma_px²·I`.
+    #[serde(default)]
+    pub mark_centres: bool,
+}
+
+/// Filter noise models (KIF and WRLS).
+///
+/// The filters' coefficients are expressed internally in a normalised row coordinate
+/// `u = (y − y_c)/s`, with `y_c` the middle ROI row and `s` half the ROI height, so that
+/// `x = b1·u² + b2·u + b3` with `b1`, `b2`, `b3` all in pixels over `u ∈ [−1, 1]`. Q and P0 are
+/// given as standard deviations of those coefficients and mapped to the paper's pixel
+/// coefficients `(a1, a2, a3)` by the linear map between the two parameterisations.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilterConfig {
+    /// Random-walk standard deviation per frame of `(b1, b2, b3)`, px/frame (each > 0). Q = diag(σ²).
+    pub q_sigma_px: [f64; 3],
+    /// Standard deviation of one pixel measurement (column of an edge pixel about the lane), px (> 0).
+    /// R = σ²·I; with `track.mark_centres` the KIF estimates R from the points instead and uses
+    /// this only for frames with fewer than 8 points.
+    pub r_sigma_px: f64,
+    /// Initial standard deviation of `(b1, b2, b3)` after an initialisation, px (each > 0).
+    pub p0_sigma_px: [f64; 3],
+    /// WRLS forgetting factor per frame, in (0, 1] (paper: 0.70).
+    pub wrls_lambda: f64,
+}
+
+/// The whole tracker configuration (one TOML file).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackerConfig {
+    /// Stage I.
+    pub gradient: GradientConfig,
+    /// Rows searched.
+    pub roi: RoiConfig,
+    /// Stage II.
+    pub init: InitConfig,
+    /// Stage III.
+    pub track: TrackConfig,
+    /// Noise models.
+    pub filter: FilterConfig,
+}
+
+fn field_err(field: &'static str, value: impl std::fmt::Display, reason: &str) -> TrackerError {
+    TrackerError::ConfigField {
+        field,
+        value: value.to_string(),
+        reason: reason.to_owned(),
+    }
+}
+
+fn check(
+    ok: bool,
+    field: &'static str,
+    value: impl std::fmt::Display,
+    reason: &str,
+) -> Result<(), TrackerError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(field_err(field, value, reason))
+    }
+}
+
+/// Parse `text` (file `name`) with the workspace's one TOML loader and validate it: every error
+/// is a [`TrackerError::ConfigFile`] naming the file, line and column — syntax, unknown, missing or
+/// mistyped keys, and the first field out of range (located at its key). Shared by every lane
+/// configuration file (tracker, camera).
+pub(crate) fn parse_validated<T: serde::de::DeserializeOwned>(
+    name: &str,
+    text: &str,
+    validate: impl FnOnce(&T) -> Result<(), TrackerError>,
+) -> Result<T, TrackerError> {
+    let doc = TomlDoc::parse(name, text).map_err(TrackerError::ConfigFile)?;
+    let cfg: T = doc.deserialize().map_err(TrackerError::ConfigFile)?;
+    validate(&cfg).map_err(|e| match e {
+        TrackerError::ConfigField {
+            field,
+            value,
+            reason,
+        } => {
+            TrackerError::ConfigFile(doc.error_at(field, format!("`{field}` = {value}: {reason}")))
+        }
+        other => other,
+    })?;
+    Ok(cfg)
+}
+
+impl TrackerConfig {
+    /// The default configuration (`configs/default.toml`): what `nav-app` runs with no
+    /// `--config`, meant to need no preset on roads and indoor floors alike.
+    pub fn default_preset() -> Result<Self, TrackerError> {
+        Self::from_toml_str("preset default", DEFAULT_TOML)
+    }
+
+    /// The `outdoor` preset.
+    pub fn outdoor() -> Result<Self, TrackerError> {
+        Self::from_toml_str("preset outdoor", OUTDOOR_TOML)
+    }
+
+    /// The `indoor` preset.
+    pub fn indoor() -> Result<Self, TrackerError> {
+        Self::from_toml_str("preset indoor", INDOOR_TOML)
+    }
+
+    /// Parse and validate TOML text; `name` (the file path) is used in errors. Every error is a
+    /// [`TrackerError::ConfigFile`] naming `name`, the line and the column: syntax, unknown, missing
+    /// or mistyped keys, and fields out of range (located at their key).
+    pub fn from_toml_str(name: &str, text: &str) -> Result<Self, TrackerError> {
+        parse_validated(name, text, Self::validate)
+    }
+
+    /// Names of the compiled-in presets, for [`Self::preset`].
+    pub const PRESETS: [&'static str; 3] = ["default", "outdoor", "indoor"];
+
+    /// The preset `name` (`default`, `outdoor`, `indoor`), or `None` for any other name (a file
+    /// path, for `lane-io` to read).
+    pub fn preset(name: &str) -> Option<Result<Self, TrackerError>> {
+        match name {
+            "default" => Some(Self::default_preset()),
+            "outdoor" => Some(Self::outdoor()),
+            "indoor" => Some(Self::indoor()),
+            _ => None,
+        }
+    }
+
+    /// Check every field's range; the error names the first offending field.
+    pub fn validate(&self) -> Result<(), TrackerError> {
+        // Stage I and II: the component crates' own checks, named by the TOML key.
+        let g = &self.gradient;
+        g.params().validate().map_err(gradient_field)?;
+        for band in g.hough_bands() {
+            band.validate().map_err(init_field)?;
+        }
+        self.init.hough_params().validate().map_err(init_field)?;
+        self.init.lane_params().validate().map_err(init_field)?;
+        let r = &self.roi;
+        check(
+            (0.0..1.0).contains(&r.top_row_fraction),
+            "roi.top_row_fraction",
+            r.top_row_fraction,
+            "must be in [0, 1)",
+        )?;
+        check(
+            r.bottom_row_fraction > r.top_row_fraction && r.bottom_row_fraction <= 1.0,
+            "roi.bottom_row_fraction",
+            r.bottom_row_fraction,
+            "must be in (top_row_fraction, 1]",
+        )?;
+        let t = &self.track;
+        check(
+            (1..=200).contains(&t.window_half_width_px),
+            "track.window_half_width_px",
+            t.window_half_width_px,
+            "must be in 1..=200 px",
+        )?;
+        check(
+            t.inlier_half_width_px > 0.0 && t.inlier_half_width_px.is_finite(),
+            "track.inlier_half_width_px",
+            t.inlier_half_width_px,
+            "must be finite and > 0 px",
+        )?;
+        check(
+            (3..=1000).contains(&t.max_points_per_lane),
+            "track.max_points_per_lane",
+            t.max_points_per_lane,
+            "must be in 3..=1000",
+        )?;
+        check(
+            t.reinit_min_points >= 3 && t.reinit_min_points <= t.max_points_per_lane,
+            "track.reinit_min_points",
+            t.reinit_min_points,
+            "must be in 3..=max_points_per_lane",
+        )?;
+        check(
+            t.lost_after_frames >= 1,
+            "track.lost_after_frames",
+            t.lost_after_frames,
+            "must be ≥ 1",
+        )?;
+        check(
+            t.max_jump_px > 0.0 && t.max_jump_px.is_finite(),
+            "track.max_jump_px",
+            t.max_jump_px,
+            "must be finite and > 0 px",
+        )?;
+        check(
+            t.min_lane_separation_px >= 0.0 && t.min_lane_separation_px.is_finite(),
+            "track.min_lane_separation_px",
+            t.min_lane_separation_px,
+            "must be finite and ≥ 0 px",
+        )?;
+        let f = &self.filter;
+        check(
+            f.q_sigma_px.iter().all(|s| s.is_finite() && *s > 0.0),
+            "filter.q_sigma_px",
+            format!("{:?}", f.q_sigma_px),
+            "each must be finite and > 0 px/frame",
+        )?;
+        check(
+            f.r_sigma_px.is_finite() && f.r_sigma_px > 0.0,
+            "filter.r_sigma_px",
+            f.r_sigma_px,
+            "must be finite and > 0 px",
+        )?;
+        check(
+            f.p0_sigma_px.iter().all(|s| s.is_finite() && *s > 0.0),
+            "filter.p0_sigma_px",
+            format!("{:?}", f.p0_sigma_px),
+            "each must be finite and > 0 px",
+        )?;
+        check(
+            f.wrls_lambda > 0.0 && f.wrls_lambda <= 1.0,
+            "filter.wrls_lambda",
+            f.wrls_lambda,
+            "must be in (0, 1]",
+        )?;
+        Ok(())
+    }
+
+    /// Multiply every pixel-valued parameter by `k` (> 0): the presets are tuned for 320-px-wide
+    /// frames, so a 1280-px frame takes `k = 4`. Scaled: window and inlier half-widths, jump
+    /// gate, lane separation, Hough band, R, Q and P0 standard deviations. Not scaled: the
+    /// gradient threshold (grey levels), fractions, angles, counts.
+    pub fn scale_pixels(&mut self, k: f64) {
+        let t = &mut self.track;
+        t.window_half_width_px = ((t.window_half_width_px as f64 * k).round() as usize).max(1);
+        t.inlier_half_width_px *= k;
+        t.max_jump_px *= k;
+        t.min_lane_separation_px *= k;
+        self.init.band_half_width_px *= k;
+        let f = &mut self.filter;
+        f.r_sigma_px *= k;
+        f.q_sigma_px = f.q_sigma_px.map(|q| q * k);
+        f.p0_sigma_px = f.p0_sigma_px.map(|q| q * k);
+    }
+
+    /// The ROI row range `[top, bottom)` for an image `height_px` rows high (at least 3 rows).
+    pub fn roi_rows(&self, height_px: usize) -> (usize, usize) {
+        let top = ((self.roi.top_row_fraction * height_px as f64).floor() as usize)
+            .min(height_px.saturating_sub(3));
+        let bottom = ((self.roi.bottom_row_fraction * height_px as f64).ceil() as usize)
+            .clamp(top + 3, height_px.max(top + 3));
+        (top, bottom.min(height_px))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_parse_and_validate() {
+        let out = TrackerConfig::outdoor().unwrap();
+        let ind = TrackerConfig::indoor().unwrap();
+        assert!(ind.gradient.magnitude_threshold < out.gradient.magnitude_threshold);
+        assert_eq!(TrackerConfig::preset("outdoor").unwrap().unwrap(), out);
+    }
+
+    #[test]
+    fn unknown_field_is_refused_naming_it() {
+        let text = OUTDOOR_TOML.replace("[track]", "[track]\nwindow_width = 3");
+        let err = TrackerConfig::from_toml_str("x.toml", &text).unwrap_err();
+        let msg = err.to_string();
+        let line = 1 + text[..text.find("window_width").unwrap()]
+            .matches('\n')
+            .count();
+        match &err {
+            TrackerError::ConfigFile(e) => {
+                assert_eq!(
+                    (e.path.as_str(), e.line, e.column),
+                    ("x.toml", Some(line), Some(1))
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(
+            msg.starts_with(&format!("x.toml:{line}:1: unknown field `window_width`")),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn missing_field_is_refused_naming_it() {
+        let text: String = OUTDOOR_TOML
+            .lines()
+            .filter(|l| !l.starts_with("r_sigma_px"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let msg = TrackerConfig::from_toml_str("x.toml", &text)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("r_sigma_px"), "{msg}");
+    }
+
+    #[test]
+    fn an_out_of_range_field_in_a_file_names_the_file_line_and_column() {
+        let text = OUTDOOR_TOML.replace("r_sigma_px = 2.0", "r_sigma_px = -2.0");
+        let line = 1 + text[..text.find("r_sigma_px = -2.0").unwrap()]
+            .matches('\n')
+            .count();
+        let msg = TrackerConfig::from_toml_str("cfg/bad.toml", &text)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            msg,
+            format!("cfg/bad.toml:{line}:1: `filter.r_sigma_px` = -2: must be finite and > 0 px")
+        );
+    }
+
+    #[test]
+    fn each_out_of_range_field_is_named() {
+        type Edit = fn(&mut TrackerConfig);
+        let cases: &[(&str, Edit)] = &[
+            ("gradient.magnitude_threshold", |c| {
+                c.gradient.magnitude_threshold = 3000
+            }),
+            ("gradient.adaptive_keep_fraction", |c| {
+                c.gradient.adaptive_keep_fraction = -0.1
+            }),
+            ("gradient.min_edge_angle_deg", |c| {
+                c.gradient.min_edge_angle_deg = -1.0
+            }),
+            ("gradient.max_edge_angle_deg", |c| {
+                c.gradient.max_edge_angle_deg = 5.0
+            }),
+            ("roi.top_row_fraction", |c| c.roi.top_row_fraction = 1.0),
+            ("roi.bottom_row_fraction", |c| {
+                c.roi.bottom_row_fraction = 0.1
+            }),
+            ("init.theta_step_deg", |c| c.init.theta_step_deg = 0.0),
+            ("init.rho_step_px", |c| c.init.rho_step_px = 51.0),
+            ("init.band_half_width_px", |c| {
+                c.init.band_half_width_px = f64::INFINITY
+            }),
+            ("init.min_points", |c| c.init.min_points = 2),
+            ("init.refit_iterations", |c| c.init.refit_iterations = 11),
+            ("track.inlier_half_width_px", |c| {
+                c.track.inlier_half_width_px = 0.0
+            }),
+            ("track.window_half_width_px", |c| {
+                c.track.window_half_width_px = 0
+            }),
+            ("track.max_points_per_lane", |c| {
+                c.track.max_points_per_lane = 2
+            }),
+            ("track.reinit_min_points", |c| {
+                c.track.reinit_min_points = 2000
+            }),
+            ("track.lost_after_frames", |c| c.track.lost_after_frames = 0),
+            ("track.max_jump_px", |c| c.track.max_jump_px = -1.0),
+            ("track.min_lane_separation_px", |c| {
+                c.track.min_lane_separation_px = f64::NAN
+            }),
+            ("filter.q_sigma_px", |c| c.filter.q_sigma_px[1] = 0.0),
+            ("filter.r_sigma_px", |c| c.filter.r_sigma_px = 0.0),
+            ("filter.p0_sigma_px", |c| c.filter.p0_sigma_px[2] = f64::NAN),
+            ("filter.wrls_lambda", |c| c.filter.wrls_lambda = 1.5),
+        ];
+        for (field, edit) in cases {
+            let mut cfg = TrackerConfig::outdoor().unwrap();
+            cfg.validate().unwrap();
+            edit(&mut cfg);
+            match cfg.validate() {
+                Err(TrackerError::ConfigField { field: f, .. }) => assert_eq!(f, *field),
+                other => panic!("{field}: expected a field error, got {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn the_configuration_and_the_components_agree_on_every_stage_one_and_two_range() {
+        // A value the configuration accepts is one the tracker's components accept, and the
+        // other way round: the ranges are checked once, by the crates that use the values.
+        let values = [
+            -1.0, 0.0, 0.005, 0.01, 0.5, 5.0, 10.0, 10.5, 45.0, 50.0, 89.0, 90.0, 1e4,
+        ];
+        type Set = fn(&mut TrackerConfig, f64);
+        let fields: &[(&str, Set)] = &[
+            ("theta_step_deg", |c, v| c.init.theta_step_deg = v),
+            ("rho_step_px", |c, v| c.init.rho_step_px = v),
+            ("band_half_width_px", |c, v| c.init.band_half_width_px = v),
+            ("min_points", |c, v| c.init.min_points = v.max(0.0) as usize),
+            ("refit_iterations", |c, v| {
+                c.init.refit_iterations = v.max(0.0) as u32
+            }),
+            ("min_edge_angle_deg", |c, v| {
+                c.gradient.min_edge_angle_deg = v
+            }),
+            ("max_edge_angle_deg", |c, v| {
+                c.gradient.max_edge_angle_deg = v
+            }),
+            ("adaptive_keep_fraction", |c, v| {
+                c.gradient.adaptive_keep_fraction = v
+            }),
+        ];
+        let mut accepted = 0;
+        for (name, set) in fields {
+            for &v in &values {
+                let mut cfg = TrackerConfig::outdoor().unwrap();
+                set(&mut cfg, v);
+                let by_config = cfg.validate().is_ok();
+                let by_components = cfg.gradient.params().validate().is_ok()
+                    && cfg
+                        .gradient
+                        .hough_bands()
+                        .iter()
+                        .all(|b| b.validate().is_ok())
+                    && cfg.init.hough_params().validate().is_ok()
+                    && cfg.init.lane_params().validate().is_ok();
+                let tracker = crate::LaneTracker::new(&cfg, crate::Estimator::Kif, 320, 240);
+                assert_eq!(by_config, by_components, "{name} = {v}");
+                assert_eq!(by_config, tracker.is_ok(), "{name} = {v}: {tracker:?}");
+                accepted += usize::from(by_config);
+            }
+        }
+        assert!(
+            accepted > 20,
+            "the sweep must cover accepted values too ({accepted})"
+        );
+    }
+
+    #[test]
+    fn scale_pixels_scales_pixel_fields_only() {
+        let base = TrackerConfig::outdoor().unwrap();
+        let mut c = base;
+        c.scale_pixels(4.0);
+        c.validate().unwrap();
+        assert_eq!(
+            c.track.window_half_width_px,
+            4 * base.track.window_half_width_px
+        );
+        assert_eq!(c.filter.r_sigma_px, 4.0 * base.filter.r_sigma_px);
+        assert_eq!(c.filter.q_sigma_px[0], 4.0 * base.filter.q_sigma_px[0]);
+        assert_eq!(
+            c.init.band_half_width_px,
+            4.0 * base.init.band_half_width_px
+        );
+        assert_eq!(c.gradient, base.gradient);
+        assert_eq!(c.roi, base.roi);
+        assert_eq!(c.track.max_points_per_lane, base.track.max_points_per_lane);
+    }
+
+    #[test]
+    fn roi_rows_follow_the_fractions_and_stay_inside_tiny_images() {
+        let mut cfg = TrackerConfig::outdoor().unwrap();
+        cfg.roi.top_row_fraction = 0.5;
+        cfg.roi.bottom_row_fraction = 1.0;
+        assert_eq!(cfg.roi_rows(240), (120, 240));
+        let (t, b) = cfg.roi_rows(4);
+        assert!(t < b && b <= 4 && b - t >= 3, "{t}..{b}");
+    }
+}

@@ -1,0 +1,455 @@
+//! The tracking loop (paper Fig. 1): directional gradient → Hough + LS initialisation → KIF
+//! (or WRLS) recursion, per lane, with a state machine and sanity gates.
+
+use hough_init::{AngleBand, HoughWorkspace, LaneInitParams, Parabola};
+use info_filter::{ParabolaKif, ProcessNoise, RowNorm, ThetaCov};
+use lane_geometry::FitRows;
+use nalgebra::{Matrix3, Vector3};
+use serde::Serialize;
+use vision_gradient::{ColSpan, EdgeBuffer, EdgeClass, GradientDetector, GreyImage};
+
+use crate::error::FilterFailure;
+use crate::wrls_lane::WrlsLane;
+use crate::{GreyFrame, TrackerConfig, TrackerError};
+
+mod init;
+mod points;
+mod update;
+mod windows;
+
+use points::Candidate;
+
+/// Which lane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Side {
+    /// The left lane mark (edge class [`EdgeClass::LeftLane`], a `/` in the image).
+    Left,
+    /// The right lane mark (edge class [`EdgeClass::RightLane`], a `\` in the image).
+    Right,
+}
+
+/// Per-lane state, reported every frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LaneState {
+    /// No estimate yet: the first initialisation has not succeeded.
+    Initialising,
+    /// Updated from this frame's points (or initialised on this frame).
+    Tracking,
+    /// Too few points (or a gated update) this frame, for fewer than
+    /// `track.lost_after_frames` frames in a row: the reported coefficients are the prediction.
+    Coasting,
+    /// Too many missed frames in a row: no coefficients are reported and the lane is
+    /// re-initialised (Hough + LS over the whole region of interest) every frame until it is found.
+    Lost,
+}
+
+impl LaneState {
+    /// Lowercase name, as in the JSON output.
+    pub fn name(self) -> &'static str {
+        match self {
+            LaneState::Initialising => "initialising",
+            LaneState::Tracking => "tracking",
+            LaneState::Coasting => "coasting",
+            LaneState::Lost => "lost",
+        }
+    }
+}
+
+/// The recursive estimator of the lane coefficients.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Estimator {
+    /// Kalman information filter, positive-definite form (paper eqs. 6–12, 24). The default.
+    #[default]
+    Kif,
+    /// Exponentially weighted recursive least squares (paper eqs. 25–27), λ =
+    /// `filter.wrls_lambda`, applied once per frame.
+    Wrls,
+}
+
+/// One lane's result for one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LaneReport {
+    /// Which lane.
+    pub side: Side,
+    /// Its state after this frame.
+    pub state: LaneState,
+    /// `[a1, a2, a3]` of `x = a1·y² + a2·y + a3` (x column, y row, pixels of the input image);
+    /// `None` when the lane is [`LaneState::Initialising`] or [`LaneState::Lost`].
+    pub coeffs: Option<[f64; 3]>,
+    /// `[y_min, y_max]`, rows (px) of the points behind the estimate (last update or initialisation).
+    pub rows: [f64; 2],
+    /// Points used this frame (filter update, or LS fit of an initialisation); 0 when missed.
+    pub points: usize,
+    /// `true` if the lane was (re-)initialised by Hough + LS on this frame.
+    pub initialised: bool,
+}
+
+impl LaneReport {
+    /// Column of the reported parabola at `row_px`, if there is one.
+    pub fn col_at_row(&self, row_px: f64) -> Option<f64> {
+        self.coeffs
+            .map(|c| Parabola::from_coeffs(c).col_at_row(row_px))
+    }
+}
+
+/// The tracker's result for one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrackReport {
+    /// Left then right.
+    pub lanes: [LaneReport; 2],
+    /// `true` if the full region of interest went through the gradient (an initialisation was
+    /// attempted); `false` on a pure tracking frame (gradient inside the windows only).
+    pub full_gradient: bool,
+}
+
+/// Counters over the tracker's life.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct TrackerCounters {
+    /// Frames processed.
+    pub frames: u64,
+    /// Successful initialisations per lane (left, right), the first one included.
+    pub initialisations: [u64; 2],
+    /// Updates rejected by the jump gate, per lane.
+    pub gated_jumps: [u64; 2],
+    /// Estimates rejected because the lanes crossed, per lane.
+    pub gated_crossings: [u64; 2],
+    /// Filter failures (numerical: a non-positive-definite matrix), per lane.
+    pub filter_failures: [u64; 2],
+}
+
+/// The per-lane recursive estimator state.
+#[derive(Debug, Clone)]
+enum LaneFilter {
+    Kif(ParabolaKif),
+    Wrls(WrlsLane),
+}
+
+impl LaneFilter {
+    fn col_at_row(&self, row_px: f64) -> f64 {
+        match self {
+            LaneFilter::Kif(k) => k.col_at_row_px(row_px),
+            LaneFilter::Wrls(w) => w.col_at_row_px(row_px),
+        }
+    }
+    fn coeffs(&self) -> [f64; 3] {
+        let v = match self {
+            LaneFilter::Kif(k) => k.estimate(),
+            LaneFilter::Wrls(w) => w.estimate(),
+        };
+        [v[0], v[1], v[2]]
+    }
+}
+
+#[derive(Debug)]
+struct Lane {
+    side: Side,
+    class: EdgeClass,
+    band: AngleBand,
+    state: LaneState,
+    filter: Option<LaneFilter>,
+    predicted: Option<LaneFilter>,
+    misses: u32,
+    points: Vec<(f32, f32)>,
+    /// Relative precision `1/v` of each point of `points` after a tracking update
+    /// ([`mark_centre`]).
+    weights: Vec<f64>,
+    spans: Vec<ColSpan>,
+    rows: [f64; 2],
+    /// Rows and weights of the points behind the last update or initialisation.
+    fit: FitRows,
+    points_now: usize,
+    initialised_now: bool,
+    updated_now: bool,
+    fresh: bool,
+}
+
+impl Lane {
+    fn report(&self) -> LaneReport {
+        let coeffs = match self.state {
+            LaneState::Tracking | LaneState::Coasting => {
+                self.filter.as_ref().map(LaneFilter::coeffs)
+            }
+            LaneState::Initialising | LaneState::Lost => None,
+        };
+        LaneReport {
+            side: self.side,
+            state: self.state,
+            coeffs,
+            rows: self.rows,
+            points: self.points_now,
+            initialised: self.initialised_now,
+        }
+    }
+
+    fn has_estimate(&self) -> bool {
+        matches!(self.state, LaneState::Tracking | LaneState::Coasting) && self.filter.is_some()
+    }
+}
+
+/// What an overlay needs of one lane: its windows, its points and its estimate.
+#[derive(Debug, Clone, Copy)]
+pub struct LaneView<'a> {
+    /// The lane's report for the last frame.
+    pub report: LaneReport,
+    /// Window of interest per image row (empty spans outside it) used on the last frame; all
+    /// empty if the lane was not tracked on it.
+    pub spans: &'a [ColSpan],
+    /// The points fed to the filter or the LS fit on the last frame, `(col_px, row_px)`.
+    pub points: &'a [(f32, f32)],
+}
+
+/// The lane tracker for frames of one size. Build once; [`LaneTracker::track`] per frame does
+/// not allocate.
+#[derive(Debug)]
+pub struct LaneTracker {
+    cfg: TrackerConfig,
+    estimator: Estimator,
+    width: usize,
+    height: usize,
+    roi: (usize, usize),
+    detector: GradientDetector,
+    edges: EdgeBuffer,
+    hough: HoughWorkspace,
+    init_params: LaneInitParams,
+    candidates: Vec<(f32, f32)>,
+    scratch: Vec<Candidate>,
+    row_norm: RowNorm,
+    q: ProcessNoise<3>,
+    p0: ThetaCov,
+    lanes: [Lane; 2],
+    counters: TrackerCounters,
+    /// The last filter failure per lane (left, right), kept typed without allocating.
+    last_failure: [Option<FilterFailure>; 2],
+}
+
+impl LaneTracker {
+    /// A tracker for `width × height` frames. Validates `cfg`.
+    pub fn new(
+        cfg: &TrackerConfig,
+        estimator: Estimator,
+        width: usize,
+        height: usize,
+    ) -> Result<Self, TrackerError> {
+        cfg.validate()?;
+        if width < 3 || height < 3 {
+            return Err(TrackerError::ZeroSize { width, height });
+        }
+        let detector = GradientDetector::new(cfg.gradient.params())?;
+        let roi = cfg.roi_rows(height);
+        let capacity = width * (roi.1 - roi.0);
+        let hough = HoughWorkspace::new(width, height, cfg.init.hough_params())?;
+        let init_params = cfg.init.lane_params();
+        init_params.validate()?;
+        let center = (roi.0 + roi.1 - 1) as f64 / 2.0;
+        let scale = ((roi.1 - 1 - roi.0) as f64 / 2.0).max(1.0);
+        let row_norm = RowNorm::new(center, scale)?;
+        let f = &cfg.filter;
+        let q_u = Matrix3::from_diagonal(&Vector3::from(f.q_sigma_px.map(|s| s * s)));
+        let q = ProcessNoise::new(&q_u)?;
+        let p0 = ThetaCov::Normalised(Matrix3::from_diagonal(&Vector3::from(
+            f.p0_sigma_px.map(|s| s * s),
+        )));
+        let [left_band, right_band] = cfg.gradient.hough_bands();
+        let make_lane = |side, class, band| Lane {
+            side,
+            class,
+            band,
+            state: LaneState::Initialising,
+            filter: None,
+            predicted: None,
+            misses: 0,
+            points: Vec::with_capacity(cfg.track.max_points_per_lane.max(capacity.min(1 << 16))),
+            weights: Vec::with_capacity(cfg.track.max_points_per_lane.max(capacity.min(1 << 16))),
+            spans: vec![ColSpan::EMPTY; height],
+            rows: [0.0, 0.0],
+            fit: FitRows::uniform(0.0, 0.0),
+            points_now: 0,
+            initialised_now: false,
+            updated_now: false,
+            fresh: false,
+        };
+        let lanes = [
+            make_lane(Side::Left, EdgeClass::LeftLane, left_band),
+            make_lane(Side::Right, EdgeClass::RightLane, right_band),
+        ];
+        for lane in &lanes {
+            lane.band.validate()?;
+        }
+        Ok(LaneTracker {
+            cfg: *cfg,
+            estimator,
+            width,
+            height,
+            roi,
+            detector,
+            edges: EdgeBuffer::with_capacity(capacity),
+            hough,
+            init_params,
+            candidates: Vec::with_capacity(capacity),
+            scratch: Vec::with_capacity(capacity),
+            row_norm,
+            q,
+            p0,
+            lanes,
+            counters: TrackerCounters::default(),
+            last_failure: [None; 2],
+        })
+    }
+
+    /// Frame size this tracker takes, px.
+    pub fn frame_size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// Rows searched, `[top, bottom)`, px.
+    pub fn roi_rows(&self) -> (usize, usize) {
+        self.roi
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &TrackerConfig {
+        &self.cfg
+    }
+
+    /// The estimator in use.
+    pub fn estimator(&self) -> Estimator {
+        self.estimator
+    }
+
+    /// Counters since construction (or the last [`LaneTracker::reset`]).
+    pub fn counters(&self) -> &TrackerCounters {
+        &self.counters
+    }
+
+    /// Forget both lanes (next frame initialises again) and zero the counters.
+    pub fn reset(&mut self) {
+        for lane in &mut self.lanes {
+            lane.state = LaneState::Initialising;
+            lane.filter = None;
+            lane.predicted = None;
+            lane.misses = 0;
+            lane.points.clear();
+            lane.weights.clear();
+            lane.spans.fill(ColSpan::EMPTY);
+            lane.points_now = 0;
+        }
+        self.counters = TrackerCounters::default();
+        self.last_failure = [None; 2];
+    }
+
+    /// Why lane `side`'s filter last refused a prediction, an update or an initialisation (the
+    /// component's typed error; counted in [`TrackerCounters::filter_failures`]), `None` if it
+    /// never has since construction or the last [`LaneTracker::reset`].
+    pub fn last_filter_error(&self, side: Side) -> Option<FilterFailure> {
+        self.last_failure[side as usize]
+    }
+
+    /// Covariance of one lane's reported coefficients `(a1, a2, a3)` in the pixel
+    /// parameterisation (entry `(i, j)` in units of `a_i·a_j`), `None` when the lane has no
+    /// estimate (initialising or lost) or its information matrix cannot be inverted.
+    ///
+    /// KIF: `P_px = T·Y_u⁻¹·Tᵀ`, the inverse of the information matrix the filter propagates in
+    /// the normalised rows `u = (y − y_c)/s`, mapped by the exact linear map `T` between the
+    /// normalised and the pixel coefficients (`info_filter::RowNorm`). WRLS: its `P` (a scaled
+    /// inverse normal matrix) times `filter.r_sigma_px²`, the least-squares covariance for that
+    /// pixel noise. No allocation.
+    pub fn lane_covariance_px(&self, side: Side) -> Option<Matrix3<f64>> {
+        let lane = &self.lanes[side as usize];
+        if !lane.has_estimate() {
+            return None;
+        }
+        match lane.filter.as_ref()? {
+            LaneFilter::Kif(k) => k.covariance().ok(),
+            LaneFilter::Wrls(w) => {
+                let r = self.cfg.filter.r_sigma_px;
+                w.covariance_px().map(|p| p * (r * r))
+            }
+        }
+    }
+
+    /// How one lane's estimate was fitted on the last update or initialisation: the weighted
+    /// mean row and the summed weight of its points in each eighth of their rows (edge pixels
+    /// weigh 1, mark centres their relative precision). `lane-geometry` uses it to remove the
+    /// image-parabola model error ([`crate::camera::CameraModel::ego_lane`]). `None` when the
+    /// lane has no estimate.
+    pub fn lane_fit_rows(&self, side: Side) -> Option<FitRows> {
+        let lane = &self.lanes[side as usize];
+        lane.has_estimate().then_some(lane.fit)
+    }
+
+    /// Windows, points and report of one lane after the last frame (for overlays).
+    pub fn lane_view(&self, side: Side) -> LaneView<'_> {
+        let lane = &self.lanes[side as usize];
+        LaneView {
+            report: lane.report(),
+            spans: &lane.spans,
+            points: &lane.points,
+        }
+    }
+
+    /// Process one frame. Errors only for a frame of the wrong size or a component refusing
+    /// its (validated) input; a lane that cannot be tracked is reported as such, not as an error.
+    pub fn track(&mut self, frame: &GreyFrame) -> Result<TrackReport, TrackerError> {
+        self.track_pixels(frame.data(), frame.width(), frame.height(), frame.width())
+    }
+
+    /// [`LaneTracker::track`] on borrowed pixels: `width × height` grey pixels, row `y` starting at
+    /// `data[y * stride_px]` (`stride_px ≥ width`), so a caller's buffer (a numpy array, a capture
+    /// buffer with padded rows) is read in place without a copy. Errors for a size other than the
+    /// tracker's or a `data` too short for the stride.
+    pub fn track_pixels(
+        &mut self,
+        data: &[u8],
+        width: usize,
+        height: usize,
+        stride_px: usize,
+    ) -> Result<TrackReport, TrackerError> {
+        if width != self.width || height != self.height {
+            return Err(TrackerError::FrameSize {
+                expected_w: self.width,
+                expected_h: self.height,
+                got_w: width,
+                got_h: height,
+            });
+        }
+        let image = GreyImage::new(data, self.width, self.height, stride_px)?;
+        self.counters.frames += 1;
+        for i in 0..2 {
+            let lane = &mut self.lanes[i];
+            lane.initialised_now = false;
+            lane.updated_now = false;
+            lane.points_now = 0;
+            if lane.has_estimate() {
+                self.track_lane(i, &image, true)?;
+            } else {
+                lane.spans.fill(ColSpan::EMPTY);
+                lane.points.clear();
+            }
+        }
+        let need_init = self.lanes.iter().any(|l| !l.has_estimate());
+        if need_init {
+            self.initialise(&image)?;
+            // Refine a fresh initialisation on the same frame: one windowed update around the
+            // LS parabola, with the window's outlier rejection (the Hough band keeps clutter).
+            for i in 0..2 {
+                if self.lanes[i].initialised_now {
+                    self.track_lane(i, &image, false)?;
+                    let lane = &mut self.lanes[i];
+                    if lane.state != LaneState::Tracking {
+                        // The refinement missed: keep the LS initialisation as it was.
+                        lane.state = LaneState::Tracking;
+                        lane.misses = 0;
+                    }
+                    lane.initialised_now = true;
+                }
+            }
+        }
+        self.crossing_gate();
+        Ok(TrackReport {
+            lanes: [self.lanes[0].report(), self.lanes[1].report()],
+            full_gradient: need_init,
+        })
+    }
+}

@@ -1,0 +1,365 @@
+//! Stage III, point selection: which window pixels measure the lane on this frame (the paper's
+//! inlier edge pixels, or one sub-pixel mark centre per row), and the measurement noise they
+//! carry.
+
+use hough_init::Parabola;
+use info_filter::{PowerSums, RowNorm};
+use lane_geometry::{FIT_SAMPLES, FitRows};
+use nalgebra::{Matrix3, Vector3};
+use vision_gradient::GreyImage;
+
+use super::LaneTracker;
+
+/// A window pixel during point selection.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Candidate {
+    col_px: u16,
+    row_px: u16,
+    /// Residual `x − x̂(y)` rounded, plus the window half-width (0..=2w).
+    bin: u16,
+    /// Third of the ROI rows (0, 1, 2).
+    band: u8,
+}
+
+/// Sub-pixel column of a lane mark in one image row: the centroid of its grey level above the
+/// local background, over the columns `lo..=hi` of the row's inlier edge pixels widened on each
+/// side by `2 + ⌈|slope|⌉` px (`slope` = the predicted `dx/dy` of the lane: the 3×3 gradient of a
+/// slanted edge reaches that far from it), at most 6 px. The background is the mean of the two
+/// end pixels; the mark is the brighter or the darker side (whichever deviates more). When the
+/// two ends differ by more than half the mark's contrast the window holds a single step edge
+/// (a floor/wall boundary, a shadow border, a mark cut by the image border), and the point is
+/// that edge's sub-pixel position ([`step_edge`]). `None` when there is no contrast.
+///
+/// Returns the column and `v = Σ_k (k − c)²/S²` over the window (`S` the summed excess grey,
+/// `c` the centroid): the centroid's variance per unit of grey-level noise variance, so `1/v`
+/// is the point's relative precision (a narrow or faint mark gives a noisier centre).
+///
+/// For a mark drawn with area anti-aliasing the centroid is exact up to a sawtooth of at most
+/// `1/(8·w)` px for a mark `w` px wide (exact for whole-pixel widths), against up to half a pixel
+/// for the integer columns of its edge pixels.
+fn mark_centre(row: &[u8], lo: u16, hi: u16, slope: f64) -> Option<(f64, f64)> {
+    let margin = if slope.is_finite() {
+        (2.0 + slope.abs().ceil()).min(6.0) as usize
+    } else {
+        2
+    };
+    let a = usize::from(lo).saturating_sub(margin);
+    let b = (usize::from(hi) + margin).min(row.len().checked_sub(1)?);
+    let pixels = row.get(a..=b)?;
+    let (&first, &last) = (pixels.first()?, pixels.last()?);
+    let bg = 0.5 * (f64::from(first) + f64::from(last));
+    let (mut hi_dev, mut lo_dev) = (0.0f64, 0.0f64);
+    for &p in pixels {
+        let d = f64::from(p) - bg;
+        hi_dev = hi_dev.max(d);
+        lo_dev = lo_dev.min(d);
+    }
+    let (polarity, contrast) = if hi_dev >= -lo_dev {
+        (1.0, hi_dev)
+    } else {
+        (-1.0, -lo_dev)
+    };
+    let step = f64::from(last) - f64::from(first);
+    if step.abs() > 0.5 * contrast {
+        return step_edge(pixels, step).map(|(c, v)| (a as f64 + c, v));
+    }
+    if contrast <= 0.0 {
+        return None;
+    }
+    let (mut sw, mut swx) = (0.0, 0.0);
+    for (k, &p) in pixels.iter().enumerate() {
+        let w = (polarity * (f64::from(p) - bg)).max(0.0);
+        sw += w;
+        swx += w * k as f64;
+    }
+    if sw <= 0.0 {
+        return None;
+    }
+    let c = swx / sw;
+    let spread: f64 = (0..pixels.len()).map(|k| (k as f64 - c).powi(2)).sum();
+    Some((a as f64 + c, spread / (sw * sw)))
+}
+
+/// [`LaneTracker::lane_fit_rows`] of `points` (with `weights`, or 1 each when `weights` is
+/// shorter) over `rows` `[first, last]`.
+pub(super) fn fit_profile(points: &[(f32, f32)], weights: &[f64], rows: [f64; 2]) -> FitRows {
+    let mut sum_w = [0.0; FIT_SAMPLES];
+    let mut sum_wy = [0.0; FIT_SAMPLES];
+    let span = rows[1] - rows[0];
+    for (i, &(_, y)) in points.iter().enumerate() {
+        let w = weights.get(i).copied().unwrap_or(1.0);
+        let y = f64::from(y);
+        let t = if span > 0.0 {
+            (y - rows[0]) / span
+        } else {
+            0.0
+        };
+        let b = ((t * FIT_SAMPLES as f64).max(0.0) as usize).min(FIT_SAMPLES - 1);
+        sum_w[b] += w;
+        sum_wy[b] += w * y;
+    }
+    let mut fit = FitRows {
+        rows_px: [0.0; FIT_SAMPLES],
+        weights: sum_w,
+    };
+    for (b, r) in fit.rows_px.iter_mut().enumerate() {
+        *r = if sum_w[b] > 0.0 {
+            sum_wy[b] / sum_w[b]
+        } else {
+            rows[0] + span * (b as f64 + 0.5) / FIT_SAMPLES as f64
+        };
+    }
+    fit
+}
+
+/// Floor of the per-point σ the KIF is given, px: a scatter estimate below it (a noise-free
+/// rendering) is not trusted further.
+const MIN_R_SIGMA_PX: f64 = 0.02;
+
+/// Fewest points for the scatter estimate of [`weighted_scatter`].
+const MIN_SCATTER_POINTS: usize = 8;
+
+/// The KIF's measurement for one frame of weighted points: the weighted power sums
+/// (`info_filter::PowerSums::from_weighted_points`) and the scale `s²` of `R = s²·diag(1/w_i)`,
+/// the unbiased weighted variance (`N − 3` degrees of freedom) of the points about their own
+/// weighted least-squares parabola, floored so that the points' mean variance `s²·N/Σw` is at
+/// least `MIN_R_SIGMA_PX²`. The residuals are taken about `pred` (the predicted coefficients)
+/// first so the sums stay small. `None` for fewer than [`MIN_SCATTER_POINTS`] points, a
+/// singular fit or bad weights.
+pub(super) fn weighted_scatter(
+    points: &[(f32, f32)],
+    weights: &[f64],
+    pred: [f64; 3],
+    row_norm: &RowNorm,
+) -> Option<(PowerSums, f64)> {
+    if points.len() < MIN_SCATTER_POINTS || weights.len() != points.len() {
+        return None;
+    }
+    let mut n = Matrix3::<f64>::zeros();
+    let mut b = Vector3::<f64>::zeros();
+    let (mut wrr, mut sw) = (0.0, 0.0);
+    for (&(x, y), &w) in points.iter().zip(weights) {
+        let y = f64::from(y);
+        let r = f64::from(x) - Parabola::from_coeffs(pred).col_at_row(y);
+        let u = row_norm.normalise_row(y);
+        let phi = Vector3::new(u * u, u, 1.0);
+        n += w * phi * phi.transpose();
+        b += w * r * phi;
+        wrr += w * r * r;
+        sw += w;
+    }
+    let theta = n.cholesky()?.solve(&b);
+    let count = points.len() as f64;
+    let s2 = ((wrr - theta.dot(&b)).max(0.0) / (count - 3.0))
+        .max(MIN_R_SIGMA_PX * MIN_R_SIGMA_PX * sw / count);
+    let sums = PowerSums::from_weighted_points(points, weights, row_norm).ok()?;
+    (s2.is_finite() && s2 > 0.0).then_some((sums, s2))
+}
+
+/// Sub-pixel position (from the window's first pixel) of a single step edge rising by `step`
+/// (grey levels, either sign) across `pixels`, and its relative variance: the centroid of the
+/// forward differences of the step's sign, each at its half-pixel position — exact for an
+/// area-anti-aliased step. `None` if the window holds no difference of that sign.
+fn step_edge(pixels: &[u8], step: f64) -> Option<(f64, f64)> {
+    let sign = step.signum();
+    let (mut sw, mut swx) = (0.0, 0.0);
+    for (k, pair) in pixels.windows(2).enumerate() {
+        let d = (sign * (f64::from(pair[1]) - f64::from(pair[0]))).max(0.0);
+        sw += d;
+        swx += d * (k as f64 + 0.5);
+    }
+    if sw <= 0.0 {
+        return None;
+    }
+    let c = swx / sw;
+    // Each difference carries two pixels' noise.
+    let spread: f64 = (0..pixels.len().saturating_sub(1))
+        .map(|k| 2.0 * (k as f64 + 0.5 - c).powi(2))
+        .sum();
+    Some((c, spread / (sw * sw)))
+}
+
+/// Largest window half-width accepted by the configuration, px.
+pub(crate) const MAX_WINDOW_HALF_WIDTH: usize = 200;
+
+impl LaneTracker {
+    /// Lane `i`'s measurement for this frame from the window pixels in `self.edges` about the
+    /// predicted `coeffs`: fills `lane.points` (and `lane.weights` with mark centres).
+    pub(super) fn select_points(&mut self, i: usize, image: &GreyImage<'_>, coeffs: [f64; 3]) {
+        let (top, bottom) = self.roi;
+        let w = self.cfg.track.window_half_width_px as i64;
+        let max_points = self.cfg.track.max_points_per_lane;
+        let lane = &mut self.lanes[i];
+        // Outlier rejection: the residuals r = x − x̂(y) of the window pixels are histogrammed
+        // in three row bands; pixels farther than `inlier_half_width_px` from their band's
+        // midhinge residual (mean of the quartiles) are dropped (clutter, noise, the edges of a shadow).
+        const BANDS: usize = 3;
+        let band_rows = [top + (bottom - top) / 3, top + 2 * (bottom - top) / 3];
+        let w_us = w as usize;
+        // One pass over the window pixels of the lane's class: residual bin (r + w, rounded;
+        // window pixels are within ±w of the prediction) and row band, histogrammed per band.
+        let mut hist = [[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS];
+        self.scratch.clear();
+        for p in self.edges.iter_class(lane.class) {
+            let v =
+                f64::from(p.col_px) - Parabola::from_coeffs(coeffs).col_at_row(f64::from(p.row_px));
+            // Truncation of a non-negative value is floor: this rounds v to the nearest bin.
+            let bin = ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w_us);
+            let row = usize::from(p.row_px);
+            let band = usize::from(row >= band_rows[0]) + usize::from(row >= band_rows[1]);
+            hist[band][bin] += 1;
+            if self.scratch.len() < self.scratch.capacity() {
+                self.scratch.push(Candidate {
+                    col_px: p.col_px,
+                    row_px: p.row_px,
+                    bin: bin as u16,
+                    band: band as u8,
+                });
+            }
+        }
+        // Band centre = midhinge (mean of the quartiles): with the two edges of a mark it
+        // lands between them, where a median would pick one edge.
+        let mut centre = [w; BANDS];
+        for (b, h) in hist.iter().enumerate() {
+            let n: u32 = h[..=2 * w_us].iter().sum();
+            if n == 0 {
+                continue;
+            }
+            let (q1, q3) = (n.div_ceil(4), (3 * n).div_ceil(4));
+            let (mut acc, mut r1, mut r3) = (0u32, None, None);
+            for (r, &c) in h[..=2 * w_us].iter().enumerate() {
+                acc += c;
+                if r1.is_none() && acc >= q1 {
+                    r1 = Some(r as i64);
+                }
+                if acc >= q3 {
+                    r3 = Some(r as i64);
+                    break;
+                }
+            }
+            if let (Some(a), Some(c)) = (r1, r3) {
+                centre[b] = (a + c).div_euclid(2);
+            }
+        }
+        let inlier = self.cfg.track.inlier_half_width_px;
+        let is_inlier =
+            |c: &Candidate| (i64::from(c.bin) - centre[usize::from(c.band)]).abs() as f64 <= inlier;
+        // With `track.mark_centres`, one sub-pixel point per row (crate docs, "Mark centres"):
+        // the inlier edge pixels of a row (both edges of the mark; the detector emits them row
+        // by row) bracket the mark, and the centroid of its grey level above the local
+        // background is the measurement.
+        lane.points.clear();
+        lane.weights.clear();
+        let mark_centres = self.cfg.track.mark_centres;
+        if !mark_centres {
+            // The paper's measurement: the inlier edge pixels, uniformly decimated (in row
+            // order) down to max_points, spread over the rows and over both edges of a mark.
+            let total = self.scratch.iter().filter(|c| is_inlier(c)).count();
+            for (j, c) in self.scratch.iter().filter(|c| is_inlier(c)).enumerate() {
+                if total <= max_points || (j + 1) * max_points / total > j * max_points / total {
+                    lane.points.push((f32::from(c.col_px), f32::from(c.row_px)));
+                }
+            }
+        }
+        let mut run: Option<(u16, u16, u16)> = None;
+        let rows_out = self
+            .scratch
+            .iter()
+            .filter(|c| mark_centres && is_inlier(c))
+            .map(Some)
+            .chain([None]);
+        for c in rows_out {
+            match (run, c) {
+                (Some((row, lo, hi)), Some(c)) if c.row_px == row => {
+                    run = Some((row, lo.min(c.col_px), hi.max(c.col_px)));
+                }
+                (prev, next) => {
+                    if let Some((row, lo, hi)) = prev {
+                        let y = f64::from(row);
+                        let slope = 2.0 * coeffs[0] * y + coeffs[1];
+                        if let Some((x, v)) = image
+                            .row(usize::from(row))
+                            .and_then(|pixels| mark_centre(pixels, lo, hi, slope))
+                            && lane.points.len() < lane.points.capacity()
+                        {
+                            lane.points.push((x as f32, f32::from(row)));
+                            lane.weights.push(1.0 / v);
+                        }
+                    }
+                    run = next.map(|c| (c.row_px, c.col_px, c.col_px));
+                }
+            }
+        }
+        // Mark centres: uniform decimation over the rows down to max_points (frames taller
+        // than the limit).
+        let total = lane.points.len();
+        if mark_centres && total > max_points {
+            let mut k = 0;
+            for j in 0..total {
+                if (j + 1) * max_points / total > j * max_points / total {
+                    lane.points[k] = lane.points[j];
+                    lane.weights[k] = lane.weights[j];
+                    k += 1;
+                }
+            }
+            lane.points.truncate(k);
+            lane.weights.truncate(k);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One row of a mark `[left, right)` (columns, px) drawn with area anti-aliasing, grey 90
+    /// on the floor and 200 on the mark, or a step from 90 up to 200 at `left` when `right` is ∞.
+    fn row(left: f64, right: f64) -> Vec<u8> {
+        (0..40)
+            .map(|x| {
+                let (lo, hi) = (x as f64 - 0.5, x as f64 + 0.5);
+                let cover = (hi.min(right) - lo.max(left)).clamp(0.0, 1.0);
+                (90.0 + 110.0 * cover).round() as u8
+            })
+            .collect()
+    }
+
+    #[test]
+    fn mark_centre_is_within_the_sawtooth_bound_of_the_true_centre() {
+        for width in [1.5, 2.0, 2.7, 4.0, 6.3] {
+            for k in 0..20 {
+                let centre = 17.0 + 0.05 * k as f64;
+                let pixels = row(centre - 0.5 * width, centre + 0.5 * width);
+                let (lo, hi) = ((centre - 0.5 * width) as u16, (centre + 0.5 * width) as u16);
+                let (x, v) = mark_centre(&pixels, lo, hi, 0.3).unwrap();
+                // 1/(8w) px, plus the rounding of the grey levels to integers.
+                let bound = 1.0 / (8.0 * width) + 0.01;
+                assert!(
+                    (x - centre).abs() <= bound,
+                    "width {width}, centre {centre}: {x} (bound {bound})"
+                );
+                assert!(v > 0.0 && v.is_finite());
+            }
+        }
+        // A dark mark on a bright floor is found the same way.
+        let dark: Vec<u8> = row(15.2, 18.9).iter().map(|&p| 255 - p + 35).collect();
+        let (x, _) = mark_centre(&dark, 15, 18, 0.0).unwrap();
+        assert!((x - 17.05).abs() < 0.04, "{x}");
+    }
+
+    #[test]
+    fn a_single_step_edge_is_located_exactly() {
+        for k in 0..20 {
+            let edge = 20.0 + 0.05 * k as f64;
+            let up = row(edge, f64::INFINITY);
+            let (x, _) = mark_centre(&up, edge as u16, edge as u16 + 1, 0.5).unwrap();
+            assert!((x - edge).abs() < 0.01, "rising {edge}: {x}");
+            let down: Vec<u8> = up.iter().rev().copied().collect();
+            let mirrored = 39.0 - edge;
+            let (x, _) = mark_centre(&down, mirrored as u16, mirrored as u16 + 1, 0.5).unwrap();
+            assert!((x - mirrored).abs() < 0.01, "falling {mirrored}: {x}");
+        }
+        // No contrast, no point.
+        assert!(mark_centre(&[100; 40], 10, 12, 0.0).is_none());
+    }
+}
