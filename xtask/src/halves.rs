@@ -1,9 +1,10 @@
-//! `cargo xtask halves`: nav-app's two halves build alone, and the lane half pulls in nothing of
-//! the INS half, of V4L2 or of the command line (`cargo tree -p nav-app --no-default-features
-//! --features lane` lists none of `ins-errors`, `sighting-model`, `akf`, `ins-sd-filter`, `v4l`,
-//! `clap`, nor the Monte Carlo's `rayon` and `plotters`); the INS simulation, crate `ins-sim`
-//! (used by the Python package), builds and depends on neither `rayon` nor `plotters`
-//! (`cargo tree -p ins-sim -e normal`; they belong to `ins-monte-carlo`).
+//! `cargo xtask halves`: the crate boundaries hold. The numeric lane tracker (`lane-tracker`)
+//! depends on no image codec (`image`), no V4L2 (`v4l`), no CLI (`clap`), not on the Monte
+//! Carlo's `rayon` and `plotters` and on no INS crate; the lane I/O (`lane-io` without
+//! `capture`) and the evaluation (`lane-eval`) on no INS crate, no V4L2, no CLI, no Monte Carlo;
+//! `lane-tracker` and `lane-io` build cleanly alone; the INS simulation, crate `ins-sim` (used by
+//! the Python package), builds and depends on neither `rayon` nor `plotters` (they belong to
+//! `ins-monte-carlo`). Each check reads `cargo tree -p CRATE -e normal`.
 
 use std::process::Command;
 
@@ -11,12 +12,29 @@ use anyhow::{Context, Result, bail};
 
 use crate::paths::workspace_root;
 
-/// Crates the lane half alone must not depend on.
+/// Crates the numeric lane tracker (`lane-tracker`) must not depend on: image codecs, V4L2, the
+/// CLI, the Monte Carlo's pool and figures, the INS crates.
+const NOT_IN_LANE_TRACKER: &[&str] = &[
+    "image",
+    "v4l",
+    "clap",
+    "rayon",
+    "plotters",
+    "ins-errors",
+    "sighting-model",
+    "akf",
+    "ins-sd-filter",
+    "ins-sim",
+];
+
+/// Crates the lane I/O and evaluation (`lane-io` without `capture`, `lane-eval`) must not
+/// depend on.
 const NOT_IN_LANE: &[&str] = &[
     "ins-errors",
     "sighting-model",
     "akf",
     "ins-sd-filter",
+    "ins-sim",
     "v4l",
     "clap",
     "rayon",
@@ -88,75 +106,52 @@ fn check_ins_sim(cargo: &str) -> Result<()> {
     Ok(())
 }
 
-/// Run `cargo xtask halves`.
-pub fn run() -> Result<()> {
-    let root = workspace_root();
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let out = Command::new(&cargo)
-        .current_dir(&root)
-        .args([
-            "tree",
-            "-p",
-            "nav-app",
-            "--no-default-features",
-            "--features",
-            "lane",
-            "-e",
-            "normal",
-            "--prefix",
-            "none",
-        ])
-        .output()
-        .context("cannot run cargo tree")?;
-    if !out.status.success() {
-        bail!(
-            "cargo tree failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+/// Clippy (`-D warnings`, all targets) on `package` built alone, with `args` (features).
+fn clippy_alone(cargo: &str, package: &str, args: &[&str]) -> Result<()> {
+    eprintln!("halves: clippy -p {package} {}", args.join(" "));
+    let status = Command::new(cargo)
+        .current_dir(workspace_root())
+        .args(["clippy", "-p", package])
+        .args(args)
+        .args(["--all-targets", "--", "-D", "warnings"])
+        .status()
+        .context("cannot run cargo clippy")?;
+    if !status.success() {
+        bail!("{package} built alone does not build cleanly");
     }
-    let tree = String::from_utf8_lossy(&out.stdout);
-    let found: Vec<&str> = NOT_IN_LANE
-        .iter()
-        .copied()
-        .filter(|c| {
-            tree.lines()
-                .any(|l| l.split_whitespace().next() == Some(*c))
-        })
-        .collect();
+    Ok(())
+}
+
+/// `package` (with `args`) depends on none of `forbidden`.
+fn check_deps(cargo: &str, package: &str, args: &[&str], forbidden: &[&str]) -> Result<()> {
+    let deps = normal_deps(cargo, package, args)?;
+    let found = found_in(&deps, forbidden);
     if !found.is_empty() {
-        bail!(
-            "nav-app with only the lane half depends on {}",
-            found.join(", ")
-        );
+        bail!("{package} depends on {}", found.join(", "));
     }
     println!(
-        "halves: the lane half depends on none of {} ({} crates in its tree)",
-        NOT_IN_LANE.join(", "),
-        tree.lines().count()
+        "halves: {package} {}depends on none of {} ({} crates in its tree)",
+        if args.is_empty() {
+            String::new()
+        } else {
+            format!("({}) ", args.join(" "))
+        },
+        forbidden.join(", "),
+        deps.len()
     );
-    // The lane half alone and with its evaluation, no binary.
-    for half in ["lane", "eval"] {
-        eprintln!("halves: clippy -p nav-app --no-default-features --features {half}");
-        let status = Command::new(&cargo)
-            .current_dir(&root)
-            .args([
-                "clippy",
-                "-p",
-                "nav-app",
-                "--no-default-features",
-                "--features",
-                half,
-                "--all-targets",
-                "--",
-                "-D",
-                "warnings",
-            ])
-            .status()
-            .context("cannot run cargo clippy")?;
-        if !status.success() {
-            bail!("nav-app with only the {half} half does not build cleanly");
-        }
-    }
+    Ok(())
+}
+
+/// Run `cargo xtask halves`.
+pub fn run() -> Result<()> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    // The numeric tracker: no image codecs, no device, no CLI, no Monte Carlo, no INS.
+    check_deps(&cargo, "lane-tracker", &[], NOT_IN_LANE_TRACKER)?;
+    // Its I/O: no INS, no CLI, no Monte Carlo; no V4L2 without the `capture` feature.
+    check_deps(&cargo, "lane-io", &["--no-default-features"], NOT_IN_LANE)?;
+    check_deps(&cargo, "lane-eval", &[], NOT_IN_LANE)?;
+    clippy_alone(&cargo, "lane-tracker", &[])?;
+    clippy_alone(&cargo, "lane-io", &["--no-default-features"])?;
     // The INS half: the simulation without the Monte Carlo's rayon and plotters.
     check_ins_sim(&cargo)
 }

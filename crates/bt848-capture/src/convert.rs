@@ -133,13 +133,9 @@ pub fn fourcc_string(fourcc: [u8; 4]) -> String {
         .collect()
 }
 
-/// BT.601 luma of one gamma-encoded R'G'B' pixel, rounded to nearest (see the module docs).
-#[inline]
-pub fn luma_bt601(r: u8, g: u8, b: u8) -> u8 {
-    let y = (19_595 * u32::from(r) + 38_470 * u32::from(g) + 7_471 * u32::from(b) + 32_768) >> 16;
-    // The weights sum to 65 536, so y ≤ 255 and the cast is exact.
-    y as u8
-}
+/// BT.601 luma of one gamma-encoded R'G'B' pixel, rounded to nearest: the workspace's one
+/// conversion, [`grey_frame::luma_bt601`] (see the module docs).
+pub use grey_frame::luma_bt601;
 
 /// Convert one `width`×`height` frame in `format`, rows `stride_bytes` apart in `src`, to
 /// tightly packed 8-bit grey in `dst_grey` (`width·height` bytes, row-major).

@@ -104,6 +104,7 @@
 pub mod config;
 pub mod convert;
 mod error;
+mod stats;
 
 #[cfg(feature = "v4l")]
 mod capture;
@@ -113,8 +114,9 @@ mod raw;
 pub use config::{CaptureConfig, InputSelect, VideoStd, parse_size};
 pub use convert::PixelFormat;
 pub use error::CaptureError;
+pub use stats::CaptureStats;
 
 #[cfg(feature = "v4l")]
-pub use capture::{Capture, CaptureStats, FrameInfo, GreyFrame, list_inputs, set_control};
+pub use capture::{Capture, FrameInfo, GreyFrame, list_inputs, set_control};
 #[cfg(feature = "v4l")]
 pub use raw::{InputInfo, StandardInfo};

@@ -52,7 +52,7 @@ use std::cell::{Cell, RefCell};
 use std::path::Path;
 use std::rc::Rc;
 
-use bt848_capture::{CaptureConfig, CaptureError, PixelFormat};
+use bt848_capture::{CaptureConfig, CaptureError, CaptureStats, PixelFormat};
 use serde::Serialize;
 
 use crate::{FrameMeta, FrameSource, LaneIoError};
@@ -220,21 +220,15 @@ pub struct DeviceFrameInfo {
     pub mean_grey: f64,
 }
 
-/// Running counters since the device was opened (the summary of `nav-app --json`).
+/// Running counters since the device was opened (the summary of `nav-app --json`): the capture
+/// layer's own counters ([`CaptureStats`], flattened into the same JSON object) and what this
+/// source adds.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct DeviceStats {
-    /// Frames delivered.
-    pub frames: u64,
-    /// Buffers dropped because the driver flagged them `V4L2_BUF_FLAG_ERROR` (or short).
-    pub errored_dropped: u64,
-    /// Frames missing from the driver's sequence numbering (dropped by the driver).
-    pub sequence_gaps: u64,
-    /// Timeouts (no frame within `timeout_ms`).
-    pub timeouts: u64,
-    /// Stream restarts (after timeouts).
-    pub restarts: u64,
-    /// Delivered frames taken while the input reported signal loss.
-    pub signal_lost_frames: u64,
+    /// The capture layer's counters (frames, dropped buffers, sequence gaps, timeouts, restarts,
+    /// frames with signal loss).
+    #[serde(flatten)]
+    pub capture: CaptureStats,
     /// Test-hook controls set.
     pub controls_set: u64,
     /// Wall time since the device was opened, s.
@@ -484,12 +478,7 @@ mod device {
             let s: CaptureStats = self.cap.stats();
             let elapsed_s = self.opened.elapsed().as_secs_f64();
             DeviceStats {
-                frames: s.frames,
-                errored_dropped: s.errored_dropped,
-                sequence_gaps: s.sequence_gaps,
-                timeouts: s.timeouts,
-                restarts: s.restarts,
-                signal_lost_frames: s.signal_lost_frames,
+                capture: s,
                 controls_set: self.controls_set,
                 elapsed_s,
                 fps: if elapsed_s > 0.0 {

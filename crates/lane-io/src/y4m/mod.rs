@@ -573,7 +573,7 @@ impl<W: Write> Y4mWriter<W> {
     }
 
     /// Append an RGB frame (`width × height × 3` bytes), converted with BT.601 full-range
-    /// (JPEG) coefficients; chroma is averaged over 2×2 blocks. In a mono stream only Y is kept.
+    /// (JPEG) coefficients (luma: [`grey_frame::luma_bt601`], the workspace's one conversion); chroma is averaged over 2×2 blocks. In a mono stream only Y is kept.
     pub fn write_rgb(&mut self, rgb: &[u8], luma_scratch: &mut Vec<u8>) -> io::Result<()> {
         let (w, h) = (self.width, self.height);
         if rgb.len() != w * h * 3 {
@@ -588,10 +588,7 @@ impl<W: Write> Y4mWriter<W> {
         }
         luma_scratch.resize(w * h, 0);
         for (y, px) in luma_scratch.iter_mut().zip(rgb.chunks_exact(3)) {
-            let (r, g, b) = (f32::from(px[0]), f32::from(px[1]), f32::from(px[2]));
-            *y = (0.299 * r + 0.587 * g + 0.114 * b)
-                .round()
-                .clamp(0.0, 255.0) as u8;
+            *y = grey_frame::luma_bt601(px[0], px[1], px[2]);
         }
         self.writer.write_all(b"FRAME\n")?;
         self.writer.write_all(luma_scratch)?;

@@ -14,6 +14,8 @@ use crate::{GreyFrame, TrackerConfig, TrackerError};
 
 mod init;
 mod points;
+#[cfg(test)]
+mod tests;
 mod update;
 mod windows;
 
