@@ -125,10 +125,18 @@ pub fn run(args: PythonArgs) -> Result<()> {
         "cargo build -p nav-app (the binary the Python results are compared with)",
     )?;
     let nav_app = crate::paths::target_dir(&root).join("debug/nav-app");
+    // The rendered sequences the suite compares on (only their truth is committed).
+    let synthetic = crate::paths::target_dir(&root).join("fixtures/synthetic");
+    crate::fixtures::run(crate::fixtures::FixturesArgs {
+        out: synthetic.clone(),
+        width: 320,
+        height: 240,
+    })?;
     run_checked(
         Command::new(&python)
             .current_dir(&root)
             .env("NAV_APP_BIN", &nav_app)
+            .env("ITA_NAV_SYNTHETIC", &synthetic)
             .args(["-m", "pytest", "-q", "crates/ita-nav-py/tests"])
             .args(&args.pytest_args),
         "pytest crates/ita-nav-py/tests",

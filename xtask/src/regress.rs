@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use lane_eval::eval::{ContinuityScore, SequenceScore, continuity, run_tracker, score_sequence};
-use lane_eval::synth::SequenceTruth;
+use lane_eval::synth::{SCENES, SceneSource, SequenceTruth};
 use lane_io::y4m::Y4mSource;
 use lane_tracker::{Estimator, TrackerConfig};
 
@@ -80,43 +80,31 @@ pub fn run(args: RegressArgs) -> Result<()> {
         other => bail!("--estimator must be kif or wrls, got {other}"),
     };
     let synth_dir = root.join("fixtures/synthetic");
-    let mut names: Vec<PathBuf> = std::fs::read_dir(&synth_dir)
-        .with_context(|| {
-            format!(
-                "cannot list {} (run `cargo xtask fixtures`)",
-                synth_dir.display()
-            )
-        })?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "y4m"))
-        .collect();
-    names.sort();
-    if names.is_empty() {
-        bail!(
-            "no .y4m fixtures in {} (run `cargo xtask fixtures`)",
-            synth_dir.display()
-        );
-    }
     let mut failures: Vec<String> = Vec::new();
     let mut synth_scores: BTreeMap<String, SequenceScore> = BTreeMap::new();
     println!(
         "{:22} {:>8} {:>8} {:>8} {:>6} {:>6} {:>5} {:>5}  acceptance",
         "sequence", "err px", "max px", "acc", "miss", "false", "rec", "inits"
     );
-    for y4m in &names {
-        let stem = y4m
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("?")
-            .to_owned();
-        let truth_path = y4m.with_extension("json");
+    for spec in SCENES {
+        // The frames are rendered (deterministic); the committed truth is the golden copy the
+        // renderer must still reproduce.
+        let stem = spec.name.to_owned();
+        let truth_path = synth_dir.join(format!("{stem}.json"));
         let truth: SequenceTruth = serde_json::from_str(
             &std::fs::read_to_string(&truth_path)
                 .with_context(|| format!("cannot read {}", truth_path.display()))?,
         )
         .with_context(|| format!("cannot parse {}", truth_path.display()))?;
+        let mut source = SceneSource::new(*spec, truth.width, truth.height);
+        if source.truth() != truth {
+            failures.push(format!(
+                "{stem}: the renderer no longer reproduces {} (run `cargo xtask fixtures --out \
+                 fixtures/synthetic` only if the change is intended)",
+                truth_path.display()
+            ));
+        }
         let cfg = lane_io::config::load_tracker_config(&truth.config)?;
-        let mut source = open_y4m(y4m)?;
         let outcome = run_tracker(&mut source, &cfg, estimator, None)?;
         for bad in &outcome.bad_frames {
             failures.push(format!("{stem}: unexpected bad frame: {bad}"));

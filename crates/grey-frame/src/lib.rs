@@ -157,6 +157,16 @@ impl GreyFrame {
     }
 }
 
+/// BT.601 luma of one gamma-encoded R'G'B' pixel, `Y' = 0.299 R' + 0.587 G' + 0.114 B'`, rounded
+/// to nearest, in 16-bit fixed point (weights 19 595, 38 470, 7 471 of 65 536): the workspace's
+/// one colour → grey conversion.
+#[inline]
+pub fn luma_bt601(r: u8, g: u8, b: u8) -> u8 {
+    let y = (19_595 * u32::from(r) + 38_470 * u32::from(g) + 7_471 * u32::from(b) + 32_768) >> 16;
+    // The weights sum to 65 536, so y ≤ 255 and the cast is exact.
+    y as u8
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -209,14 +219,4 @@ mod tests {
         assert_eq!(f.row(1), Some(&[10, 11, 12][..]));
         assert_eq!(f.row(2), None);
     }
-}
-
-/// BT.601 luma of one gamma-encoded R'G'B' pixel, `Y' = 0.299 R' + 0.587 G' + 0.114 B'`, rounded
-/// to nearest, in 16-bit fixed point (weights 19 595, 38 470, 7 471 of 65 536): the workspace's
-/// one colour → grey conversion.
-#[inline]
-pub fn luma_bt601(r: u8, g: u8, b: u8) -> u8 {
-    let y = (19_595 * u32::from(r) + 38_470 * u32::from(g) + 7_471 * u32::from(b) + 32_768) >> 16;
-    // The weights sum to 65 536, so y ≤ 255 and the cast is exact.
-    y as u8
 }

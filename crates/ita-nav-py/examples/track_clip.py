@@ -6,7 +6,7 @@ import sys
 
 import ita_nav
 
-clip = sys.argv[1] if len(sys.argv) > 1 else "fixtures/udacity/solidWhiteRight-first30.y4m"
+clip = sys.argv[1] if len(sys.argv) > 1 else "../shared/data/udacity/solidWhiteRight-320x240-gray.y4m"
 tracker = ita_nav.LaneTracker()  # default configuration
 for i, frame in enumerate(ita_nav.read_frames(clip)):
     left, right = tracker.track(frame)

@@ -2,7 +2,7 @@
 //! (information matrix inverted, mapped to pixel coefficients) and the ego lane in metres with
 //! its covariance (`CameraModel::ego_lane`), on the robot road rendered through the robot camera.
 //!
-//! `cargo bench -p nav-app --bench metric -- --warm-up-time 1 --measurement-time 3`
+//! `cargo bench -p lane-eval --bench metric -- --warm-up-time 1 --measurement-time 3`
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::hint::black_box;

@@ -1,7 +1,7 @@
 //! One tracking frame (gradient in the windows + point gathering + KIF, two lanes) and the
 //! paper's Table 1 stages, one thread.
 //!
-//! `cargo bench -p nav-app --bench track -- --warm-up-time 1 --measurement-time 3`
+//! `cargo bench -p lane-eval --bench track -- --warm-up-time 1 --measurement-time 3`
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::hint::black_box;
@@ -21,7 +21,7 @@ fn udacity_frame() -> GreyFrame {
     let path = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).unwrap();
     let mut src = Y4mSource::new(
         std::io::BufReader::new(std::fs::File::open(&path).unwrap()),
-        &path.display().to_string(),
+        path.display().to_string(),
     )
     .unwrap();
     let mut frame = GreyFrame::default();

@@ -1,6 +1,6 @@
 //! TuSimple-style accuracy of the initialisation stage on the six labelled lanenet frames.
 //!
-//! `cargo run --release -p nav-app --example lanenet_eval [DIR]` (default `../shared/data/lanenet`).
+//! `cargo run --release -p lane-eval --example lanenet_eval [DIR]` (default `../shared/data/lanenet`).
 //! Each 1280×720 colour frame goes to a fresh tracker (grey conversion, full-ROI gradient,
 //! Hough + LS per lane, one windowed refinement on the same frame) and the two reported lanes
 //! are scored against the two ego lanes of `gt_instance_image/` at rows 160, 170, … (TuSimple's

@@ -1,7 +1,7 @@
 //! The robot road rendered through the robot camera, tracked, and drawn side by side: the camera
 //! frame with the tracker's overlay, and the bird's-eye view with the ego lane in metres.
 //!
-//! `cargo run --release -p nav-app --example robot_birdseye -- OUT.png [FRAME]`
+//! `cargo run --release -p lane-eval --example robot_birdseye -- OUT.png [FRAME]`
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use lane_eval::synth::road::{ROBOT_ROADS, RoadRenderer};

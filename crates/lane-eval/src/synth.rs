@@ -474,6 +474,11 @@ impl SceneSource {
     /// Frame rate the time stamps assume, frames/s.
     pub const FRAME_RATE_HZ: f64 = 25.0;
 
+    /// The ground truth of the whole sequence (what `cargo xtask fixtures` writes beside it).
+    pub fn truth(&self) -> SequenceTruth {
+        self.renderer.sequence_truth()
+    }
+
     /// The scene `spec` rendered at `width × height`.
     pub fn new(spec: SceneSpec, width: usize, height: usize) -> Self {
         SceneSource {
@@ -512,4 +517,39 @@ impl lane_io::FrameSource for SceneSource {
     fn frame_rate_hz(&self) -> Option<f64> {
         Some(Self::FRAME_RATE_HZ)
     }
+}
+
+/// The scene `spec` rendered at `width × height` as a grey (`C mono`) YUV4MPEG2 stream at
+/// [`SceneSource::FRAME_RATE_HZ`], into `out` (a file, a `Vec<u8>`): the bytes `cargo xtask
+/// fixtures` writes, so tests render their inputs instead of reading committed copies.
+///
+/// # Errors
+/// [`EvalError::Io`] when `out` refuses a write (`name` in the message).
+pub fn write_scene_y4m<W: std::io::Write>(
+    spec: SceneSpec,
+    width: usize,
+    height: usize,
+    out: W,
+    name: &str,
+) -> Result<(), crate::EvalError> {
+    let io = |source| crate::EvalError::Io {
+        path: name.to_owned(),
+        source,
+    };
+    let mut renderer = SceneRenderer::new(spec, width, height);
+    let mut frame = GreyFrame::default();
+    let mut writer = lane_io::y4m::Y4mWriter::new(
+        out,
+        renderer.width,
+        renderer.height,
+        SceneSource::FRAME_RATE_HZ,
+        lane_io::y4m::Y4mChroma::Mono,
+    )
+    .map_err(io)?;
+    for i in 0..spec.frames {
+        renderer.render(i, &mut frame);
+        writer.write_grey(frame.data()).map_err(io)?;
+    }
+    writer.finish().map_err(io)?;
+    Ok(())
 }

@@ -191,7 +191,7 @@ fn blank_frames_report_initialising_without_coefficients() {
 fn the_real_udacity_clip_keeps_both_lanes_in_its_first_30_frames() {
     let path = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).unwrap();
     let file = std::io::BufReader::new(std::fs::File::open(&path).unwrap());
-    let mut source = Y4mSource::new(file, &path.display().to_string()).unwrap();
+    let mut source = Y4mSource::new(file, path.display().to_string()).unwrap();
     let cfg = TrackerConfig::outdoor().unwrap();
     let run = run_tracker(&mut source, &cfg, Estimator::Kif, Some(30)).unwrap();
     let c = continuity(&run.reports, 239.0);

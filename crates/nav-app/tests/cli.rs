@@ -20,8 +20,25 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-fn fixture(rel: &str) -> String {
-    format!("{}/../../fixtures/{rel}", env!("CARGO_MANIFEST_DIR"))
+/// The project's rendered scene `name` (`lane_eval::synth`, deterministic) as a YUV4MPEG2 file in
+/// the test target directory, written once (atomically, tests run in parallel).
+fn rendered(name: &str) -> String {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("rendered");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{name}.y4m"));
+    if !path.exists() {
+        let spec = lane_eval::synth::SCENES
+            .iter()
+            .find(|s| s.name == name)
+            .copied()
+            .unwrap();
+        let mut bytes = Vec::new();
+        lane_eval::synth::write_scene_y4m(spec, 320, 240, &mut bytes, name).unwrap();
+        let tmp = dir.join(format!("{name}.{:?}.tmp", std::thread::current().id()));
+        std::fs::write(&tmp, bytes).unwrap();
+        std::fs::rename(&tmp, &path).unwrap();
+    }
+    path.display().to_string()
 }
 
 fn stderr(o: &Output) -> String {
@@ -53,7 +70,7 @@ fn with_no_input_it_runs_on_the_rendered_sample() {
     assert!(o.status.success(), "{}", stderr(&o));
     let e = stderr(&o);
     assert!(
-        e.contains("rendered sample") && e.contains("5 frames"),
+        e.contains("rendered scene `curve_left_dashed`") && e.contains("5 frames"),
         "{e}"
     );
     assert!(o.stdout.is_empty(), "human output goes to stderr");
@@ -61,11 +78,7 @@ fn with_no_input_it_runs_on_the_rendered_sample() {
 
 #[test]
 fn json_is_one_object_per_frame_with_the_documented_schema() {
-    let o = nav_app(&[
-        "--input",
-        &fixture("synthetic/straight_solid.y4m"),
-        "--json",
-    ]);
+    let o = nav_app(&["--input", &rendered("straight_solid"), "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(o.stderr.is_empty(), "quiet under --json: {}", stderr(&o));
     let (frames, summary) = json_output(&o);
@@ -225,7 +238,7 @@ fn fatal_bad_input_exits_non_zero_naming_the_file() {
 #[test]
 fn a_short_last_frame_is_reported_skipped_and_counted_as_lost_exit_5() {
     let dir = scratch("short");
-    let mut bytes = std::fs::read(fixture("synthetic/straight_solid.y4m")).unwrap();
+    let mut bytes = std::fs::read(rendered("straight_solid")).unwrap();
     let frame_len = 6 + 320 * 240;
     let header_len = bytes.iter().position(|&b| b == b'\n').unwrap() + 1;
     bytes.truncate(header_len + 3 * frame_len + 1000);
@@ -286,7 +299,7 @@ fn a_bad_config_exits_1_naming_the_file_line_column_and_field_once() {
 fn loop_repeats_a_file_up_to_max_frames() {
     let o = nav_app(&[
         "--input",
-        &fixture("synthetic/straight_solid.y4m"),
+        &rendered("straight_solid"),
         "--loop",
         "--max-frames",
         "60",
@@ -305,7 +318,7 @@ fn loop_repeats_a_file_up_to_max_frames() {
 #[test]
 fn a_y4m_stream_on_stdin_is_read_with_input_dash() {
     use std::io::Write;
-    let bytes = std::fs::read(fixture("synthetic/shadows.y4m")).unwrap();
+    let bytes = std::fs::read(rendered("shadows")).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_nav-app"))
         .args(["--input", "-", "--json", "--max-frames", "10"])
         .stdin(std::process::Stdio::piped())
@@ -329,7 +342,7 @@ fn a_y4m_stream_on_stdin_is_read_with_input_dash() {
 /// `straight_solid.y4m` (24 frames, 320×240 mono) with one flipped byte in the `FRAME` header of
 /// each frame in `damaged`.
 fn damaged_fixture(damaged: &[usize]) -> Vec<u8> {
-    let mut bytes = std::fs::read(fixture("synthetic/straight_solid.y4m")).unwrap();
+    let mut bytes = std::fs::read(rendered("straight_solid")).unwrap();
     let header_len = bytes.iter().position(|&b| b == b'\n').unwrap() + 1;
     let record = 6 + 320 * 240;
     for (k, &i) in damaged.iter().enumerate() {

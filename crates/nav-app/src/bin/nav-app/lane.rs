@@ -534,14 +534,14 @@ pub fn main() -> ExitCode {
              buffers, {} frames (sequence gaps); {} timeouts ({} restarts); {} frames without \
              signal",
             dev.display(),
-            stats.frames,
+            stats.capture.frames,
             stats.elapsed_s,
             stats.fps,
-            stats.errored_dropped,
-            stats.sequence_gaps,
-            stats.timeouts,
-            stats.restarts,
-            stats.signal_lost_frames
+            stats.capture.errored_dropped,
+            stats.capture.sequence_gaps,
+            stats.capture.timeouts,
+            stats.capture.restarts,
+            stats.capture.signal_lost_frames
         );
     }
     ExitCode::from(code)
