@@ -263,6 +263,94 @@ impl HoughWorkspace {
         })
     }
 
+    /// The `out.len()` strongest, mutually separated lines of `points` in `band` (an addition
+    /// beyond the paper, which takes the single best line): the peak of [`Self::find_line`],
+    /// then repeatedly the next peak after the votes within `±sep_theta_deg` and `±sep_rho_px`
+    /// of every line taken are cleared (non-maximum suppression), strongest first. Stops early
+    /// when no vote is left. Returns the number of lines written. No allocation.
+    ///
+    /// # Errors
+    /// As [`Self::find_line`]; [`HoughError::InvalidParam`] for a negative or non-finite
+    /// separation.
+    pub fn find_lines<I>(
+        &mut self,
+        points: I,
+        band: &AngleBand,
+        sep_theta_deg: f64,
+        sep_rho_px: f64,
+        out: &mut [HoughLine],
+    ) -> Result<usize, HoughError>
+    where
+        I: IntoIterator + Clone,
+        I::Item: EdgePoint,
+    {
+        for (field, value) in [("sep_theta_deg", sep_theta_deg), ("sep_rho_px", sep_rho_px)] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(HoughError::InvalidParam {
+                    field,
+                    value,
+                    reason: "must be finite and >= 0",
+                });
+            }
+        }
+        let (k0, k1) = self.band_bins(band)?;
+        let count = self.check_points(points.clone())?;
+        if count > u32::MAX as usize {
+            return Err(HoughError::TooManyPoints {
+                found: count,
+                limit: u32::MAX as usize,
+            });
+        }
+        if count < 2 {
+            return Err(HoughError::TooFewPoints {
+                set: PointSet::Candidates,
+                found: count,
+                required: 2,
+            });
+        }
+        self.vote(points, k0, k1);
+        let dk = (sep_theta_deg / self.params.theta_step_deg).round() as usize;
+        let dr = (sep_rho_px / self.params.rho_step_px).round() as usize;
+        let nr = self.rho_bins;
+        let mut n = 0;
+        for slot in out.iter_mut() {
+            let (k, r) = if self.params.peak_smoothing {
+                self.peak_smoothed(k0, k1)
+            } else {
+                self.peak_raw(k0, k1)
+            };
+            let votes = self.acc[k * nr + r];
+            if self.score(k, r, k0, k1) <= 0.0 {
+                break;
+            }
+            let (ek, er) = if self.params.subbin_refinement {
+                self.refine(k, r, k0, k1)
+            } else {
+                (0.0, 0.0)
+            };
+            *slot = self.line_of(k as f64 + ek, r as f64 + er, votes);
+            n += 1;
+            for kk in k.saturating_sub(dk).max(k0)..=(k + dk).min(k1) {
+                let lo = kk * nr + r.saturating_sub(dr);
+                let hi = kk * nr + (r + dr).min(nr - 1);
+                self.acc[lo..=hi].fill(0);
+            }
+        }
+        Ok(n)
+    }
+
+    /// The line of (fractional) bin `(k, r)`, top-left origin.
+    fn line_of(&self, k: f64, r: f64, votes: u32) -> HoughLine {
+        let theta_rad = self.theta_deg_of_bin(k).to_radians();
+        let rho_c_px = (r - self.rho_zero_bin as f64) * self.params.rho_step_px;
+        let (s, c) = theta_rad.sin_cos();
+        HoughLine {
+            rho_px: rho_c_px + self.center_col_px * c + self.center_row_px * s,
+            theta_rad,
+            votes,
+        }
+    }
+
     /// Validate every point; returns their number.
     fn check_points<I>(&self, points: I) -> Result<usize, HoughError>
     where
@@ -526,6 +614,43 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// `find_lines` returns the drawn lines strongest first, separated, and stops when no vote
+    /// is left; its first line is `find_line`'s.
+    #[test]
+    fn find_lines_returns_separate_lines_strongest_first() {
+        let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
+        // Two `/` lines: x = 200 − 0.6·(y − 100) over 140 rows and x = 100 − 0.5·(y − 100) over
+        // 80 rows (weaker), both θ > 0.
+        let mut pts: Vec<Point> = (100..240)
+            .map(|y| Point::new(200.0 - 0.6 * f64::from(y - 100), f64::from(y)))
+            .collect();
+        pts.extend((100..180).map(|y| Point::new(100.0 - 0.5 * f64::from(y - 100), f64::from(y))));
+        let band = AngleBand::LEFT_LANE;
+        let best = ws.find_line(&pts, &band).unwrap();
+        let none = HoughLine {
+            rho_px: 0.0,
+            theta_rad: 0.0,
+            votes: 0,
+        };
+        let mut out = [none; 6];
+        let n = ws.find_lines(&pts, &band, 3.0, 8.0, &mut out).unwrap();
+        assert!(n >= 2, "{n} lines");
+        assert_eq!(out[0], best);
+        assert!(out[0].votes >= out[1].votes);
+        let at = |l: &HoughLine, y: f64| l.col_at_row(y).unwrap();
+        assert!((at(&out[0], 200.0) - 140.0).abs() < 1.0, "{:?}", out[0]);
+        // The second line is the weaker drawn one, not a near copy of the first.
+        assert!((at(&out[1], 150.0) - 75.0).abs() < 1.0, "{:?}", out[1]);
+        for l in &out[..n] {
+            assert!(band.contains_deg(l.theta_deg()));
+        }
+        // Two points only: at most as many lines as there are votes, never an error.
+        let two = [Point::new(10.0, 10.0), Point::new(20.0, 30.0)];
+        let k = ws.find_lines(&two, &band, 3.0, 8.0, &mut out).unwrap();
+        assert!((1..=6).contains(&k));
+        assert!(ws.find_lines(&pts, &band, -1.0, 8.0, &mut out).is_err());
     }
 
     /// The three-point vertex formula is exact on a sampled parabola and clamps outside ±½.

@@ -57,6 +57,26 @@ where
         });
     }
     let line = workspace.find_line(points.clone(), band)?;
+    fit_around_line(points, line, params)
+}
+
+/// Steps 3–4 of [`init_lane`] for a given line (e.g. one of
+/// [`HoughWorkspace::find_lines`]' candidates): the least-squares parabola of the pixels within
+/// `band_px` of `line`, refitted `refit_iterations` times to the pixels within `band_px` of
+/// the last fit. Allocation-free.
+///
+/// # Errors
+/// Any [`HoughError`] from the parameters, too few points in the band, or a degenerate fit.
+pub fn fit_around_line<I>(
+    points: I,
+    line: HoughLine,
+    params: &LaneInitParams,
+) -> Result<LaneInit, HoughError>
+where
+    I: IntoIterator + Clone,
+    I::Item: EdgePoint,
+{
+    params.validate()?;
     let band_px = params.band_px;
     let (sin_t, cos_t) = line.theta_rad.sin_cos();
     let rho_px = line.rho_px;
@@ -82,4 +102,44 @@ where
         rms_residual_px: fit.rms_residual_px,
         rows_px: fit.rows_px,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{HoughParams, Point};
+
+    /// `fit_around_line` on a chosen line fits only the pixels of that line: with two marks in
+    /// the points, each line gives its own parabola, and `init_lane` equals it on the best line.
+    #[test]
+    fn fitting_around_a_given_line_keeps_to_that_line() {
+        let a = |y: f64| 0.0005 * y * y - 0.8 * y + 250.0;
+        let b = |y: f64| -0.4 * y + 120.0;
+        let mut pts: Vec<Point> = (100..240)
+            .map(|y| Point::new(a(f64::from(y)), f64::from(y)))
+            .collect();
+        pts.extend((120..200).map(|y| Point::new(b(f64::from(y)), f64::from(y))));
+        let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
+        let params = LaneInitParams {
+            refit_iterations: 2,
+            ..LaneInitParams::default()
+        };
+        let band = AngleBand::LEFT_LANE;
+        let whole = init_lane(&pts, &band, &mut ws, &params).unwrap();
+        let again = fit_around_line(&pts, whole.line, &params).unwrap();
+        assert_eq!(whole, again);
+        assert!((whole.parabola.col_at_row(200.0) - a(200.0)).abs() < 0.5);
+        // The weaker line, given explicitly.
+        let line_b = HoughLine {
+            theta_rad: (0.4f64).atan(),
+            rho_px: 120.0 * (0.4f64).atan().cos(),
+            votes: 0,
+        };
+        let fit_b = fit_around_line(&pts, line_b, &params).unwrap();
+        assert!(
+            (fit_b.parabola.col_at_row(160.0) - b(160.0)).abs() < 0.5,
+            "{fit_b:?}"
+        );
+        assert_eq!(fit_b.points_used, 80);
+    }
 }

@@ -95,6 +95,17 @@
 //! no allocation once the workspace exists; labelled real frames (lanenet ground truth)
 //! within the TuSimple tolerance.
 //!
+//! # Beyond the paper: several candidates and a joint ego-pair choice
+//!
+//! [`HoughWorkspace::find_lines`] returns the strongest few lines of a band (non-maximum
+//! suppression in θ and ρ) instead of the single best; [`choose_ego_pair`] picks the ego lane's
+//! two boundaries among the candidates of both bands jointly — a plausible lane width at the
+//! bottom ROI row, boundaries that converge towards a vanishing point above the ROI, the camera
+//! inside the lane, the pair nearest the image centre — so a neighbour lane's stronger line, a
+//! crosswalk stripe or a car edge leaning the wrong way no longer wins on votes alone, and on a
+//! curve the two boundaries may lean the same way. [`fit_around_line`] is the least-squares
+//! half of [`init_lane`] for a chosen line.
+//!
 //! # Parameters and units
 //!
 //! | struct | field | unit | default | disables |
@@ -128,6 +139,7 @@
 //! # Ok::<(), hough_init::HoughError>(())
 //! ```
 
+mod ego;
 mod error;
 mod hough;
 mod init;
@@ -135,9 +147,10 @@ mod parabola;
 mod params;
 mod point;
 
+pub use ego::{Chord, EgoChoice, EgoPairParams, choose_ego_pair};
 pub use error::{HoughError, PointSet};
 pub use hough::{HoughLine, HoughWorkspace, MAX_ACCUMULATOR_CELLS, MAX_IMAGE_SIDE_PX};
-pub use init::{LaneInit, init_lane};
+pub use init::{LaneInit, fit_around_line, init_lane};
 pub use parabola::{MIN_RELATIVE_PIVOT, Parabola, ParabolaFit, fit_parabola, fit_parabola_where};
 pub use params::{AngleBand, HoughParams, InitConfig, LaneInitParams};
 pub use point::{EdgePoint, Point};

@@ -82,6 +82,26 @@ fn tracking_frame(c: &mut Criterion) {
                 black_box(tracker.track(black_box(frame)).unwrap())
             });
         });
+        // The default configuration (joint initialisation, stripe pairing): a tracking frame and
+        // an initialisation frame (several Hough candidates per band, ego-pair choice, two
+        // refinements in the wider window).
+        let default = TrackerConfig::default_preset().unwrap();
+        let mut tracker =
+            LaneTracker::new(&default, Estimator::Kif, frame.width(), frame.height()).unwrap();
+        for _ in 0..5 {
+            tracker.track(frame).unwrap();
+        }
+        if !tracker.track(frame).unwrap().full_gradient {
+            group.bench_function(BenchmarkId::new("kif_default", name), |b| {
+                b.iter(|| black_box(tracker.track(black_box(frame)).unwrap()));
+            });
+        }
+        group.bench_function(BenchmarkId::new("init_frame_default", name), |b| {
+            b.iter(|| {
+                tracker.reset();
+                black_box(tracker.track(black_box(frame)).unwrap())
+            });
+        });
     }
     group.finish();
 }

@@ -4,14 +4,23 @@
 
 use alloc_counter::allocations_in;
 use lane_eval::synth::{SCENES, SceneRenderer};
-use lane_tracker::{Estimator, GreyFrame, LaneTracker};
+use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
 
 #[global_allocator]
 static ALLOC: alloc_counter::CountingAllocator = alloc_counter::CountingAllocator::new();
 
 fn allocations_while_tracking(estimator: Estimator, scene: &str) -> (u64, u64) {
     let spec = SCENES.iter().find(|s| s.name == scene).copied().unwrap();
-    let cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
+    allocations_with(
+        estimator,
+        scene,
+        &lane_io::config::load_tracker_config(spec.config).unwrap(),
+    )
+}
+
+fn allocations_with(estimator: Estimator, scene: &str, cfg: &TrackerConfig) -> (u64, u64) {
+    let spec = SCENES.iter().find(|s| s.name == scene).copied().unwrap();
+    let cfg = *cfg;
     let mut renderer = SceneRenderer::new(spec, 320, 240);
     let mut tracker = LaneTracker::new(&cfg, estimator, 320, 240).unwrap();
     let mut frame = GreyFrame::default();
@@ -32,6 +41,22 @@ fn kif_tracking_and_reinitialisation_frames_do_not_allocate() {
     // wall_recovery covers tracking, coasting, loss and Hough + LS re-initialisation.
     for scene in ["straight_solid", "wall_recovery", "noise"] {
         let (allocs, frames) = allocations_while_tracking(Estimator::Kif, scene);
+        assert!(frames > 20);
+        assert_eq!(
+            allocs, 0,
+            "{scene}: {allocs} allocations in {frames} frames"
+        );
+    }
+}
+
+#[test]
+fn the_default_configuration_does_not_allocate() {
+    // Joint initialisation (several Hough candidates, ego-pair choice) and stripe splitting,
+    // on every frame of sequences with re-initialisation.
+    let cfg = TrackerConfig::default_preset().unwrap();
+    assert!(cfg.init.candidate_lines > 0 && cfg.gradient.stripe_paired_votes > 0);
+    for scene in ["wall_recovery", "noise"] {
+        let (allocs, frames) = allocations_with(Estimator::Kif, scene, &cfg);
         assert!(frames > 20);
         assert_eq!(
             allocs, 0,

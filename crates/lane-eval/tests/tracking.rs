@@ -203,3 +203,88 @@ fn the_real_udacity_clip_keeps_both_lanes_in_its_first_30_frames() {
         "no unexplained re-initialisation: {c:?}"
     );
 }
+
+/// A dark floor with two bright 4-px marks, both leaning `\` (a right-hand curve seen from inside
+/// the lane): the left boundary from column 100 (bottom) to 40 (row 150), the right one from 290
+/// to 160.
+fn curve_pair_frame() -> GreyFrame {
+    let (w, h) = (320usize, 240usize);
+    let mut data = vec![40u8; w * h];
+    for y in 0..h {
+        let t = (239.0 - y as f64) / 89.0;
+        for (bottom, top) in [(100.0, 40.0), (290.0, 160.0)] {
+            let centre = bottom + (top - bottom) * t;
+            for x in 0..w {
+                if (x as f64 - centre).abs() <= 2.0 {
+                    data[y * w + x] = 200;
+                }
+            }
+        }
+    }
+    let mut frame = GreyFrame::default();
+    frame.reshape(w, h).unwrap();
+    frame.data_mut().copy_from_slice(&data);
+    frame
+}
+
+#[test]
+fn the_default_joint_initialisation_sides_lanes_by_position_on_a_curve() {
+    // The paper's initialisation takes the best `/` line as the left lane: there is none, and
+    // the right lane's class holds both marks. The default's joint choice finds the pair.
+    let frame = curve_pair_frame();
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
+    let report = tracker.track(&frame).unwrap();
+    let [left, right] = report.lanes;
+    let at = |l: &lane_tracker::LaneReport, y: f64| l.col_at_row(y).unwrap();
+    assert_eq!(left.state, LaneState::Tracking);
+    assert_eq!(right.state, LaneState::Tracking);
+    assert!(
+        (at(&left, 230.0) - (100.0 - 60.0 * 9.0 / 89.0)).abs() < 2.0,
+        "{left:?}"
+    );
+    assert!(
+        (at(&right, 230.0) - (290.0 - 130.0 * 9.0 / 89.0)).abs() < 2.0,
+        "{right:?}"
+    );
+    // Tracking the next (identical) frame keeps both: rows take the class of the predicted slope.
+    let report = tracker.track(&frame).unwrap();
+    assert!(report.lanes.iter().all(|l| l.state == LaneState::Tracking));
+    assert!(!report.full_gradient);
+
+    let mut paper = cfg;
+    paper.init.candidate_lines = 0;
+    let mut tracker = LaneTracker::new(&paper, Estimator::Kif, 320, 240).unwrap();
+    let report = tracker.track(&frame).unwrap();
+    assert!(report.lanes[0].coeffs.is_none(), "{:?}", report.lanes[0]);
+}
+
+#[test]
+fn every_synthetic_scene_is_tracked_with_the_default_configuration() {
+    // The default configuration (joint initialisation, stripe pairing, threshold 60) on the
+    // rendered sequences: the presets' acceptance bounds, except on `noise`, where the lower
+    // magnitude threshold lets more noise pixels into the windows (measured: mean error 1.8 px,
+    // accuracy 0.90, against 0.6 px and 0.99 with the paper's initialisation and threshold 90).
+    // A known cost of the default's real-data tuning; the bound below catches a further loss.
+    let cfg = TrackerConfig::default_preset().unwrap();
+    for spec in SCENES {
+        let mut renderer = SceneRenderer::new(*spec, 320, 240);
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
+        let mut frame = GreyFrame::default();
+        let reports: Vec<Option<TrackReport>> = (0..spec.frames)
+            .map(|i| {
+                renderer.render(i, &mut frame);
+                Some(tracker.track(&frame).unwrap())
+            })
+            .collect();
+        let s = score_sequence(&renderer.sequence_truth(), &reports);
+        let (max_err, min_acc) = if spec.name == "noise" {
+            (2.5, 0.85)
+        } else {
+            (1.5, 0.98)
+        };
+        assert!(s.mean_lateral_error_px <= max_err, "{}: {s:?}", spec.name);
+        assert!(s.accuracy >= min_acc, "{}: {s:?}", spec.name);
+        assert!(s.max_recovery_frames <= 3, "{}: {s:?}", spec.name);
+    }
+}

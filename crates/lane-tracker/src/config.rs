@@ -3,7 +3,7 @@
 //! Every field carries its unit in its name or its doc. Unknown fields are refused
 //! (`deny_unknown_fields`) and [`TrackerConfig::validate`] names the first field out of range.
 
-use hough_init::{AngleBand, HoughError, HoughParams, LaneInitParams};
+use hough_init::{AngleBand, EgoPairParams, HoughError, HoughParams, LaneInitParams};
 use serde::{Deserialize, Serialize};
 use toml_config::TomlDoc;
 use vision_gradient::{GradientError, GradientParams, Threshold};
@@ -36,6 +36,29 @@ pub struct GradientConfig {
     pub min_edge_angle_deg: f64,
     /// Upper limit of the edge-line angle band, degrees.
     pub max_edge_angle_deg: f64,
+    /// Stripe pairing (an addition beyond the paper; `vision_gradient::keep_bright_stripes`):
+    /// keep only edge pixels that pair, along their row, with an edge of the same class and the
+    /// opposite polarity within this many columns (rising on the left, falling on the right:
+    /// the two sides of a bright mark), px, 0..=200; 0 (default when absent) keeps every edge
+    /// pixel (the paper).
+    #[serde(default)]
+    pub stripe_max_width_px: u16,
+    /// With stripe pairing that drops unpaired pixels (`stripe_paired_votes = 0`): also keep
+    /// an unpaired edge pixel whose bright side faces away from the image's middle column (a
+    /// kerb or road edge, the road being the darker side towards the middle). Default `false`.
+    #[serde(default)]
+    pub stripe_keep_outward_steps: bool,
+    /// With stripe pairing: 0 (default when absent) drops the unpaired edge pixels; `k` in
+    /// 1..=4 keeps them instead and lets the paired ones count `k` times in the initialisation
+    /// (Hough votes and least squares) against once for an unpaired one (kerbs and road edges
+    /// still count, marks count more); tracking windows then keep every pixel. Votes per pixel.
+    #[serde(default)]
+    pub stripe_paired_votes: u8,
+    /// With `stripe_paired_votes > 0`: drop the edge pixels that bound only a dark stripe at
+    /// most `stripe_max_width_px` wide (the seam beside a mark, a tar joint, a crack); single
+    /// steps still count. Default `false`.
+    #[serde(default)]
+    pub stripe_drop_dark: bool,
 }
 
 /// Region of interest: the rows where lanes are looked for (the sky is not lane).
@@ -65,6 +88,32 @@ pub struct InitConfig {
     /// Refits of the LS parabola to the pixels within `band_half_width_px` of the previous fit
     /// (follows a curved mark beyond the straight Hough band), 0..=10; 0 disables.
     pub refit_iterations: u32,
+    /// Joint initialisation (an addition beyond the paper): Hough candidate lines taken per
+    /// angle band (non-maximum suppression, `hough_init::HoughWorkspace::find_lines`), the ego
+    /// pair then chosen among the candidates of both bands by `init.ego_pair`
+    /// (`hough_init::choose_ego_pair`), each lane's side given by its position, not its lean;
+    /// tracking then takes, per row, the edge class of the predicted slope. Count, 0..=8;
+    /// 0 (default when absent): the paper's best line per band, left = `/`, right = `\`.
+    #[serde(default)]
+    pub candidate_lines: usize,
+    /// Non-maximum suppression between candidate lines: angle, degrees (≥ 0).
+    #[serde(default = "default_separation_deg")]
+    pub candidate_separation_deg: f64,
+    /// Non-maximum suppression between candidate lines: normal distance ρ, px (≥ 0).
+    #[serde(default = "default_separation_px")]
+    pub candidate_separation_px: f64,
+    /// The plausible ego lane (`hough_init::EgoPairParams`; widths are fractions of the image
+    /// width, dimensionless), used when `candidate_lines > 0`.
+    #[serde(default)]
+    pub ego_pair: EgoPairParams,
+}
+
+fn default_separation_deg() -> f64 {
+    3.0
+}
+
+fn default_separation_px() -> f64 {
+    8.0
 }
 
 impl GradientConfig {
@@ -197,6 +246,26 @@ pub struct TrackConfig {
     /// edge pixels with `R = filter.r_sigma_px²·I`.
     #[serde(default)]
     pub mark_centres: bool,
+    /// Half-width of the window of the windowed refinement that follows an initialisation on
+    /// the same frame, px (1..=200; an addition beyond the paper); 0 (default when absent):
+    /// `window_half_width_px`.
+    #[serde(default)]
+    pub refine_window_half_width_px: usize,
+    /// Windowed refinements after an initialisation on the same frame, 1..=5 (default 1 when
+    /// absent; 0 is read as 1).
+    #[serde(default)]
+    pub refine_passes: u32,
+}
+
+impl TrackConfig {
+    /// The window half-width of the refinement after an initialisation, px.
+    pub fn refine_window_half_width(&self) -> usize {
+        if self.refine_window_half_width_px == 0 {
+            self.window_half_width_px
+        } else {
+            self.refine_window_half_width_px
+        }
+    }
 }
 
 /// Filter noise models (KIF and WRLS).
@@ -330,6 +399,56 @@ impl TrackerConfig {
         }
         self.init.hough_params().validate().map_err(init_field)?;
         self.init.lane_params().validate().map_err(init_field)?;
+        let i = &self.init;
+        check(
+            i.candidate_lines <= 8,
+            "init.candidate_lines",
+            i.candidate_lines,
+            "must be in 0..=8",
+        )?;
+        check(
+            i.candidate_separation_deg.is_finite() && i.candidate_separation_deg >= 0.0,
+            "init.candidate_separation_deg",
+            i.candidate_separation_deg,
+            "must be finite and ≥ 0 degrees",
+        )?;
+        check(
+            i.candidate_separation_px.is_finite() && i.candidate_separation_px >= 0.0,
+            "init.candidate_separation_px",
+            i.candidate_separation_px,
+            "must be finite and ≥ 0 px",
+        )?;
+        i.ego_pair.validate().map_err(|e| match e {
+            HoughError::InvalidParam {
+                field,
+                value,
+                reason,
+            } => field_err(
+                match field {
+                    "min_width_frac" => "init.ego_pair.min_width_frac",
+                    "max_width_frac" => "init.ego_pair.max_width_frac",
+                    "centre_margin_frac" => "init.ego_pair.centre_margin_frac",
+                    "max_top_width_ratio" => "init.ego_pair.max_top_width_ratio",
+                    "centre_weight" => "init.ego_pair.centre_weight",
+                    _ => "init.ego_pair.min_support_frac",
+                },
+                value,
+                reason,
+            ),
+            other => TrackerError::Hough(other),
+        })?;
+        check(
+            g.stripe_max_width_px <= 200,
+            "gradient.stripe_max_width_px",
+            g.stripe_max_width_px,
+            "must be in 0..=200 px",
+        )?;
+        check(
+            g.stripe_paired_votes <= 4,
+            "gradient.stripe_paired_votes",
+            g.stripe_paired_votes,
+            "must be in 0..=4",
+        )?;
         let r = &self.roi;
         check(
             (0.0..1.0).contains(&r.top_row_fraction),
@@ -349,6 +468,18 @@ impl TrackerConfig {
             "track.window_half_width_px",
             t.window_half_width_px,
             "must be in 1..=200 px",
+        )?;
+        check(
+            t.refine_window_half_width_px <= 200,
+            "track.refine_window_half_width_px",
+            t.refine_window_half_width_px,
+            "must be in 0..=200 px (0: window_half_width_px)",
+        )?;
+        check(
+            t.refine_passes <= 5,
+            "track.refine_passes",
+            t.refine_passes,
+            "must be in 0..=5",
         )?;
         check(
             t.inlier_half_width_px > 0.0 && t.inlier_half_width_px.is_finite(),
@@ -416,15 +547,20 @@ impl TrackerConfig {
 
     /// Multiply every pixel-valued parameter by `k` (> 0): the presets are tuned for 320-px-wide
     /// frames, so a 1280-px frame takes `k = 4`. Scaled: window and inlier half-widths, jump
-    /// gate, lane separation, Hough band, R, Q and P0 standard deviations. Not scaled: the
+    /// gate, lane separation, Hough band and candidate separation, stripe width, R, Q and P0 standard deviations. Not scaled: the
     /// gradient threshold (grey levels), fractions, angles, counts.
     pub fn scale_pixels(&mut self, k: f64) {
         let t = &mut self.track;
         t.window_half_width_px = ((t.window_half_width_px as f64 * k).round() as usize).max(1);
+        t.refine_window_half_width_px =
+            ((t.refine_window_half_width_px as f64 * k).round() as usize).min(200);
         t.inlier_half_width_px *= k;
         t.max_jump_px *= k;
         t.min_lane_separation_px *= k;
         self.init.band_half_width_px *= k;
+        self.init.candidate_separation_px *= k;
+        let g = &mut self.gradient;
+        g.stripe_max_width_px = (f64::from(g.stripe_max_width_px) * k).round().min(200.0) as u16;
         let f = &mut self.filter;
         f.r_sigma_px *= k;
         f.q_sigma_px = f.q_sigma_px.map(|q| q * k);

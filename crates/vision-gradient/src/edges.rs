@@ -87,6 +87,22 @@ impl EdgeBuffer {
         self.dropped = 0;
     }
 
+    /// The stored pixels, mutable (for in-crate post-filters).
+    pub(crate) fn pixels_mut(&mut self) -> &mut [EdgePixel] {
+        &mut self.pixels
+    }
+
+    /// Keeps the pixels whose `magnitude` has bit `flag` set, then masks every kept magnitude
+    /// with `mask`; returns the number dropped. Order is preserved, no allocation.
+    pub(crate) fn retain_flagged(&mut self, flag: u16, mask: u16) -> usize {
+        let before = self.pixels.len();
+        self.pixels.retain(|p| p.magnitude & flag != 0);
+        for p in &mut self.pixels {
+            p.magnitude &= mask;
+        }
+        before - self.pixels.len()
+    }
+
     #[inline]
     pub(crate) fn push(&mut self, pixel: EdgePixel) {
         if self.pixels.len() < self.capacity {

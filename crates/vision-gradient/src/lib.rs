@@ -77,6 +77,19 @@
 //! row first so truncation loses the far rows; truncation is reported) and, optionally, into a
 //! caller `&mut [u8]` class image of `width·height` bytes (`0` none, `1` left, `2` right).
 //!
+//! ## Stripe pairing (an addition beyond the paper; [`keep_bright_stripes`])
+//! Lane marks are bright stripes on a darker ground. Both sides of a stripe get the same class,
+//! but opposite horizontal polarity: the left side rises (`gx > 0`, dark → bright to the
+//! right), the right side falls. [`keep_bright_stripes`] keeps, row by row, only the pixels
+//! that have a partner of the same class and the opposite polarity within `max_width_px`
+//! columns on the correct side, i.e. the two sides of a bright stripe at most that wide along
+//! the row. The dark seam beside a mark, tar joints, and the single edges of dark objects
+//! (cars, kerbs, walls, shadows) then no longer vote. [`split_stripes`] is the weighting form:
+//! it copies the bright-stripe pixels aside (to be counted more) and drops only the sides of
+//! *dark* stripes, so a single step such as a kerb still counts. Both run after [`GradientDetector::detect`]
+//! on its output (any region), costs one 3×3 `gx` per kept pixel and a scan of its row
+//! neighbours, and allocates nothing.
+//!
 //! ## Defaults
 //! [`GradientParams::default`]: band 15°..80°, fixed threshold 120 (a 45° step of 20 grey
 //! levels). On the Udacity 320×240 frames (`shared/data/udacity`) this keeps both marks of the
@@ -127,11 +140,13 @@ mod error;
 mod image;
 mod kernel;
 mod params;
+mod ridge;
 
 pub use edges::{EdgeBuffer, EdgeClass, EdgePixel, EdgeStats};
 pub use error::GradientError;
 pub use image::{GreyImage, MAX_SIDE_PX};
 pub use params::{GradientParams, Threshold};
+pub use ridge::{keep_bright_stripes, split_stripes};
 
 use kernel::{Band, CheckedRegion, HIST_BINS, Sink};
 

@@ -213,6 +213,8 @@ pub struct LaneTracker {
     roi: (usize, usize),
     detector: GradientDetector,
     edges: EdgeBuffer,
+    /// The edge pixels that pair into bright stripes (`gradient.stripe_paired_votes`).
+    paired: EdgeBuffer,
     hough: HoughWorkspace,
     init_params: LaneInitParams,
     candidates: Vec<(f32, f32)>,
@@ -287,9 +289,12 @@ impl LaneTracker {
             roi,
             detector,
             edges: EdgeBuffer::with_capacity(capacity),
+            paired: EdgeBuffer::with_capacity(capacity),
             hough,
             init_params,
-            candidates: Vec::with_capacity(capacity),
+            candidates: Vec::with_capacity(
+                usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity,
+            ),
             scratch: Vec::with_capacity(capacity),
             row_norm,
             q,
@@ -437,7 +442,9 @@ impl LaneTracker {
             // LS parabola, with the window's outlier rejection (the Hough band keeps clutter).
             for i in 0..2 {
                 if self.lanes[i].initialised_now {
-                    self.track_lane(i, &image, false)?;
+                    for _ in 0..self.cfg.track.refine_passes.max(1) {
+                        self.track_lane(i, &image, false)?;
+                    }
                     let lane = &mut self.lanes[i];
                     if lane.state != LaneState::Tracking {
                         // The refinement missed: keep the LS initialisation as it was.

@@ -6,7 +6,7 @@ use hough_init::Parabola;
 use info_filter::{PowerSums, RowNorm};
 use lane_geometry::{FIT_SAMPLES, FitRows};
 use nalgebra::{Matrix3, Vector3};
-use vision_gradient::GreyImage;
+use vision_gradient::{EdgeClass, EdgePixel, GreyImage};
 
 use super::LaneTracker;
 
@@ -179,15 +179,24 @@ fn step_edge(pixels: &[u8], step: f64) -> Option<(f64, f64)> {
     Some((c, spread / (sw * sw)))
 }
 
+/// `|dx/dy|` below which a tracked mark is near vertical and both edge classes are taken
+/// (joint initialisation): tan 10°, the edge band's default upper limit.
+const NEAR_VERTICAL_SLOPE: f64 = 0.176;
+
 /// Largest window half-width accepted by the configuration, px.
 pub(crate) const MAX_WINDOW_HALF_WIDTH: usize = 200;
 
 impl LaneTracker {
-    /// Lane `i`'s measurement for this frame from the window pixels in `self.edges` about the
-    /// predicted `coeffs`: fills `lane.points` (and `lane.weights` with mark centres).
-    pub(super) fn select_points(&mut self, i: usize, image: &GreyImage<'_>, coeffs: [f64; 3]) {
+    /// Lane `i`'s measurement for this frame from the window pixels in `self.edges` (windows
+    /// `±w` px) about the predicted `coeffs`: fills `lane.points` (and `lane.weights` with mark centres).
+    pub(super) fn select_points(
+        &mut self,
+        i: usize,
+        image: &GreyImage<'_>,
+        coeffs: [f64; 3],
+        w: i64,
+    ) {
         let (top, bottom) = self.roi;
-        let w = self.cfg.track.window_half_width_px as i64;
         let max_points = self.cfg.track.max_points_per_lane;
         let lane = &mut self.lanes[i];
         // Outlier rejection: the residuals r = x − x̂(y) of the window pixels are histogrammed
@@ -200,7 +209,25 @@ impl LaneTracker {
         // window pixels are within ±w of the prediction) and row band, histogrammed per band.
         let mut hist = [[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS];
         self.scratch.clear();
-        for p in self.edges.iter_class(lane.class) {
+        // Joint initialisation (lanes sided by position, not lean): per row, the edge class of
+        // the predicted slope (`/`: dx/dy < 0), either class where the mark is near vertical.
+        let joint = self.cfg.init.candidate_lines > 0;
+        let class_ok = |p: &&EdgePixel| {
+            if !joint {
+                return p.class == lane.class;
+            }
+            let slope = Parabola::from_coeffs(coeffs).slope_at_row(f64::from(p.row_px));
+            if slope.abs() < NEAR_VERTICAL_SLOPE {
+                return true;
+            }
+            p.class
+                == if slope < 0.0 {
+                    EdgeClass::LeftLane
+                } else {
+                    EdgeClass::RightLane
+                }
+        };
+        for p in self.edges.pixels().iter().filter(class_ok) {
             let v =
                 f64::from(p.col_px) - Parabola::from_coeffs(coeffs).col_at_row(f64::from(p.row_px));
             // Truncation of a non-negative value is floor: this rounds v to the nearest bin.

@@ -1,7 +1,7 @@
 //! Stage III, measurement update and gates: the filter update (KIF eqs. 6, 12 or WRLS eqs.
 //! 25–27), the jump gate, misses, and the crossing gate between the two lanes.
 
-use vision_gradient::{GreyImage, Region};
+use vision_gradient::{GreyImage, Region, keep_bright_stripes};
 
 use super::points::{fit_profile, weighted_scatter};
 use super::{Lane, LaneFilter, LaneState, LaneTracker};
@@ -27,7 +27,16 @@ impl LaneTracker {
             &mut self.edges,
             None,
         )?;
-        self.select_points(i, image, coeffs);
+        // Stripe pairing that drops unpaired pixels (`gradient.stripe_paired_votes = 0`) applies
+        // in the windows too; with weighted pairing the windows keep every pixel.
+        let stripe_px = if self.cfg.gradient.stripe_paired_votes > 0 {
+            0
+        } else {
+            self.cfg.gradient.stripe_max_width_px
+        };
+        let outward = self.outward_col();
+        keep_bright_stripes(image, &mut self.edges, None, stripe_px, outward);
+        self.select_points(i, image, coeffs, self.window_half_width(predict));
         if self.lanes[i].points.len() < self.cfg.track.reinit_min_points {
             Self::miss(&mut self.lanes[i], &self.cfg);
             return Ok(());

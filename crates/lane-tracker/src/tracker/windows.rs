@@ -8,13 +8,24 @@ use super::{LaneFilter, LaneState, LaneTracker};
 use crate::error::FilterFailure;
 
 impl LaneTracker {
+    /// Window half-width, px: `track.window_half_width_px` while tracking (`predict`); the
+    /// refinement of a fresh initialisation may take a wider one
+    /// (`track.refine_window_half_width_px`: the Hough line can sit a few pixels off the mark).
+    pub(super) fn window_half_width(&self, predict: bool) -> i64 {
+        if predict {
+            self.cfg.track.window_half_width_px as i64
+        } else {
+            self.cfg.track.refine_window_half_width() as i64
+        }
+    }
+
     /// Time update of lane `i` (KIF eq. 24 when `predict`; WRLS forgets once per frame in its
     /// update) and its windows for this frame. Returns the predicted coefficients, or `None` when
     /// the lane has no filter or its prediction failed (then counted, kept in
     /// [`LaneTracker::last_filter_error`], and the lane is lost).
     pub(super) fn predict_windows(&mut self, i: usize, predict: bool) -> Option<[f64; 3]> {
         let (top, bottom) = self.roi;
-        let w = self.cfg.track.window_half_width_px as i64;
+        let w = self.window_half_width(predict);
         let lane = &mut self.lanes[i];
         let filter = lane.filter.as_mut()?;
         let predicted = match filter {
