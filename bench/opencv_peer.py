@@ -58,7 +58,7 @@ def opencv_pipeline(grey, roi_mask):
     lines = cv2.HoughLinesP(edges, 1, np.pi / 180, 20, minLineLength=20, maxLineGap=10)
     fits = []
     if lines is not None:
-        seg = lines[:, 0, :].astype(np.float64)
+        seg = np.asarray(lines).reshape(-1, 4).astype(np.float64)  # (N, 1, 4) or (N, 4) by version
         dx = seg[:, 2] - seg[:, 0]
         dy = seg[:, 3] - seg[:, 1]
         slope = np.divide(dy, dx, out=np.zeros_like(dy), where=dx != 0)
@@ -78,7 +78,7 @@ def opencv_sides(grey, roi_mask):
     lines = cv2.HoughLinesP(edges, 1, np.pi / 180, 20, minLineLength=20, maxLineGap=10)
     out = [None, None]
     if lines is not None:
-        seg = lines[:, 0, :].astype(np.float64)
+        seg = np.asarray(lines).reshape(-1, 4).astype(np.float64)  # (N, 1, 4) or (N, 4) by version
         dx = seg[:, 2] - seg[:, 0]
         dy = seg[:, 3] - seg[:, 1]
         slope = np.divide(dy, dx, out=np.zeros_like(dy), where=dx != 0)

@@ -4,9 +4,10 @@
 //!
 //! Every set is split once and for all: the first 70 % of its frames (in set order) are the
 //! **development** part, the rest the **held-out** part; the tracker's defaults may be tuned on the
-//! development part only, and the held-out figures are reported on their own. Scored: the default
+//! development part only, and the held-out figures are reported on their own. Scored: the ceiling (parabolas fitted to the labels over the ROI rows), the default
 //! configuration (what `nav-app` runs with no `--config`), the presets, and the classic OpenCV
-//! pipeline (`bench/opencv_peer.py`) when `target/opencv-venv/bin/python` exists. Writes
+//! pipeline (`bench/opencv_peer.py`, in `target/opencv-venv`, made from PyPI on first use; `--no-peer`
+//! leaves it out). Writes
 //! `summary.md`, `summary.json` and `worst_frames.png` (the worst frames of the default run:
 //! labels green, nav-app red, the OpenCV peer blue). `--check` compares the default's figures with
 //! the floors in `fixtures/expectations-lanes-real.json` and fails below them; `--record` writes
@@ -19,7 +20,7 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use lane_eval::labelled::{
     EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, ScoringRules,
-    score_frame, track_label_set,
+    ceiling_prediction, score_frame, track_label_set,
 };
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
@@ -61,6 +62,10 @@ const DEV_FRACTION: f64 = 0.7;
 const FLOOR_MARGIN: f64 = 0.03;
 /// Name of the default configuration in the reports.
 const DEFAULT_NAME: &str = "default";
+/// Name of the ceiling (parabolas fitted to the labels over the ROI rows) in the reports.
+const CEILING_NAME: &str = "ceiling";
+/// What the OpenCV peer's virtual environment (`target/opencv-venv`) holds, from PyPI.
+const PEER_REQUIREMENTS: &[&str] = &["opencv-python-headless<5", "numpy"];
 /// Name of the OpenCV peer in the reports.
 const PEER_NAME: &str = "opencv-peer";
 /// Tiles in the contact sheet.
@@ -205,12 +210,15 @@ fn find_sets(dir: &Path) -> Result<Vec<(PathBuf, LabelSet)>> {
         .collect()
 }
 
-/// The peer's `(frame index, prediction)` per frame, `None` without its venv.
+/// The peer's `(frame index, prediction)` per frame (its virtual environment made on first use).
 fn run_peer(root: &Path, set_dir: &Path, out: &Path) -> Result<Option<Vec<(u64, EgoPrediction)>>> {
-    let python = root.join("target/opencv-venv/bin/python");
-    if !python.exists() {
-        return Ok(None);
-    }
+    let python = crate::python::ensure_venv_with(
+        root,
+        "opencv-venv",
+        PEER_REQUIREMENTS,
+        "import cv2, numpy",
+        None,
+    )?;
     let status = Command::new(&python)
         .arg(root.join("bench/opencv_peer.py"))
         .arg("--predict-set")
@@ -288,6 +296,16 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
             }
             None => None,
         };
+        // The ceiling: a parabola fitted to the labels themselves over the default's ROI rows,
+        // scored by the same rules (what the lane model can reach on this set).
+        let roi = configs[0].1.roi_rows(set.height);
+        runs.push((
+            CEILING_NAME.to_owned(),
+            set.frames
+                .iter()
+                .map(|f| ceiling_prediction(f, roi))
+                .collect(),
+        ));
         for (name, preds) in &runs {
             let mut totals = SplitTotals::default();
             for (i, (f, p)) in set.frames.iter().zip(preds).enumerate() {

@@ -50,34 +50,53 @@ fn pip_install(python: &Path) -> Command {
 
 /// Make `target/py-venv` with the requirements; returns its python.
 fn ensure_venv(root: &Path) -> Result<PathBuf> {
-    let venv = root.join("target/py-venv");
+    ensure_venv_with(
+        root,
+        "py-venv",
+        REQUIREMENTS,
+        "import numpy, pytest",
+        Some("bin/maturin"),
+    )
+}
+
+/// Make (once) the virtual environment `target/NAME` holding `requirements` from PyPI, checked
+/// by running `import_check` in it (and, if given, by `marker` existing in it); returns its
+/// python. Debian's `python3-venv` is installed when `python3 -m venv` is missing.
+pub fn ensure_venv_with(
+    root: &Path,
+    name: &str,
+    requirements: &[&str],
+    import_check: &str,
+    marker: Option<&str>,
+) -> Result<PathBuf> {
+    let venv = root.join("target").join(name);
     let python = venv.join("bin/python");
     if !python.exists() {
         let made = Command::new("python3")
             .args(["-m", "venv"])
             .arg(&venv)
             .status()
-            .context("python3 is needed for the Python package (cannot start python3)")?;
+            .context("python3 is needed (cannot start python3)")?;
         if !made.success() {
             // Debian splits the venv module out (python3-venv).
             crate::vivid::ensure_host_packages(&["python3-venv"])?;
             let _ = std::fs::remove_dir_all(&venv);
             run_checked(
                 Command::new("python3").args(["-m", "venv"]).arg(&venv),
-                "python3 -m venv target/py-venv",
+                &format!("python3 -m venv target/{name}"),
             )?;
         }
     }
     let have = Command::new(&python)
-        .args(["-c", "import numpy, pytest"])
+        .args(["-c", import_check])
         .output()
         .map(|o| o.status.success())
         .unwrap_or(false)
-        && venv.join("bin/maturin").exists();
+        && marker.is_none_or(|m| venv.join(m).exists());
     if !have {
         run_checked(
-            pip_install(&python).args(REQUIREMENTS),
-            &format!("pip install {}", REQUIREMENTS.join(" ")),
+            pip_install(&python).args(requirements),
+            &format!("pip install {}", requirements.join(" ")),
         )?;
     }
     Ok(python)

@@ -459,6 +459,54 @@ pub fn track_label_set(
     Ok(out)
 }
 
+/// The **ceiling** of the lane model: for each ego label lane of `frame`, the least-squares
+/// parabola `x = a1·y² + a2·y + a3` of its points on the rows `[top, bottom)` (the tracker's
+/// region of interest), reported as that side's prediction (`None` with fewer than 3 such points
+/// or a degenerate fit). Scored by the same rules as the tracker, it says what a perfect tracker
+/// with this model and this ROI would reach: the labels themselves, bent to a parabola and cut
+/// to the rows the tracker looks at.
+pub fn ceiling_prediction(frame: &LabelFrame, rows: (usize, usize)) -> EgoPrediction {
+    let mut out: EgoPrediction = [None, None];
+    for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
+        let Some(lane) = frame.lanes.iter().find(|l| l.side == side) else {
+            continue;
+        };
+        out[k] = fit_parabola_in_rows(&lane.points, rows);
+    }
+    out
+}
+
+/// Least-squares parabola `x(y)` of the points with `top ≤ y < bottom`, centred on their mean
+/// row for conditioning; `None` for fewer than 3 points or a singular system.
+fn fit_parabola_in_rows(points: &[[f64; 2]], (top, bottom): (usize, usize)) -> Option<[f64; 3]> {
+    let inside = || {
+        points
+            .iter()
+            .filter(move |p| p[1] >= top as f64 && p[1] < bottom as f64)
+    };
+    let n = inside().count();
+    if n < 3 {
+        return None;
+    }
+    let yc = inside().map(|p| p[1]).sum::<f64>() / n as f64;
+    let mut a = nalgebra::Matrix3::<f64>::zeros();
+    let mut b = nalgebra::Vector3::<f64>::zeros();
+    for p in inside() {
+        let u = p[1] - yc;
+        let phi = nalgebra::Vector3::new(u * u, u, 1.0);
+        a += phi * phi.transpose();
+        b += phi * p[0];
+    }
+    let c = a.cholesky()?.solve(&b);
+    // x = c0·(y − yc)² + c1·(y − yc) + c2, expanded in y.
+    let coeffs = [
+        c[0],
+        c[1] - 2.0 * c[0] * yc,
+        c[0] * yc * yc - c[1] * yc + c[2],
+    ];
+    coeffs.iter().all(|v| v.is_finite()).then_some(coeffs)
+}
+
 /// Slope `dx/dy` of the least-squares line `x = k·y + b` through the points (0 if degenerate).
 fn fit_slope(pts: &[[f64; 2]]) -> f64 {
     let n = pts.len() as f64;
@@ -477,6 +525,38 @@ fn fit_slope(pts: &[[f64; 2]]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_ceiling_of_parabolic_labels_is_exact_and_cut_to_the_rows() {
+        let para = |a: [f64; 3]| move |y: f64| a[0] * y * y + a[1] * y + a[2];
+        let (l, r) = ([0.002, -1.1, 300.0], [-0.001, 1.3, -20.0]);
+        let pts = |f: &dyn Fn(f64) -> f64, y0: usize| -> Vec<[f64; 2]> {
+            (y0..240).map(|y| [f(y as f64), y as f64]).collect()
+        };
+        let f = frame(vec![
+            LabelLane {
+                side: LabelSide::Left,
+                points: pts(&para(l), 100),
+            },
+            LabelLane {
+                side: LabelSide::Right,
+                points: pts(&para(r), 100),
+            },
+        ]);
+        let p = ceiling_prediction(&f, (150, 240));
+        for (got, want) in p.iter().zip([l, r]) {
+            let got = got.unwrap();
+            for y in [150.0, 200.0, 239.0] {
+                let (g, w) = (para(got)(y), para(want)(y));
+                assert!((g - w).abs() < 1e-6, "{y}: {g} vs {w}");
+            }
+        }
+        // Scored by the same rules, the ceiling of exact parabolas is perfect.
+        let t = score_frame(&f, 320, 240, &p, &ScoringRules::default());
+        assert_eq!(t.tusimple_matched, 2);
+        // Fewer than three label points inside the rows: nothing to report.
+        assert_eq!(ceiling_prediction(&f, (238, 240))[0], None);
+    }
 
     fn frame(lanes: Vec<LabelLane>) -> LabelFrame {
         LabelFrame {
