@@ -308,7 +308,7 @@ pub fn monte_carlo<'py>(
                     })?;
                     Ok((st, kept, excluded))
                 })
-                .collect::<Result<Vec<_>, ins_sim::RunError>>()
+                .collect::<Result<Vec<_>, ins_sim::SimError>>()
         })
         .map_err(err)?;
     let d = PyDict::new(py);
