@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::McError;
 use super::stats::{Exclusion, ModeStats, RunSummary};
 use ins_sim::runs::{Verdict, run_range};
-use ins_sim::{Mode, RunError, Sample, SimRunOutcome};
+use ins_sim::{Mode, Sample, SimError, SimRunOutcome};
 
 /// Where the driver reports progress: the binary draws a progress bar, tests and the library
 /// default stay [`Silent`]. Called from the worker threads (`run_done`) and from the folding
@@ -65,7 +65,7 @@ struct Job {
     index: u64,
     mode_slot: usize,
     samples: Vec<Sample>,
-    verdict: Result<Verdict, RunError>,
+    verdict: Result<Verdict, SimError>,
     elapsed_s: f64,
     cpu_s: f64,
 }
@@ -101,7 +101,7 @@ pub use ins_sim::stats::first_non_finite;
 /// are not properties of one run).
 pub fn simulate<F>(plan: &Plan, runner: F, progress: &dyn Progress) -> Result<Simulated, McError>
 where
-    F: Fn(Mode, u64, &mut [Sample]) -> Result<SimRunOutcome, RunError> + Sync,
+    F: Fn(Mode, u64, &mut [Sample]) -> Result<SimRunOutcome, SimError> + Sync,
 {
     let pool = crate::pool(Some(plan.threads))?;
     let (lo, hi) = plan.range;

@@ -2,8 +2,7 @@
 
 use std::path::PathBuf;
 
-use super::stats::StatsError;
-use ins_sim::{RunError, ScenarioError};
+use ins_sim::SimError;
 
 /// Everything that can stop a Monte Carlo, a merge, a sweep or the scenario table. Each variant
 /// names what failed: the file, the option and its value, the run, or the figure. (A run that
@@ -20,9 +19,12 @@ pub enum McError {
         #[source]
         source: std::io::Error,
     },
-    /// The scenario file is invalid (its error names the file, line and column, and the field).
+    /// The simulation library refused: the scenario file is invalid (the error names the file,
+    /// line and column, and the field), statistics cannot be merged (other scenario, seed or
+    /// run count, or overlapping), a `stats.json` breaks an invariant, or a shard is not a slice
+    /// of the runs. See [`SimError`].
     #[error(transparent)]
-    Scenario(#[from] ScenarioError),
+    Sim(#[from] SimError),
     /// An option holds a value outside its range.
     #[error("{flag} {value}: {reason}")]
     Argument {
@@ -42,10 +44,6 @@ pub enum McError {
         #[source]
         source: serde_json::Error,
     },
-    /// Statistics that cannot be merged (other scenario, seed or run count, or overlapping), a
-    /// `stats.json` that breaks an invariant, or a shard that is not a slice of the runs.
-    #[error(transparent)]
-    Stats(#[from] StatsError),
     /// A merge lacks some run indices and `--allow-partial` was not given.
     #[error(
         "merge: {present} of {total} runs present; missing run indices {missing} (pass \
@@ -69,7 +67,7 @@ pub enum McError {
         mode: ins_sim::Mode,
         /// The closed loop's error.
         #[source]
-        source: Box<RunError>,
+        source: Box<SimError>,
     },
     /// The worker pool could not be built.
     #[error("cannot start the worker threads: {0}")]
@@ -95,6 +93,6 @@ pub enum McError {
         dir: PathBuf,
         /// The log writer's error.
         #[source]
-        source: Box<ins_sim::logs::LogError>,
+        source: Box<SimError>,
     },
 }

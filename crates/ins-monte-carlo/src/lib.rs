@@ -50,7 +50,7 @@
 //! ## Failure
 //!
 //! The one exclusion rule (`ins_sim::runs`, the same in the sweeps, the scenario table and
-//! Python): a run that returns `RunError` (non-finite state, a sighting or filter failure),
+//! Python): a run that returns `ins_sim::SimError` (non-finite state, a sighting or filter failure),
 //! writes too few records, or whose records hold a NaN/∞, is excluded from its configuration's statistics, printed on stderr with
 //! its index and time, and listed and counted in `summary.md` / `summary.json`; it is never
 //! averaged in. An invalid config names the field (from `Scenario::from_toml_str`). Every

@@ -9,7 +9,7 @@ use super::report::{self, NEES_DOF, NIS_DOF};
 use super::stats::{self, ModeStats, Moments, Stats, qi};
 use super::*;
 use ins_sim::stats::ShardInfo;
-use ins_sim::{Mode, RunError, Sample, Scenario, SimRunOutcome};
+use ins_sim::{Mode, Sample, Scenario, SimError, SimRunOutcome};
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("nav-app-mc-{name}-{}", std::process::id()));
@@ -220,9 +220,9 @@ fn consistency_says_which_way_a_filter_is_inconsistent() {
 
 /// Stand-in generator: run `i` has position error N = i·t, E = 1, D = −t; run 2 fails as
 /// non-finite at 7 s, run 3 returns a NaN record at 5 s.
-fn stand_in(_mode: Mode, index: u64, out: &mut [Sample]) -> Result<SimRunOutcome, RunError> {
+fn stand_in(_mode: Mode, index: u64, out: &mut [Sample]) -> Result<SimRunOutcome, SimError> {
     if index == 2 {
-        return Err(RunError::NonFinite {
+        return Err(SimError::NonFinite {
             t_s: 7.0,
             what: "INS velocity",
         });
@@ -344,7 +344,61 @@ fn bad_arguments_give_clear_errors() {
     let path = dir.join("bad.toml");
     std::fs::write(&path, bad).unwrap();
     assert!(err(RunOptions::new(&path, &dir)).contains("filter.r_var_m2"));
+    // It is the simulation library's typed error, named by its field, file and line.
+    let e = resolve(&RunOptions::new(&path, &dir)).unwrap_err();
+    let McError::Sim(sim @ SimError::ScenarioFile { field, error }) = &e else {
+        panic!("{e:?}")
+    };
+    assert_eq!(field, "filter.r_var_m2");
+    assert_eq!(sim.scenario_field(), Some("filter.r_var_m2"));
+    assert!(error.line.is_some());
+    assert!(
+        e.to_string().starts_with(&path.display().to_string()),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn a_run_that_cannot_start_names_its_index_and_mode_and_keeps_the_sim_error() {
+    let plan = Plan {
+        modes: vec![Mode::Akf],
+        samples: 11,
+        range: (0, 3),
+        threads: 1,
+    };
+    let short = |_: Mode, _: u64, out: &mut [Sample]| -> Result<SimRunOutcome, SimError> {
+        Err(SimError::OutputLength {
+            expected: 12,
+            got: out.len(),
+        })
+    };
+    let e = drive(&plan, short, &Silent).unwrap_err();
+    let McError::RunSetup {
+        index,
+        mode,
+        source,
+    } = &e
+    else {
+        panic!("{e:?}")
+    };
+    assert_eq!((*index, *mode), (0, Mode::Akf));
+    assert!(matches!(
+        **source,
+        SimError::OutputLength {
+            expected: 12,
+            got: 11
+        }
+    ));
+    let shown = e.to_string();
+    assert!(
+        shown.starts_with("run 0 (akf) could not start: "),
+        "{shown}"
+    );
+    assert!(shown.contains("needs 12"), "{shown}");
+    // The source is the boxed `SimError` itself.
+    let inner = std::error::Error::source(&e).unwrap();
+    assert!(inner.downcast_ref::<Box<SimError>>().is_some());
 }
 
 #[test]

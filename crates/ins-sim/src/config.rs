@@ -7,54 +7,7 @@ use ins_errors::imu::{DEGPH_TO_RADPS, MG_TO_MPS2};
 use serde::{Deserialize, Serialize};
 use sighting_model::SightingConfig;
 
-/// Errors of [`super::Scenario::from_toml_str`]: every variant names the section or the dotted
-/// field (`"filter.r_var_m2"`, `"imu.accel_bias_sigma_mg"`, `"sighting.landmarks[1].lat_deg"`).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ScenarioError {
-    /// The text is not TOML, a section is missing or unknown, or a key is unknown or mistyped,
-    /// without a location. The loader ([`super::Scenario::from_toml_named`]) returns
-    /// [`ScenarioError::InFile`] instead; this variant remains for callers that parse
-    /// sections of their own.
-    #[error("scenario TOML, section [{section}]: {message}")]
-    Parse {
-        /// Section concerned (`"(document)"` for top-level problems).
-        section: String,
-        /// Parser message (names the offending key).
-        message: String,
-    },
-    /// An error in a scenario text, located by the one TOML loader (crate `toml-config`): `error`
-    /// names the file (or the name given to [`super::Scenario::from_toml_named`]), the line and
-    /// the column of the offending key or value, and says what is wrong. Every error of
-    /// [`super::Scenario::from_toml_str`] / [`super::Scenario::from_toml_named`] is one of these.
-    #[error("{error}")]
-    InFile {
-        /// What [`ScenarioError::Parse`] or [`ScenarioError::Invalid`] would name: the section
-        /// (`"(document)"` for a syntax error) or the dotted field.
-        field: String,
-        /// The located error.
-        error: toml_config::TomlError,
-    },
-    /// A field holds an invalid value.
-    #[error("{field}: {requirement} (got {value})")]
-    Invalid {
-        /// Dotted path, e.g. `filter.open_loop_until_s`.
-        field: String,
-        /// What the field must satisfy.
-        requirement: String,
-        /// The value found (formatted).
-        value: String,
-    },
-}
-
-impl ScenarioError {
-    pub(crate) fn invalid(field: &str, requirement: &str, value: impl std::fmt::Debug) -> Self {
-        Self::Invalid {
-            field: field.to_string(),
-            requirement: requirement.to_string(),
-            value: format!("{value:?}"),
-        }
-    }
-}
+use crate::SimError;
 
 pub use ins_sd_filter::MeasurementJacobian;
 
@@ -177,10 +130,10 @@ impl ScenarioFilterConfig {
     /// and the `akf` estimator configurations), checked once in their own units by
     /// [`super::Scenario::validate`] on the converted configuration, the error naming the
     /// `[filter]` key ([`ScenarioFilterConfig::toml_key`]).
-    pub fn validate(&self) -> Result<(), ScenarioError> {
+    pub fn validate(&self) -> Result<(), SimError> {
         let v = self.open_loop_until_s;
         if !(v.is_finite() && v >= 0.0) {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "filter.open_loop_until_s",
                 "must be finite and >= 0",
                 v,
@@ -338,7 +291,7 @@ impl MismatchConfig {
     }
 
     /// Checks every field; the error names it as `mismatch.<field>`.
-    pub fn validate(&self) -> Result<(), ScenarioError> {
+    pub fn validate(&self) -> Result<(), SimError> {
         for (f, v) in [
             (
                 "mismatch.accel_scale_factor_sigma_ppm",
@@ -374,25 +327,25 @@ impl MismatchConfig {
             ("mismatch.latency_s", self.latency_s),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(ScenarioError::invalid(f, "must be finite and >= 0", v));
+                return Err(SimError::invalid(f, "must be finite and >= 0", v));
             }
         }
         if !(self.bias_correlation_time_s.is_finite() && self.bias_correlation_time_s > 0.0) {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "mismatch.bias_correlation_time_s",
                 "must be finite and > 0",
                 self.bias_correlation_time_s,
             ));
         }
         if !(0.0..=1.0).contains(&self.outlier_fraction) {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "mismatch.outlier_fraction",
                 "must be within [0, 1]",
                 self.outlier_fraction,
             ));
         }
         if !(self.camera_max_off_nadir_deg > 0.0 && self.camera_max_off_nadir_deg <= 180.0) {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "mismatch.camera_max_off_nadir_deg",
                 "must be within (0, 180]",
                 self.camera_max_off_nadir_deg,
@@ -428,9 +381,9 @@ impl MonteCarloConfig {
     }
 
     /// Checks every field; the error names it as `monte_carlo.<field>`.
-    pub fn validate(&self) -> Result<(), ScenarioError> {
+    pub fn validate(&self) -> Result<(), SimError> {
         if self.runs == 0 {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "monte_carlo.runs",
                 "must be >= 1",
                 self.runs,
@@ -464,13 +417,13 @@ const SECTIONS: [&str; 6] = [
 
 /// Parses the document section by section (through the workspace's one TOML loader,
 /// `toml_config::TomlDoc`) so that an error names its section, file, line and column.
-pub(crate) fn parse(doc: &toml_config::TomlDoc<'_>) -> Result<ScenarioFile, ScenarioError> {
+pub(crate) fn parse(doc: &toml_config::TomlDoc<'_>) -> Result<ScenarioFile, SimError> {
     let located = |field: &str| {
         let field = field.to_string();
-        move |error| ScenarioError::InFile { field, error }
+        move |error| SimError::ScenarioFile { field, error }
     };
     doc.allow_only(&SECTIONS)
-        .map_err(|error| ScenarioError::InFile {
+        .map_err(|error| SimError::ScenarioFile {
             field: doc
                 .keys()
                 .find(|k| !SECTIONS.contains(k))

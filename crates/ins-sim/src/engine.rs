@@ -17,7 +17,7 @@ use rand_chacha::ChaCha8Rng;
 use sighting_model::Landmark;
 
 use super::mismatch::World;
-use super::{AkfScheme, Mode, RunError, Sample, Scenario, SimRunOutcome};
+use super::{AkfScheme, Mode, Sample, Scenario, SimError, SimRunOutcome};
 
 /// Sees what a run feeds its filter (for exporting a run as logs, [`super::logs`]). Every
 /// method defaults to nothing; the Monte Carlo uses [`NoObserver`] (compiled away).
@@ -142,19 +142,19 @@ pub(crate) fn landmark_entries(scenario: &Scenario) -> Vec<LandmarkEntry> {
 }
 
 /// The scenario's landmarks as a table ([`landmark_entries`]).
-pub(crate) fn landmark_table(scenario: &Scenario) -> Result<LandmarkTable, RunError> {
+pub(crate) fn landmark_table(scenario: &Scenario) -> Result<LandmarkTable, SimError> {
     LandmarkTable::new(&landmark_entries(scenario))
-        .map_err(|source| RunError::Online { t_s: 0.0, source })
+        .map_err(|source| SimError::Online { t_s: 0.0, source })
 }
 
 /// Maps the online filter's errors onto the run's error kinds.
-pub(crate) fn run_error(e: FilterError) -> RunError {
+pub(crate) fn run_error(e: FilterError) -> SimError {
     match e {
-        FilterError::NonFiniteState { what, t_s } => RunError::NonFinite { t_s, what },
-        FilterError::Sighting { t_s, source, .. } => RunError::Sighting { t_s, source },
-        FilterError::Akf { t_s, source } => RunError::Filter { t_s, source },
-        FilterError::Ins(e) => RunError::Ins(e),
-        other => RunError::Online {
+        FilterError::NonFiniteState { what, t_s } => SimError::NonFinite { t_s, what },
+        FilterError::Sighting { t_s, source, .. } => SimError::Sighting { t_s, source },
+        FilterError::Akf { t_s, source } => SimError::Filter { t_s, source },
+        FilterError::Ins(e) => SimError::Ins(e),
+        other => SimError::Online {
             t_s: f64::NAN,
             source: other,
         },
@@ -170,8 +170,8 @@ impl Loop {
         mode: Mode,
         seed: u64,
         first: &TruthSample,
-    ) -> Result<Self, RunError> {
-        let params = ImuErrorParams::from_config(&scenario.imu).map_err(RunError::Ins)?;
+    ) -> Result<Self, SimError> {
+        let params = ImuErrorParams::from_config(&scenario.imu).map_err(SimError::Ins)?;
         let mut rng_imu = ChaCha8Rng::seed_from_u64(seed);
         let imu = ImuErrors::draw(&params, &mut rng_imu);
         let mut rng_sd = ChaCha8Rng::seed_from_u64(seed);
@@ -179,7 +179,7 @@ impl Loop {
         let landmarks = scenario
             .sighting
             .landmarks()
-            .map_err(|source| RunError::Sighting { t_s: 0.0, source })?;
+            .map_err(|source| SimError::Sighting { t_s: 0.0, source })?;
         let filter = InsSdFilter::new(
             online_config(scenario, mode),
             landmark_table(scenario)?,
@@ -227,7 +227,7 @@ impl Loop {
     pub(crate) fn step(
         &mut self,
         ideal: &TruthSample,
-    ) -> Result<(Vector3<f64>, Vector3<f64>), RunError> {
+    ) -> Result<(Vector3<f64>, Vector3<f64>), SimError> {
         let (f, w) = match self.world.as_deref_mut() {
             None => self.imu.measure(
                 &ideal.specific_force_body_mps2,
@@ -271,11 +271,11 @@ impl Loop {
         &mut self,
         t_s: f64,
         truth: &NavState,
-    ) -> Result<&[Sighting], RunError> {
+    ) -> Result<&[Sighting], SimError> {
         let computed = self.filter.pointing_pose();
         let truth_pose = nav_pose(truth);
         self.sightings.clear();
-        let se = |source| RunError::Sighting { t_s, source };
+        let se = |source| SimError::Sighting { t_s, source };
         if let Some(world) = self.world.as_deref_mut() {
             let sigma_m = self.sd_noise_var_m2.sqrt();
             for (i, lm) in self.landmarks.iter().enumerate() {
@@ -324,7 +324,7 @@ impl Loop {
 
     /// SD epoch at time `t_s`: simulate the sightings, then the filter's update (predict,
     /// update, feedback after `open_loop_until_s`). Returns the NIS (NaN without a filter).
-    pub(crate) fn sd_update(&mut self, t_s: f64, truth: &NavState) -> Result<f64, RunError> {
+    pub(crate) fn sd_update(&mut self, t_s: f64, truth: &NavState) -> Result<f64, SimError> {
         if self.latency_steps() == 0 {
             self.simulate_sightings(t_s, truth)?;
         }
@@ -355,11 +355,11 @@ impl Loop {
         truth: &NavState,
         distance_m: f64,
         nis: Option<f64>,
-    ) -> Result<Sample, RunError> {
+    ) -> Result<Sample, SimError> {
         let e = self.true_error(truth) - self.filter.error_state();
         let nees = match (nis, self.filter.covariance()) {
             (Some(_), Some(p)) => {
-                Some(akf::nees(&e, p).map_err(|source| RunError::Filter { t_s, source })?)
+                Some(akf::nees(&e, p).map_err(|source| SimError::Filter { t_s, source })?)
             }
             _ => None,
         };
@@ -386,7 +386,7 @@ pub(crate) fn run(
     mode: Mode,
     seed: u64,
     out: &mut [Sample],
-) -> Result<SimRunOutcome, RunError> {
+) -> Result<SimRunOutcome, SimError> {
     run_observed(scenario, mode, seed, out, &mut NoObserver)
 }
 
@@ -397,18 +397,18 @@ pub(crate) fn run_observed<O: RunObserver>(
     seed: u64,
     out: &mut [Sample],
     obs: &mut O,
-) -> Result<SimRunOutcome, RunError> {
+) -> Result<SimRunOutcome, SimError> {
     let plan = scenario.plan()?;
     if out.len() != plan.samples {
-        return Err(RunError::OutputLength {
+        return Err(SimError::OutputLength {
             expected: plan.samples,
             got: out.len(),
         });
     }
-    let tr = Trajectory::new(&scenario.trajectory).map_err(RunError::Ins)?;
+    let tr = Trajectory::new(&scenario.trajectory).map_err(SimError::Ins)?;
     let mut truth_it = tr.samples();
     let Some(first) = truth_it.next() else {
-        return Err(RunError::OutputLength {
+        return Err(SimError::OutputLength {
             expected: plan.samples,
             got: 0,
         });

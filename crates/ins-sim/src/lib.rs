@@ -187,6 +187,19 @@
 //! epochs NEES (all 15 states: true ∇, ε minus the sensor corrections applied so far, minus
 //! x̂; against P⁺) and NIS (from the update).
 //!
+//! ## Errors
+//!
+//! One error type, [`SimError`], for everything the crate does; each variant says where it
+//! failed and keeps the wrapped error typed as its `source`: the scenario
+//! ([`SimError::ScenarioFile`]: file, line, column and dotted field, through `toml-config`;
+//! [`SimError::ScenarioInvalid`]: the field of a scenario built in code), one run
+//! ([`SimError::NonFinite`], [`SimError::Sighting`], [`SimError::Filter`],
+//! [`SimError::Online`]: the time; [`SimError::OutputLength`], [`SimError::Ins`]), the logs
+//! ([`SimError::LogParse`], [`SimError::LogToml`], [`SimError::LogFilter`], [`SimError::LogIo`],
+//! [`SimError::LogWrite`], [`SimError::ExportRun`]: the file and, for content, the line and
+//! column) and the statistics (`SimError::Stats*`: the field, the shard, the run ranges).
+//! [`SimError::is_setup`] tells the errors that stop the run loop from those that exclude a run.
+//!
 //! ## Example
 //!
 //! ```
@@ -203,6 +216,7 @@
 
 mod config;
 mod engine;
+mod error;
 pub mod logs;
 mod mismatch;
 pub mod runs;
@@ -210,15 +224,12 @@ mod scenario;
 pub mod stats;
 
 pub use config::{
-    AkfScheme, MeasurementJacobian, MismatchConfig, MonteCarloConfig, ScenarioError,
-    ScenarioFilterConfig,
+    AkfScheme, MeasurementJacobian, MismatchConfig, MonteCarloConfig, ScenarioFilterConfig,
 };
 pub use engine::{NoObserver, RunObserver};
+pub use error::SimError;
 
 pub use scenario::Scenario;
-
-use ins_errors::InsError;
-use sighting_model::SightingError;
 
 /// Simulation mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -319,58 +330,6 @@ pub struct SimRunOutcome {
     pub sightings_rejected: u64,
 }
 
-/// Failures of [`run`]; each says where (time) and what.
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    /// The INS or the filter state became NaN/∞.
-    #[error("run became non-finite at t = {t_s} s: {what}")]
-    NonFinite {
-        /// Time of detection, s.
-        t_s: f64,
-        /// Which quantity.
-        what: &'static str,
-    },
-    /// The scenario is invalid.
-    #[error("invalid scenario: {0}")]
-    Scenario(#[from] ScenarioError),
-    /// `out` has the wrong length.
-    #[error("output buffer holds {got} samples, the run needs {expected} (duration + 1)")]
-    OutputLength {
-        /// Required length.
-        expected: usize,
-        /// Length passed.
-        got: usize,
-    },
-    /// `ins-errors` rejected an input (trajectory, IMU parameters, initial state).
-    #[error("ins-errors: {0}")]
-    Ins(InsError),
-    /// The SD model failed (e.g. a landmark behind the camera because the errors exploded).
-    #[error("sighting model at t = {t_s} s: {source}")]
-    Sighting {
-        /// Time, s.
-        t_s: f64,
-        /// The model's error.
-        source: SightingError,
-    },
-    /// The filter rejected a matrix (non-finite, S not positive definite, …).
-    #[error("filter at t = {t_s} s: {source}")]
-    Filter {
-        /// Time, s.
-        t_s: f64,
-        /// The filter's error.
-        source: akf::AkfError,
-    },
-    /// The online filter rejected its input (time stamps, landmark ids; not expected from the
-    /// simulator).
-    #[error("online filter at t = {t_s} s: {source}")]
-    Online {
-        /// Time, s (NaN when unknown).
-        t_s: f64,
-        /// The filter's error.
-        source: ins_sd_filter::FilterError,
-    },
-}
-
 /// Simulates one Monte Carlo run. `seed` fully determines the run. `out` has length
 /// duration + 1 ([`Scenario::samples_per_run`]) and is caller-owned; the step loop does not
 /// allocate.
@@ -379,7 +338,7 @@ pub fn run(
     mode: Mode,
     seed: u64,
     out: &mut [Sample],
-) -> Result<SimRunOutcome, RunError> {
+) -> Result<SimRunOutcome, SimError> {
     engine::run(scenario, mode, seed, out)
 }
 

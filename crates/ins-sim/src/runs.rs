@@ -7,19 +7,19 @@
 //! ## The exclusion rule
 //!
 //! A run is **excluded** from the statistics (and listed with its index, time and reason) when
-//! * it fails on its own: [`RunError::NonFinite`], a sighting, filter or online-filter failure
+//! * it fails on its own: [`SimError::NonFinite`], a sighting, filter or online-filter failure
 //!   (the time of the failure is kept), or an `ins-errors` rejection;
 //! * it returns but wrote fewer records than the buffer holds;
 //! * any of its 1 Hz records holds a NaN/∞ ([`first_non_finite`]: position, velocity,
 //!   misalignment, distance, NEES or NIS; the time of the first one is kept).
 //!
-//! An invalid scenario or a wrong buffer length ([`RunError::Scenario`],
-//! [`RunError::OutputLength`]) is not a property of one run: [`run_range`] stops and returns it.
+//! An invalid scenario or a wrong buffer length ([`SimError::is_setup`]: a scenario error or
+//! [`SimError::OutputLength`]) is not a property of one run: [`run_range`] stops and returns it.
 
 use std::ops::Range;
 
 use crate::stats::{Exclusion, ModeStats, RunSummary, first_non_finite};
-use crate::{Mode, RunError, Sample, Scenario, SimRunOutcome};
+use crate::{Mode, Sample, Scenario, SimError, SimRunOutcome};
 
 /// What the one exclusion rule made of a run.
 #[derive(Clone, Debug, PartialEq)]
@@ -49,9 +49,9 @@ impl Verdict {
     /// Applies the exclusion rule to what a run returned and the records it wrote into `out`.
     /// `Err` only for the errors that are not a property of one run (see the module doc).
     pub fn judge(
-        result: Result<SimRunOutcome, RunError>,
+        result: Result<SimRunOutcome, SimError>,
         out: &[Sample],
-    ) -> Result<Verdict, RunError> {
+    ) -> Result<Verdict, SimError> {
         match result {
             Ok(outcome) => Ok(if outcome.samples_written != out.len() {
                 Verdict::Excluded {
@@ -72,15 +72,9 @@ impl Verdict {
             } else {
                 Verdict::Kept(outcome)
             }),
-            Err(e @ (RunError::Scenario(_) | RunError::OutputLength { .. })) => Err(e),
+            Err(e) if e.is_setup() => Err(e),
             Err(e) => {
-                let t_s = match &e {
-                    RunError::NonFinite { t_s, .. }
-                    | RunError::Sighting { t_s, .. }
-                    | RunError::Filter { t_s, .. }
-                    | RunError::Online { t_s, .. } => Some(*t_s),
-                    _ => None,
-                };
+                let t_s = e.run_time_s();
                 Ok(Verdict::Excluded {
                     steps: 0,
                     t_s,
@@ -126,7 +120,7 @@ impl Verdict {
 pub fn closed_loop(
     scenario: &Scenario,
     master_seed: u64,
-) -> impl Fn(Mode, u64, &mut [Sample]) -> Result<SimRunOutcome, RunError> + Sync + '_ {
+) -> impl Fn(Mode, u64, &mut [Sample]) -> Result<SimRunOutcome, SimError> + Sync + '_ {
     move |mode, index, out| crate::run(scenario, mode, crate::run_seed(master_seed, index), out)
 }
 
@@ -141,9 +135,9 @@ pub fn run_range<R, F>(
     indices: Range<u64>,
     out: &mut [Sample],
     mut done: F,
-) -> Result<(), RunError>
+) -> Result<(), SimError>
 where
-    R: Fn(Mode, u64, &mut [Sample]) -> Result<SimRunOutcome, RunError> + ?Sized,
+    R: Fn(Mode, u64, &mut [Sample]) -> Result<SimRunOutcome, SimError> + ?Sized,
     F: FnMut(u64, &[Sample], Verdict),
 {
     for index in indices {
@@ -160,15 +154,15 @@ mod tests {
 
     /// Run i: finite records, except run 1 fails at 3 s, run 2 writes a NaN NEES at t = 2 s,
     /// run 3 writes one record too few, run 4 has a setup error.
-    fn stand_in(_mode: Mode, index: u64, out: &mut [Sample]) -> Result<SimRunOutcome, RunError> {
+    fn stand_in(_mode: Mode, index: u64, out: &mut [Sample]) -> Result<SimRunOutcome, SimError> {
         if index == 1 {
-            return Err(RunError::NonFinite {
+            return Err(SimError::NonFinite {
                 t_s: 3.0,
                 what: "INS position",
             });
         }
         if index == 4 {
-            return Err(RunError::OutputLength {
+            return Err(SimError::OutputLength {
                 expected: 5,
                 got: out.len(),
             });
@@ -210,7 +204,7 @@ mod tests {
         // A setup error is no run's property: the loop stops there.
         let mut n = 0;
         let e = run_range(&stand_in, Mode::Kf, 3..10, &mut out, |_, _, _| n += 1).unwrap_err();
-        assert!(matches!(e, RunError::OutputLength { .. }));
+        assert!(matches!(e, SimError::OutputLength { .. }));
         assert_eq!(n, 1, "only run 3 was handed over");
     }
 

@@ -48,17 +48,17 @@ fn is_integer_multiple(x: f64, unit: f64) -> Option<usize> {
 impl Scenario {
     /// Parses and validates a scenario document: [`Scenario::from_toml_named`] with the name
     /// `scenario`.
-    pub fn from_toml_str(text: &str) -> Result<Scenario, ScenarioError> {
+    pub fn from_toml_str(text: &str) -> Result<Scenario, SimError> {
         Self::from_toml_named("scenario", text)
     }
 
     /// Parses and validates the scenario document `text`, read from the file `path`. Unknown
-    /// sections and keys are rejected. Every error is a [`ScenarioError::InFile`] naming `path`,
+    /// sections and keys are rejected. Every error is a [`SimError::ScenarioFile`] naming `path`,
     /// the line and the column of the offending key or value (a field out of range is located
     /// at its key), and its section or dotted field (`"filter.r_var_m2"`).
-    pub fn from_toml_named(path: &str, text: &str) -> Result<Scenario, ScenarioError> {
+    pub fn from_toml_named(path: &str, text: &str) -> Result<Scenario, SimError> {
         let doc =
-            toml_config::TomlDoc::parse(path, text).map_err(|error| ScenarioError::InFile {
+            toml_config::TomlDoc::parse(path, text).map_err(|error| SimError::ScenarioFile {
                 field: "(document)".to_string(),
                 error,
             })?;
@@ -72,7 +72,7 @@ impl Scenario {
             mismatch: f.mismatch,
         };
         s.validate().map_err(|e| match e {
-            ScenarioError::Invalid { ref field, .. } => ScenarioError::InFile {
+            SimError::ScenarioInvalid { ref field, .. } => SimError::ScenarioFile {
                 error: doc.error_at(field, e.to_string()),
                 field: field.clone(),
             },
@@ -115,18 +115,18 @@ impl Scenario {
 
     /// Checks every section and the cross-section constraints (integer seconds of flight, SD
     /// period a multiple of the INS step, three landmarks in view from the start).
-    pub fn validate(&self) -> Result<(), ScenarioError> {
+    pub fn validate(&self) -> Result<(), SimError> {
         let ins = |e: InsError| match e {
             InsError::InvalidConfig {
                 field,
                 requirement,
                 value,
-            } => ScenarioError::Invalid {
+            } => SimError::ScenarioInvalid {
                 field,
                 requirement,
                 value,
             },
-            other => ScenarioError::Invalid {
+            other => SimError::ScenarioInvalid {
                 field: "trajectory".to_string(),
                 requirement: other.to_string(),
                 value: String::new(),
@@ -151,7 +151,7 @@ impl Scenario {
     /// The `[filter]` limits, checked once, by the online filter on the configuration each
     /// filtering mode converts to (Mohamed–Schwarz, Sage–Husa and the structured projection
     /// cover every estimator field); the error names the scenario key and its value as written.
-    fn validate_online_filter(&self) -> Result<(), ScenarioError> {
+    fn validate_online_filter(&self) -> Result<(), SimError> {
         let named = |field: &str, requirement: String, value: String| {
             let (key, written) = match self.filter.toml_key(field) {
                 Some(k) => k,
@@ -162,7 +162,7 @@ impl Scenario {
                 ),
                 None => ("trajectory.step_s", value),
             };
-            ScenarioError::Invalid {
+            SimError::ScenarioInvalid {
                 field: key.to_string(),
                 requirement,
                 value: written,
@@ -188,7 +188,7 @@ impl Scenario {
                     value,
                 }) => return Err(named(field, requirement.to_string(), value)),
                 Err(other) => {
-                    return Err(ScenarioError::Invalid {
+                    return Err(SimError::ScenarioInvalid {
                         field: "filter".to_string(),
                         requirement: other.to_string(),
                         value: String::new(),
@@ -199,10 +199,10 @@ impl Scenario {
         Ok(())
     }
 
-    pub(crate) fn plan(&self) -> Result<Plan, ScenarioError> {
+    pub(crate) fn plan(&self) -> Result<Plan, SimError> {
         let step_s = self.trajectory.step_s;
         let steps = is_integer_multiple(self.trajectory.end_time_s, step_s).ok_or_else(|| {
-            ScenarioError::invalid(
+            SimError::invalid(
                 "trajectory.end_time_s",
                 "must be a positive multiple of trajectory.step_s",
                 self.trajectory.end_time_s,
@@ -210,14 +210,14 @@ impl Scenario {
         })?;
         let end = self.trajectory.end_time_s;
         if (end - end.round()).abs() > 1e-9 || end < 1.0 {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "trajectory.end_time_s",
                 "must be a whole number of seconds >= 1 (1 Hz records)",
                 end,
             ));
         }
         let steps_per_sample = is_integer_multiple(1.0, step_s).ok_or_else(|| {
-            ScenarioError::invalid(
+            SimError::invalid(
                 "trajectory.step_s",
                 "must divide 1 s (1 Hz records)",
                 step_s,
@@ -225,7 +225,7 @@ impl Scenario {
         })?;
         let steps_per_update = is_integer_multiple(self.sighting.update_period_s, step_s)
             .ok_or_else(|| {
-                ScenarioError::invalid(
+                SimError::invalid(
                     "sighting.update_period_s",
                     "must be a positive multiple of trajectory.step_s",
                     self.sighting.update_period_s,
@@ -233,14 +233,14 @@ impl Scenario {
             })?;
         let lat = self.mismatch.latency_s / step_s;
         if (lat - lat.round()).abs() > 1e-6 || lat.round() as usize >= steps_per_update {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "mismatch.latency_s",
                 "must be a multiple of trajectory.step_s below sighting.update_period_s",
                 self.mismatch.latency_s,
             ));
         }
         if self.filter.phi_subintervals > steps_per_update {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "filter.phi_subintervals",
                 "must not exceed the INS steps per SD interval",
                 self.filter.phi_subintervals,
@@ -274,9 +274,9 @@ impl Scenario {
     /// start after it are dropped, the last one shortened). For fast tests and `--duration`.
     /// Errors (naming `trajectory.end_time_s`) when longer than the scenario or not a whole
     /// number of seconds.
-    pub fn truncated(&self, duration_s: f64) -> Result<Scenario, ScenarioError> {
+    pub fn truncated(&self, duration_s: f64) -> Result<Scenario, SimError> {
         if !(duration_s.is_finite() && duration_s <= self.trajectory.end_time_s) {
-            return Err(ScenarioError::invalid(
+            return Err(SimError::invalid(
                 "trajectory.end_time_s",
                 "a truncated scenario must not be longer than the original",
                 duration_s,
@@ -385,23 +385,23 @@ impl Scenario {
     }
 }
 
-fn sighting_err(e: SightingError) -> ScenarioError {
+fn sighting_err(e: SightingError) -> SimError {
     match e {
         SightingError::InvalidField {
             field,
             value,
             requirement,
-        } => ScenarioError::Invalid {
+        } => SimError::ScenarioInvalid {
             field: format!("sighting.{field}"),
             requirement: requirement.to_string(),
             value: format!("{value:?}"),
         },
-        SightingError::LandmarkCount { expected, found } => ScenarioError::Invalid {
+        SightingError::LandmarkCount { expected, found } => SimError::ScenarioInvalid {
             field: "sighting.landmarks".to_string(),
             requirement: format!("must hold exactly {expected} landmarks"),
             value: found.to_string(),
         },
-        other => ScenarioError::Invalid {
+        other => SimError::ScenarioInvalid {
             field: "sighting.landmarks".to_string(),
             requirement: other.to_string(),
             value: String::new(),

@@ -2,7 +2,7 @@
 //! with an error naming the section or the dotted field.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
-use ins_sim::{Scenario, ScenarioError, run_seed};
+use ins_sim::{Scenario, SimError, run_seed};
 
 fn paper_toml() -> String {
     std::fs::read_to_string(concat!(
@@ -20,11 +20,12 @@ fn with_value(text: &str, section: &str, key: &str, value: &str) -> String {
     format!("{}{key} = {value}{}", &text[..rel], &text[end..])
 }
 
-fn field_of(e: &ScenarioError) -> String {
+fn field_of(e: &SimError) -> String {
     match e {
-        ScenarioError::Invalid { field, .. } => field.clone(),
-        ScenarioError::Parse { section, .. } => section.clone(),
-        ScenarioError::InFile { field, .. } => field.clone(),
+        SimError::ScenarioInvalid { field, .. } => field.clone(),
+        SimError::ScenarioParse { section, .. } => section.clone(),
+        SimError::ScenarioFile { field, .. } => field.clone(),
+        other => panic!("not a scenario error: {other:?}"),
     }
 }
 

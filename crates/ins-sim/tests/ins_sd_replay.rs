@@ -7,7 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use ins_errors::error_model;
-use ins_sim::logs::{self, LogError, ReplayInputs, names};
+use ins_sim::SimError;
+use ins_sim::logs::{self, ReplayInputs, names};
 use ins_sim::{Mode, Scenario, run_seed};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -29,7 +30,7 @@ fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
     }
 }
 
-fn replay_to(dir: &Path, inp: &ReplayInputs) -> Result<logs::ReplaySummary, LogError> {
+fn replay_to(dir: &Path, inp: &ReplayInputs) -> Result<logs::ReplaySummary, SimError> {
     let out_path = dir.join("solution_replayed.csv");
     let mut out = std::io::BufWriter::new(std::fs::File::create(&out_path).unwrap());
     logs::replay(inp, &mut out, &out_path)
@@ -86,9 +87,9 @@ fn replay_of_an_export_reproduces_the_run() {
     }
 }
 
-fn expect_parse(r: Result<logs::ReplaySummary, LogError>, file: &Path, line: usize, column: usize) {
+fn expect_parse(r: Result<logs::ReplaySummary, SimError>, file: &Path, line: usize, column: usize) {
     match r {
-        Err(LogError::Parse {
+        Err(SimError::LogParse {
             path,
             line: l,
             column: c,
@@ -98,7 +99,7 @@ fn expect_parse(r: Result<logs::ReplaySummary, LogError>, file: &Path, line: usi
             assert_eq!((l, c), (line, column), "{message}");
             let shown = format!(
                 "{}",
-                LogError::Parse {
+                SimError::LogParse {
                     path,
                     line: l,
                     column: c,
@@ -200,7 +201,7 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
             ..inp.clone()
         },
     ) {
-        Err(LogError::Filter {
+        Err(SimError::LogFilter {
             path: p,
             line,
             source,
@@ -243,15 +244,25 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
             ..inp.clone()
         },
     ) {
-        Err(LogError::Parse {
-            path: p,
-            line,
-            message,
-            ..
-        }) => {
-            assert_eq!(p, path);
+        Err(e @ SimError::LogToml { .. }) => {
+            let SimError::LogToml { path: p, error } = &e else {
+                unreachable!()
+            };
+            assert_eq!(p, &path);
+            let line = error.line.expect("a line");
             assert!(line > 1, "{line}");
-            assert!(message.contains("height_m"), "{message}");
+            assert!(error.message.contains("height_m"), "{error}");
+            // The message names the file and the line, once.
+            let shown = e.to_string();
+            assert!(
+                shown.starts_with(&format!("{}:{line}:", path.display())),
+                "{shown}"
+            );
+            assert_eq!(
+                shown.matches(&path.display().to_string()).count(),
+                1,
+                "{shown}"
+            );
         }
         other => panic!("{other:?}"),
     }

@@ -8,7 +8,7 @@ use ins_errors::error_model;
 use ins_errors::imu::{ImuErrorParams, ImuErrors};
 use ins_errors::strapdown::Strapdown;
 use ins_errors::trajectory::Trajectory;
-use ins_sim::{Mode, RunError, Sample, Scenario, run, run_seed};
+use ins_sim::{Mode, Sample, Scenario, SimError, run, run_seed};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -241,7 +241,7 @@ fn wrong_buffer_length_is_an_error() {
     let sc = Scenario::paper_default().truncated(10.0).unwrap();
     let mut out = vec![Sample::default(); 10];
     match run(&sc, Mode::Kf, 1, &mut out) {
-        Err(RunError::OutputLength {
+        Err(SimError::OutputLength {
             expected: 11,
             got: 10,
         }) => {}
@@ -259,11 +259,11 @@ fn exploding_sensors_give_non_finite_with_time_or_a_sighting_error() {
     // IMU sample (an infinite specific force) before mechanising it: detected within the first
     // steps, not at a 1 s record epoch.
     match run(&sc, Mode::Standalone, 1, &mut out) {
-        Err(RunError::NonFinite { t_s, what }) => {
+        Err(SimError::NonFinite { t_s, what }) => {
             assert!(t_s > 0.0 && t_s < 0.1, "{t_s}");
             assert!(what.contains("INS"));
         }
-        Err(RunError::Online {
+        Err(SimError::Online {
             source: ins_sd_filter::FilterError::ImplausibleImu { t_s, .. },
             ..
         }) => assert!(t_s > 0.0 && t_s < 0.1, "{t_s}"),
@@ -272,8 +272,8 @@ fn exploding_sensors_give_non_finite_with_time_or_a_sighting_error() {
     // The filter modes go through the online filter, which refuses the first implausible IMU
     // sample (an infinite specific force) before mechanising it.
     match run(&sc, Mode::Kf, 1, &mut out) {
-        Err(RunError::NonFinite { t_s, .. }) => assert!(t_s > 0.0 && t_s < 0.1, "{t_s}"),
-        Err(RunError::Online {
+        Err(SimError::NonFinite { t_s, .. }) => assert!(t_s > 0.0 && t_s < 0.1, "{t_s}"),
+        Err(SimError::Online {
             source: ins_sd_filter::FilterError::ImplausibleImu { t_s, .. },
             ..
         }) => assert!(t_s > 0.0 && t_s < 0.1, "{t_s}"),

@@ -7,7 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use ins_sim::logs::{self, InitialState, LogError, ReplayInputs, names};
+use ins_sim::SimError;
+use ins_sim::logs::{self, InitialState, ReplayInputs, names};
 use ins_sim::{Mode, Scenario};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
@@ -138,14 +139,18 @@ fn apply(text: &[u8], m: &Mutation) -> Vec<u8> {
 /// The error names a file the replay reads (the mutated one, or — when damage in one file
 /// surfaces where another is applied — that one) and a line inside it (and, for a parse error,
 /// a column), once, at the start of its message.
-fn check_located(e: &LogError, inputs: &[PathBuf]) -> Result<(), TestCaseError> {
+fn check_located(e: &SimError, inputs: &[PathBuf]) -> Result<(), TestCaseError> {
     let shown = e.to_string();
     let (p, line, column) = match e {
-        LogError::Parse {
+        SimError::LogParse {
             path, line, column, ..
         } => (path, Some(*line), Some(*column)),
-        LogError::Filter { path, line, .. } => (path, Some(*line), None),
-        LogError::Io { path, .. } => (path, None, None),
+        SimError::LogToml { path, error } => {
+            prop_assert_eq!(error.path.as_str(), path.display().to_string());
+            (path, error.line, error.column)
+        }
+        SimError::LogFilter { path, line, .. } => (path, Some(*line), None),
+        SimError::LogIo { path, .. } => (path, None, None),
         other => {
             return Err(TestCaseError::fail(format!(
                 "unexpected error kind: {other}"
@@ -172,7 +177,7 @@ fn check_located(e: &LogError, inputs: &[PathBuf]) -> Result<(), TestCaseError> 
 }
 
 /// Replay with one of the files replaced by `bytes`; returns the files it read and the result.
-fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Result<(), LogError>) {
+fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Result<(), SimError>) {
     let (dir, sc) = exported();
     std::fs::create_dir_all(case_dir).unwrap();
     let mut inputs = ReplayInputs {
@@ -282,9 +287,11 @@ fn a_duplicate_landmark_is_located_at_its_entry() {
     let path = d.join(names::LANDMARKS);
     std::fs::write(&path, &doubled).unwrap();
     let e = logs::read_landmarks(&path).unwrap_err();
-    let LogError::Parse { line, .. } = &e else {
+    let SimError::LogToml { path: p, error } = &e else {
         panic!("{e}")
     };
+    assert_eq!(p, &path);
+    let line = &error.line.expect("a line");
     let appended_at = text.lines().count() + 2;
     assert!(
         *line >= appended_at,

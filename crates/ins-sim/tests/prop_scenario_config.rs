@@ -5,7 +5,7 @@
 //! configurations round-trip serialise → parse → equal.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
-use ins_sim::{Scenario, ScenarioError};
+use ins_sim::{Scenario, SimError};
 use proptest::prelude::*;
 use proptest::sample::Index;
 use proptest::test_runner::{Config, RngSeed};
@@ -189,7 +189,7 @@ proptest! {
         let text = edits.iter().fold(paper_toml(), |t, e| apply(&t, e));
         match Scenario::from_toml_named("configs/s.toml", &text) {
             Ok(s) => prop_assert!(s.validate().is_ok()),
-            Err(ScenarioError::InFile { error, .. }) => {
+            Err(SimError::ScenarioFile { error, .. }) => {
                 prop_assert_eq!(&error.path, "configs/s.toml");
                 check_location(&text, error.line, error.column)?;
             }
@@ -214,7 +214,7 @@ proptest! {
         let (line, name) = &keys[key.index(keys.len())];
         let text = with_value_on_line(&base, *line, value);
         match Scenario::from_toml_named("s.toml", &text) {
-            Err(ScenarioError::InFile { error, field }) => {
+            Err(SimError::ScenarioFile { error, field }) => {
                 prop_assert!(field.ends_with(name.as_str()) || error.message.contains(name.as_str()), "{} / {}", field, error);
                 prop_assert_eq!(error.line, Some(line + 1), "{}", error);
             }

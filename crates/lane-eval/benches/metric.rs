@@ -17,6 +17,7 @@ fn metric_step(c: &mut Criterion) {
     let mut renderer = RoadRenderer::new(ROBOT_ROADS[1], &cam_cfg).unwrap();
     let mut cfg = TrackerConfig::indoor().unwrap();
     cfg.roi.top_row_fraction = 0.45;
+    cfg.track.mark_centres = true; // sub-pixel mark centres (no preset turns them on)
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
     let mut frame = GreyFrame::default();
     let mut report = None;

@@ -21,6 +21,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut renderer = RoadRenderer::new(spec, &cam_cfg)?;
     let mut cfg = TrackerConfig::indoor()?;
     cfg.roi.top_row_fraction = 0.45;
+    cfg.track.mark_centres = true; // sub-pixel mark centres (no preset turns them on)
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240)?;
     let view = BirdseyeView::for_camera(&camera)?;
     let mut frame = GreyFrame::default();

@@ -509,4 +509,19 @@ fn ins_replays_exported_logs_prints_truth_errors_and_names_bad_lines() {
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
     assert!(e.contains(&format!("{bad_s}:11:1:")), "{e}");
+    // A bad landmark table (TOML): its file and line, named once, and the key.
+    let lm = std::fs::read_to_string(p(names::LANDMARKS)).unwrap();
+    let bad = dir.join("landmarks_bad.toml");
+    std::fs::write(&bad, lm.replacen("alt_m", "height_m", 1)).unwrap();
+    let bad_s = bad.display().to_string();
+    let mut a = args;
+    a[6] = &bad_s;
+    let o = nav_app(&a);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(
+        e.contains(&format!("{bad_s}:")) && e.contains("height_m"),
+        "{e}"
+    );
+    assert_eq!(e.matches(&bad_s).count(), 1, "{e}");
 }

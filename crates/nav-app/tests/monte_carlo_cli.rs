@@ -153,6 +153,34 @@ fn a_missing_scenario_file_is_an_error_that_names_it() {
 }
 
 #[test]
+fn a_bad_scenario_names_the_file_line_column_and_field_once() {
+    let text = std::fs::read_to_string(paper()).unwrap();
+    let bad = text.replace("r_var_m2 = 40.0", "r_var_m2 = -40.0");
+    let line = 1 + bad[..bad.find("r_var_m2 = -40.0").unwrap()]
+        .matches('\n')
+        .count();
+    let dir = temp("badcfg");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, bad).unwrap();
+    let p = path.display().to_string();
+    let o = nav_app(&[
+        "--config",
+        &p,
+        "--runs",
+        "1",
+        "--out-root",
+        &dir.display().to_string(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains(&format!("{p}:{line}:1: ")), "{err}");
+    assert!(err.contains("filter.r_var_m2"), "{err}");
+    assert_eq!(err.matches(&p).count(), 1, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn help_states_the_default_input_and_the_exit_codes() {
     let o = nav_app(&["--help"]);
     ok(&o);

@@ -51,7 +51,7 @@ use serde::{Deserialize, Serialize};
 use toml_config::TomlDoc;
 
 use super::engine::{self, RunObserver};
-use super::{Mode, RunError, Sample, Scenario, SimRunOutcome};
+use super::{Mode, Sample, Scenario, SimError, SimRunOutcome};
 
 /// Header of the IMU log.
 pub const IMU_HEADER: &str =
@@ -80,45 +80,6 @@ pub mod names {
     pub const SCENARIO: &str = "scenario.toml";
     /// The simulated filter's own solution.
     pub const SOLUTION: &str = "solution_simulated.csv";
-}
-
-/// Errors of reading, writing and replaying logs; each names the file and, for content, the
-/// line and column (both 1-based).
-#[derive(Debug, thiserror::Error)]
-pub enum LogError {
-    /// The file could not be opened, read or written.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
-    },
-    /// A malformed, missing or out-of-range field.
-    #[error("{}:{line}:{column}: {message}", path.display())]
-    Parse {
-        /// The file.
-        path: PathBuf,
-        /// Line, 1-based.
-        line: usize,
-        /// Column of the field's first character, 1-based.
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// The filter rejected the record of this line.
-    #[error("{}:{line}: {source}", path.display())]
-    Filter {
-        /// The file.
-        path: PathBuf,
-        /// Line, 1-based.
-        line: usize,
-        /// The filter's error.
-        source: FilterError,
-    },
-    /// The simulation of an exported run failed.
-    #[error("simulating the run to export: {0}")]
-    Run(#[from] RunError),
 }
 
 mod read;

@@ -3,8 +3,8 @@
 
 use super::*;
 
-pub(super) fn io_err(path: &Path) -> impl Fn(std::io::Error) -> LogError + '_ {
-    move |source| LogError::Io {
+pub(super) fn io_err(path: &Path) -> impl Fn(std::io::Error) -> SimError + '_ {
+    move |source| SimError::LogIo {
         path: path.to_path_buf(),
         source,
     }
@@ -26,7 +26,7 @@ pub(super) struct CsvReader {
 }
 
 impl CsvReader {
-    pub(super) fn open(path: &Path, header: &str) -> Result<Self, LogError> {
+    pub(super) fn open(path: &Path, header: &str) -> Result<Self, SimError> {
         let file = File::open(path).map_err(io_err(path))?;
         let mut r = Self {
             path: path.to_path_buf(),
@@ -67,8 +67,8 @@ impl CsvReader {
         Ok(r)
     }
 
-    pub(super) fn parse_err(&self, line: usize, column: usize, message: String) -> LogError {
-        LogError::Parse {
+    pub(super) fn parse_err(&self, line: usize, column: usize, message: String) -> SimError {
+        SimError::LogParse {
             path: self.path.clone(),
             line,
             column,
@@ -77,10 +77,10 @@ impl CsvReader {
     }
 
     /// Next non-blank, non-comment line, split.
-    pub(super) fn next_raw(&mut self) -> Result<Option<Record>, LogError> {
+    pub(super) fn next_raw(&mut self) -> Result<Option<Record>, SimError> {
         for text in self.lines.by_ref() {
             self.line += 1;
-            let text = text.map_err(|source| LogError::Io {
+            let text = text.map_err(|source| SimError::LogIo {
                 path: self.path.clone(),
                 source,
             })?;
@@ -100,7 +100,7 @@ impl CsvReader {
     }
 
     /// Next data record, with exactly the header's number of fields.
-    pub(super) fn next(&mut self) -> Result<Option<Record>, LogError> {
+    pub(super) fn next(&mut self) -> Result<Option<Record>, SimError> {
         let Some(rec) = self.next_raw()? else {
             return Ok(None);
         };
@@ -123,7 +123,7 @@ impl CsvReader {
         &rec.text[rec.starts[i]..end]
     }
 
-    pub(super) fn f64(&self, rec: &Record, i: usize, name: &str) -> Result<f64, LogError> {
+    pub(super) fn f64(&self, rec: &Record, i: usize, name: &str) -> Result<f64, SimError> {
         let s = self.field(rec, i).trim();
         match s.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
@@ -140,7 +140,7 @@ impl CsvReader {
         rec: &Record,
         i: usize,
         name: &str,
-    ) -> Result<Option<f64>, LogError> {
+    ) -> Result<Option<f64>, SimError> {
         if self.field(rec, i).trim().is_empty() {
             Ok(None)
         } else {
@@ -148,7 +148,7 @@ impl CsvReader {
         }
     }
 
-    pub(super) fn u32(&self, rec: &Record, i: usize, name: &str) -> Result<u32, LogError> {
+    pub(super) fn u32(&self, rec: &Record, i: usize, name: &str) -> Result<u32, SimError> {
         let s = self.field(rec, i).trim();
         s.parse::<u32>().map_err(|_| {
             self.parse_err(
@@ -213,22 +213,20 @@ pub(super) struct LandmarkFile {
     pub(super) landmarks: Vec<LandmarkEntry>,
 }
 
-pub(super) fn toml_err(path: &Path, e: toml_config::TomlError) -> LogError {
-    LogError::Parse {
+pub(super) fn toml_err(path: &Path, error: toml_config::TomlError) -> SimError {
+    SimError::LogToml {
         path: path.to_path_buf(),
-        line: e.line.unwrap_or(1),
-        column: e.column.unwrap_or(1),
-        message: e.message,
+        error,
     }
 }
 
 /// Reads a landmark table file.
 ///
 /// # Errors
-/// [`LogError::Io`], [`LogError::Parse`] (TOML errors with their line and column, through the
+/// [`SimError::LogIo`], [`SimError::LogToml`] (TOML errors with their line and column, through the
 /// workspace's one TOML loader `toml-config`; a duplicate id or a bad coordinate at the
 /// `[[landmarks]]` entry concerned).
-pub fn read_landmarks(path: &Path) -> Result<LandmarkTable, LogError> {
+pub fn read_landmarks(path: &Path) -> Result<LandmarkTable, SimError> {
     let text = std::fs::read_to_string(path).map_err(io_err(path))?;
     let doc = TomlDoc::parse(path.display().to_string(), &text).map_err(|e| toml_err(path, e))?;
     let file: LandmarkFile = doc.deserialize().map_err(|e| toml_err(path, e))?;
@@ -250,15 +248,15 @@ pub fn read_landmarks(path: &Path) -> Result<LandmarkTable, LogError> {
 /// Reads an initial-state file.
 ///
 /// # Errors
-/// [`LogError::Io`], [`LogError::Parse`].
-pub fn read_initial(path: &Path) -> Result<InitialState, LogError> {
+/// [`SimError::LogIo`], [`SimError::LogToml`].
+pub fn read_initial(path: &Path) -> Result<InitialState, SimError> {
     let text = std::fs::read_to_string(path).map_err(io_err(path))?;
     let doc = TomlDoc::parse(path.display().to_string(), &text).map_err(|e| toml_err(path, e))?;
     doc.deserialize().map_err(|e| toml_err(path, e))
 }
 
 /// Reads a navigation-state row (truth or the first columns of a solution).
-pub(super) fn read_nav(r: &CsvReader, rec: &Record) -> Result<(f64, NavState), LogError> {
+pub(super) fn read_nav(r: &CsvReader, rec: &Record) -> Result<(f64, NavState), SimError> {
     let names = TRUTH_HEADER.split(',').collect::<Vec<_>>();
     let mut v = [0.0; 11];
     for (i, x) in v.iter_mut().enumerate() {
@@ -279,8 +277,8 @@ pub(super) fn read_nav(r: &CsvReader, rec: &Record) -> Result<(f64, NavState), L
 /// Reads a truth (or solution) file: (t, state) per row.
 ///
 /// # Errors
-/// [`LogError::Io`], [`LogError::Parse`] naming the line and column.
-pub fn read_truth(path: &Path) -> Result<Vec<(f64, NavState)>, LogError> {
+/// [`SimError::LogIo`], [`SimError::LogParse`] naming the line and column.
+pub fn read_truth(path: &Path) -> Result<Vec<(f64, NavState)>, SimError> {
     let mut r = CsvReader::open(path, TRUTH_HEADER)?;
     let mut out = Vec::new();
     while let Some(rec) = r.next()? {
@@ -293,7 +291,7 @@ pub fn read_truth(path: &Path) -> Result<Vec<(f64, NavState)>, LogError> {
 ///
 /// # Errors
 /// As [`read_truth`].
-pub fn read_solution(path: &Path) -> Result<Vec<(f64, NavState)>, LogError> {
+pub fn read_solution(path: &Path) -> Result<Vec<(f64, NavState)>, SimError> {
     let mut r = CsvReader::open(path, SOLUTION_HEADER)?;
     let mut out = Vec::new();
     while let Some(rec) = r.next()? {

@@ -36,18 +36,18 @@ pub struct ReplaySummary {
 /// Replays logs through the online filter, writing the solution CSV to `out`.
 ///
 /// # Errors
-/// [`LogError`] naming the file, line and column of the first bad record, or the line whose
+/// [`SimError`] naming the file, line and column of the first bad record, or the line whose
 /// record the filter rejected.
 pub fn replay(
     inputs: &ReplayInputs,
     out: &mut impl Write,
     out_path: &Path,
-) -> Result<ReplaySummary, LogError> {
+) -> Result<ReplaySummary, SimError> {
     let table = read_landmarks(&inputs.landmarks)?;
     let init = read_initial(&inputs.initial)?;
     let mut filter =
         InsSdFilter::new(inputs.config, table, init.nav_state(), init.t_s).map_err(|source| {
-            LogError::Filter {
+            SimError::LogFilter {
                 path: inputs.initial.clone(),
                 line: 1,
                 source,
@@ -67,7 +67,7 @@ pub fn replay(
                      pending: &mut Option<Record>,
                      summary: &mut ReplaySummary,
                      out: &mut dyn Write|
-     -> Result<(), LogError> {
+     -> Result<(), SimError> {
         loop {
             let Some(rec) = pending.as_ref() else {
                 return Ok(());
@@ -101,7 +101,7 @@ pub fn replay(
             let now = filter.time_s();
             let report = filter
                 .update(now, &epoch)
-                .map_err(|source| LogError::Filter {
+                .map_err(|source| SimError::LogFilter {
                     path: inputs.sightings.clone(),
                     line: first_line,
                     source,
@@ -126,7 +126,7 @@ pub fn replay(
                 &Vector3::new(v[1], v[2], v[3]),
                 &Vector3::new(v[4], v[5], v[6]),
             )
-            .map_err(|source| LogError::Filter {
+            .map_err(|source| SimError::LogFilter {
                 path: inputs.imu.clone(),
                 line: rec.line,
                 source,
@@ -162,7 +162,7 @@ pub struct TruthComparison {
 pub fn compare_with_truth(
     truth: &Path,
     solution: &[(f64, NavState)],
-) -> Result<TruthComparison, LogError> {
+) -> Result<TruthComparison, SimError> {
     let truth = read_truth(truth)?;
     let mut c = TruthComparison::default();
     let mut sum2 = 0.0;

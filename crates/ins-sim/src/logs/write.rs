@@ -56,13 +56,13 @@ pub(super) struct LogWriter {
     pub(super) solution: BufWriter<File>,
     pub(super) step_s: f64,
     pub(super) initial: Option<InitialState>,
-    pub(super) error: Option<LogError>,
+    pub(super) error: Option<SimError>,
 }
 
 impl LogWriter {
-    pub(super) fn create(dir: &Path, step_s: f64) -> Result<Self, LogError> {
+    pub(super) fn create(dir: &Path, step_s: f64) -> Result<Self, SimError> {
         std::fs::create_dir_all(dir).map_err(io_err(dir))?;
-        let open = |name: &str, header: &str| -> Result<BufWriter<File>, LogError> {
+        let open = |name: &str, header: &str| -> Result<BufWriter<File>, SimError> {
             let path = dir.join(name);
             let mut w = BufWriter::new(File::create(&path).map_err(io_err(&path))?);
             writeln!(w, "{header}").map_err(io_err(&path))?;
@@ -82,7 +82,7 @@ impl LogWriter {
 
     pub(super) fn keep(&mut self, name: &str, r: std::io::Result<()>) {
         if let (Err(source), None) = (r, &self.error) {
-            self.error = Some(LogError::Io {
+            self.error = Some(SimError::LogIo {
                 path: self.dir.join(name),
                 source,
             });
@@ -124,14 +124,14 @@ impl RunObserver for LogWriter {
     }
 }
 
-pub(super) fn ser_err(path: &Path) -> impl Fn(toml::ser::Error) -> LogError + '_ {
-    move |e| LogError::Io {
+pub(super) fn ser_err(path: &Path) -> impl Fn(toml::ser::Error) -> SimError + '_ {
+    move |source| SimError::LogWrite {
         path: path.to_path_buf(),
-        source: std::io::Error::other(e.to_string()),
+        source,
     }
 }
 
-pub(super) fn write_text(path: &Path, text: &str) -> Result<(), LogError> {
+pub(super) fn write_text(path: &Path, text: &str) -> Result<(), SimError> {
     std::fs::write(path, text).map_err(io_err(path))
 }
 
@@ -140,16 +140,21 @@ pub(super) fn write_text(path: &Path, text: &str) -> Result<(), LogError> {
 /// simulated filter's own solution. Returns the run's outcome and 1 Hz records.
 ///
 /// # Errors
-/// [`LogError::Run`] when the simulation fails, [`LogError::Io`] when a file cannot be written.
+/// [`SimError::ExportRun`] when the simulation fails, [`SimError::LogIo`] or
+/// [`SimError::LogWrite`] when a file cannot be written or serialised.
 pub fn export_run(
     scenario: &Scenario,
     mode: Mode,
     seed: u64,
     dir: &Path,
-) -> Result<(SimRunOutcome, Vec<Sample>), LogError> {
+) -> Result<(SimRunOutcome, Vec<Sample>), SimError> {
     let mut w = LogWriter::create(dir, scenario.trajectory.step_s)?;
     let mut out = vec![Sample::default(); scenario.samples_per_run()];
-    let outcome = engine::run_observed(scenario, mode, seed, &mut out, &mut w)?;
+    let outcome = engine::run_observed(scenario, mode, seed, &mut out, &mut w).map_err(|e| {
+        SimError::ExportRun {
+            source: Box::new(e),
+        }
+    })?;
     if let Some(e) = w.error.take() {
         return Err(e);
     }

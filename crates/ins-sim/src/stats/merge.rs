@@ -1,20 +1,21 @@
 //! Merging shards of the statistics, and which run indices a shard or a merge covers.
 
-use super::{FORMAT, Stats, StatsError, order_key};
+use super::{FORMAT, Stats, order_key};
+use crate::SimError;
 
 /// Merges shard statistics (any order) into one. Checks that they describe the same scenario,
 /// seed and total run count and that their run ranges are disjoint; sums in the order of the
 /// ranges' starts.
-pub fn merge(mut parts: Vec<Stats>) -> Result<Stats, StatsError> {
+pub fn merge(mut parts: Vec<Stats>) -> Result<Stats, SimError> {
     if parts.is_empty() {
-        return Err(StatsError::Empty);
+        return Err(SimError::StatsEmpty);
     }
     parts.sort_by_key(|p| p.run_ranges.first().map_or(0, |r| r.0));
     let first = parts[0].clone();
-    let differ = |what, a: String, b: String| StatsError::Mismatch { what, a, b };
+    let differ = |what, a: String, b: String| SimError::StatsMismatch { what, a, b };
     for p in &parts {
         if p.format != FORMAT {
-            return Err(StatsError::Format {
+            return Err(SimError::StatsFormat {
                 found: p.format.clone(),
             });
         }
@@ -70,7 +71,7 @@ pub fn merge(mut parts: Vec<Stats>) -> Result<Stats, StatsError> {
     out.run_ranges.sort_unstable();
     for w in out.run_ranges.windows(2) {
         if w[1].0 < w[0].1 {
-            return Err(StatsError::Overlap(w[0].0, w[0].1, w[1].0, w[1].1));
+            return Err(SimError::StatsOverlap(w[0].0, w[0].1, w[1].0, w[1].1));
         }
     }
     out.shards.sort_by_key(|s| s.index);
@@ -81,11 +82,11 @@ pub fn merge(mut parts: Vec<Stats>) -> Result<Stats, StatsError> {
 }
 
 /// Run indices of shard `index` (1-based) of `count` over `runs`: a contiguous slice, sizes
-/// differing by at most one. [`StatsError::Shard`] when `count` is 0 or `index` is not in
+/// differing by at most one. [`SimError::StatsShard`] when `count` is 0 or `index` is not in
 /// `1..=count`.
-pub fn shard_range(runs: u64, index: u64, count: u64) -> Result<(u64, u64), StatsError> {
+pub fn shard_range(runs: u64, index: u64, count: u64) -> Result<(u64, u64), SimError> {
     if count == 0 || !(1..=count).contains(&index) {
-        return Err(StatsError::Shard { index, count });
+        return Err(SimError::StatsShard { index, count });
     }
     // In u128: `index · runs` cannot overflow.
     let at = |i: u64| (u128::from(i) * u128::from(runs) / u128::from(count)) as u64;

@@ -8,55 +8,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Mode, Sample};
+use super::{Mode, Sample, SimError};
 
 mod merge;
 pub use merge::{merge, missing_ranges, shard_range};
-
-/// Why statistics cannot be loaded or merged, or a shard is not a slice of the runs.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum StatsError {
-    /// Nothing to merge.
-    #[error("merge: no statistics to merge")]
-    Empty,
-    /// A file of another format.
-    #[error("merge: format `{found}` is not `{FORMAT}`")]
-    Format {
-        /// The format found.
-        found: String,
-    },
-    /// The shards disagree on what they simulated.
-    #[error("merge: shards come from different {what} ({a} vs {b})")]
-    Mismatch {
-        /// Which property (`scenarios`, `master seeds`, `total run counts`, `modes or durations`).
-        what: &'static str,
-        /// One value.
-        a: String,
-        /// The other.
-        b: String,
-    },
-    /// Two shards cover the same runs.
-    #[error("merge: run ranges {0}..{1} and {2}..{3} overlap (the same shard given twice?)")]
-    Overlap(u64, u64, u64, u64),
-    /// A statistics file breaks an invariant of [`Stats`] (its field named).
-    #[error("stats: {field}: {reason}")]
-    Invalid {
-        /// The field, e.g. `modes` or `run_ranges`.
-        field: &'static str,
-        /// What is wrong with it.
-        reason: String,
-    },
-    /// A shard is not a slice of the runs: `count` is 0 or `index` is not in `1..=count`.
-    #[error(
-        "shard {index}/{count}: the shard number must be within 1..={count} and the count at least 1"
-    )]
-    Shard {
-        /// Shard number given (1-based).
-        index: u64,
-        /// Number of shards given.
-        count: u64,
-    },
-}
 
 /// Number of accumulated quantities per time bin.
 pub const Q: usize = 14;
@@ -345,7 +300,7 @@ pub struct StatsFile {
 /// holds: modes in `Mode::EVERY` order, each once, all with the same number of time bins; run
 /// ranges sorted, disjoint and within `0..runs_total`; exclusions and kept runs sorted by mode
 /// then run index, of modes present. A `stats.json` that breaks one is refused on load
-/// ([`StatsError::Invalid`] names the field).
+/// ([`SimError::StatsInvalid`] names the field).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "StatsFile")]
 pub struct Stats {
@@ -385,13 +340,13 @@ pub struct Stats {
 }
 
 impl TryFrom<StatsFile> for Stats {
-    type Error = StatsError;
+    type Error = SimError;
 
     /// Sorts the run ranges, exclusions and runs, then checks the invariants of [`Stats`].
-    fn try_from(mut f: StatsFile) -> Result<Stats, StatsError> {
-        let invalid = |field, reason: String| StatsError::Invalid { field, reason };
+    fn try_from(mut f: StatsFile) -> Result<Stats, SimError> {
+        let invalid = |field, reason: String| SimError::StatsInvalid { field, reason };
         if f.format != FORMAT {
-            return Err(StatsError::Format { found: f.format });
+            return Err(SimError::StatsFormat { found: f.format });
         }
         for w in f.modes.windows(2) {
             if w[0].mode.order() >= w[1].mode.order() {
@@ -431,7 +386,7 @@ impl TryFrom<StatsFile> for Stats {
         }
         for w in f.run_ranges.windows(2) {
             if w[1].0 < w[0].1 {
-                return Err(StatsError::Overlap(w[0].0, w[0].1, w[1].0, w[1].1));
+                return Err(SimError::StatsOverlap(w[0].0, w[0].1, w[1].0, w[1].1));
             }
         }
         let known = |m: Mode| f.modes.iter().any(|x| x.mode == m);

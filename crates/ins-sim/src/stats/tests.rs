@@ -33,10 +33,17 @@ fn file(modes: &[Mode]) -> StatsFile {
     }
 }
 
-fn invalid_field(r: Result<Stats, StatsError>) -> &'static str {
+fn invalid_field(r: Result<Stats, SimError>) -> &'static str {
     match r {
-        Err(StatsError::Invalid { field, .. }) => field,
-        other => panic!("expected StatsError::Invalid, got {other:?}"),
+        Err(e @ SimError::StatsInvalid { field, .. }) => {
+            // The message names the field.
+            assert!(
+                e.to_string().starts_with(&format!("stats: {field}: ")),
+                "{e}"
+            );
+            field
+        }
+        other => panic!("expected SimError::StatsInvalid, got {other:?}"),
     }
 }
 
@@ -75,10 +82,9 @@ fn modes_out_of_order_duplicated_or_of_other_lengths_are_refused() {
 fn bad_run_ranges_and_foreign_modes_are_refused() {
     let mut f = file(&[Mode::Standalone, Mode::Kf]);
     f.run_ranges = vec![(0, 6), (5, 10)];
-    assert_eq!(
-        Stats::try_from(f).unwrap_err(),
-        StatsError::Overlap(0, 6, 5, 10)
-    );
+    let e = Stats::try_from(f).unwrap_err();
+    assert!(matches!(e, SimError::StatsOverlap(0, 6, 5, 10)), "{e:?}");
+    assert!(e.to_string().contains("0..6 and 5..10"), "{e}");
     let mut f = file(&[Mode::Standalone, Mode::Kf]);
     f.run_ranges = vec![(0, 11)];
     assert_eq!(invalid_field(Stats::try_from(f)), "run_ranges");
@@ -92,7 +98,10 @@ fn bad_run_ranges_and_foreign_modes_are_refused() {
     );
     let mut f = file(&[Mode::Standalone, Mode::Kf]);
     f.format = "other/1".to_string();
-    assert!(matches!(Stats::try_from(f), Err(StatsError::Format { .. })));
+    assert!(matches!(
+        Stats::try_from(f),
+        Err(SimError::StatsFormat { .. })
+    ));
 }
 
 #[test]
@@ -106,20 +115,24 @@ fn the_paper_scenario_keeps_its_fingerprint() {
 
 #[test]
 fn shard_range_refuses_shard_zero_and_count_zero() {
-    assert_eq!(
-        shard_range(10, 0, 3),
-        Err(StatsError::Shard { index: 0, count: 3 })
-    );
-    assert_eq!(
-        shard_range(10, 1, 0),
-        Err(StatsError::Shard { index: 1, count: 0 })
-    );
-    assert_eq!(
-        shard_range(10, 4, 3),
-        Err(StatsError::Shard { index: 4, count: 3 })
-    );
-    assert_eq!(shard_range(10, 1, 3), Ok((0, 3)));
-    assert_eq!(shard_range(10, 3, 3), Ok((6, 10)));
+    for (index, count) in [(0, 3), (1, 0), (4, 3)] {
+        let e = shard_range(10, index, count).unwrap_err();
+        assert!(
+            matches!(e, SimError::StatsShard { index: i, count: c } if (i, c) == (index, count)),
+            "{e:?}"
+        );
+        // The message names the shard given.
+        assert!(
+            e.to_string()
+                .starts_with(&format!("shard {index}/{count}:")),
+            "{e}"
+        );
+    }
+    assert_eq!(shard_range(10, 1, 3).unwrap(), (0, 3));
+    assert_eq!(shard_range(10, 3, 3).unwrap(), (6, 10));
     // No overflow for huge run counts.
-    assert_eq!(shard_range(u64::MAX, 2, 2), Ok((u64::MAX / 2, u64::MAX)));
+    assert_eq!(
+        shard_range(u64::MAX, 2, 2).unwrap(),
+        (u64::MAX / 2, u64::MAX)
+    );
 }

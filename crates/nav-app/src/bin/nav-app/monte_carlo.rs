@@ -174,7 +174,10 @@ pub fn main(args: impl IntoIterator<Item = std::ffi::OsString>) -> ExitCode {
     match run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("nav-app monte-carlo: error: {e:#}");
+            eprintln!(
+                "nav-app monte-carlo: error: {}",
+                crate::ins::error_chain(e.as_ref())
+            );
             ExitCode::from(1)
         }
     }
