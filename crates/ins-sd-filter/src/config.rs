@@ -77,7 +77,7 @@ impl ProcessNoisePsd {
 
 /// The error-state estimator run on the INS.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Estimator {
+pub enum ErrorStateEstimator {
     /// No estimator: the free (stand-alone) INS; sightings are checked and ignored.
     StandAlone,
     /// Kalman filter with the configured (a-priori) process noise.
@@ -90,12 +90,12 @@ pub enum Estimator {
     SageHusa(SageHusaConfig),
 }
 
-impl Estimator {
+impl ErrorStateEstimator {
     /// The projection of the adaptive estimate (`None` for KF and stand-alone).
     pub fn projection(&self) -> Option<QProjection> {
         match self {
-            Estimator::MohamedSchwarz(c) => Some(c.projection),
-            Estimator::SageHusa(c) => Some(c.projection),
+            ErrorStateEstimator::MohamedSchwarz(c) => Some(c.projection),
+            ErrorStateEstimator::SageHusa(c) => Some(c.projection),
             _ => None,
         }
     }
@@ -128,7 +128,7 @@ pub struct InsSdFilterConfig {
     /// `gate_probability` quantile (−2 ln(1 − p)) is rejected. `None` = no gate.
     pub gate_probability: Option<f64>,
     /// KF, adaptive KF or none.
-    pub estimator: Estimator,
+    pub estimator: ErrorStateEstimator,
     /// Measurement matrix.
     pub jacobian: MeasurementJacobian,
 }
@@ -211,8 +211,8 @@ impl InsSdFilterConfig {
             return Err(bad("gate_probability", "must be within (0, 1)", p));
         }
         let checked = match &self.estimator {
-            Estimator::MohamedSchwarz(c) => c.validate(akf::DEFAULT_WINDOW_CAPACITY),
-            Estimator::SageHusa(c) => c.validate(),
+            ErrorStateEstimator::MohamedSchwarz(c) => c.validate(akf::DEFAULT_WINDOW_CAPACITY),
+            ErrorStateEstimator::SageHusa(c) => c.validate(),
             _ => Ok(()),
         };
         checked.map_err(|e| FilterError::InvalidConfig {

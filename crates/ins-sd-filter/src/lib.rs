@@ -38,7 +38,7 @@
 //!   ∇̂, ε̂ added to its sensor corrections, x̂ ← 0, P kept.
 //! * 0 sightings at an epoch: nothing happens (the interval continues to the next epoch).
 //!
-//! ## Estimators ([`Estimator`])
+//! ## Estimators ([`ErrorStateEstimator`])
 //!
 //! Stand-alone INS (no filter), the KF with the a-priori Q, and two adaptive Q̂ schemes used
 //! as the next interval's Q once they have an estimate: Mohamed–Schwarz (paper eq. 19, a
@@ -65,7 +65,7 @@
 //! use ins_errors::earth::{Geodetic, gravity_ned_mps2};
 //! use ins_errors::strapdown::NavState;
 //! use ins_sd_filter::{
-//!     ErrorSigmas, Estimator, InsSdFilter, InsSdFilterConfig, LandmarkEntry, LandmarkTable,
+//!     ErrorSigmas, ErrorStateEstimator, InsSdFilter, InsSdFilterConfig, LandmarkEntry, LandmarkTable,
 //!     MeasurementJacobian, ProcessNoisePsd, Sighting,
 //! };
 //! use nalgebra::{UnitQuaternion, Vector3};
@@ -85,7 +85,7 @@
 //!     r_var_m2: 40.0,
 //!     open_loop_until_s: f64::INFINITY,
 //!     gate_probability: Some(0.999),
-//!     estimator: Estimator::Kalman,
+//!     estimator: ErrorStateEstimator::Kalman,
 //!     jacobian: MeasurementJacobian::Verified,
 //! };
 //! let table = LandmarkTable::new(&[
@@ -128,7 +128,9 @@ mod filter;
 pub mod interval;
 mod landmarks;
 
-pub use config::{ErrorSigmas, Estimator, InsSdFilterConfig, MeasurementJacobian, ProcessNoisePsd};
+pub use config::{
+    ErrorSigmas, ErrorStateEstimator, InsSdFilterConfig, MeasurementJacobian, ProcessNoisePsd,
+};
 pub use error::FilterError;
 pub use filter::{
     FilterStatistics, InsSdFilter, MAX_ANGULAR_RATE_RADPS, MAX_BATCH, MAX_SPECIFIC_FORCE_MPS2,

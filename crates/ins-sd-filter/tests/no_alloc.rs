@@ -7,7 +7,7 @@ use alloc_counter::allocations_in;
 use ins_errors::earth::Geodetic;
 use ins_errors::strapdown::NavState;
 use ins_sd_filter::{
-    ErrorSigmas, Estimator, InsSdFilter, InsSdFilterConfig, LandmarkEntry, LandmarkTable,
+    ErrorSigmas, ErrorStateEstimator, InsSdFilter, InsSdFilterConfig, LandmarkEntry, LandmarkTable,
     MeasurementJacobian, ProcessNoisePsd, Sighting,
 };
 use nalgebra::{UnitQuaternion, Vector3};
@@ -15,7 +15,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 #[global_allocator]
 static ALLOC: alloc_counter::CountingAllocator = alloc_counter::CountingAllocator::new();
 
-fn filter(estimator: Estimator) -> InsSdFilter {
+fn filter(estimator: ErrorStateEstimator) -> InsSdFilter {
     let cfg = InsSdFilterConfig {
         imu_step_s: 0.01,
         timestamp_tolerance_s: 1e-8,
@@ -87,12 +87,16 @@ fn run(f: &mut InsSdFilter, seconds: usize) {
 
 #[test]
 fn propagate_and_update_do_not_allocate() {
-    let ms = Estimator::MohamedSchwarz(AdaptiveQConfig {
+    let ms = ErrorStateEstimator::MohamedSchwarz(AdaptiveQConfig {
         window: 10,
         projection: QProjection::Diagonal,
         min_variance: 0.0,
     });
-    for est in [Estimator::StandAlone, Estimator::Kalman, ms] {
+    for est in [
+        ErrorStateEstimator::StandAlone,
+        ErrorStateEstimator::Kalman,
+        ms,
+    ] {
         let mut f = filter(est);
         let (_, n) = allocations_in(|| run(&mut f, 20));
         assert_eq!(n, 0, "{est:?}: {n} allocations in 20 s");

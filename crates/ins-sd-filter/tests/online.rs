@@ -10,7 +10,7 @@ use ins_errors::imu::{ImuErrorParams, ImuErrors};
 use ins_errors::strapdown::NavState;
 use ins_errors::trajectory::Trajectory;
 use ins_sd_filter::{
-    ErrorSigmas, Estimator, FilterError, InsSdFilter, InsSdFilterConfig, LandmarkEntry,
+    ErrorSigmas, ErrorStateEstimator, FilterError, InsSdFilter, InsSdFilterConfig, LandmarkEntry,
     LandmarkTable, MeasurementJacobian, ProcessNoisePsd, Sighting, nav_pose,
 };
 use nalgebra::Vector3;
@@ -41,7 +41,7 @@ fn table(n: usize) -> LandmarkTable {
     LandmarkTable::new(&entries).unwrap()
 }
 
-fn config(estimator: Estimator, gate: Option<f64>) -> InsSdFilterConfig {
+fn config(estimator: ErrorStateEstimator, gate: Option<f64>) -> InsSdFilterConfig {
     let mg = ins_errors::imu::MG_TO_MPS2;
     let degph = ins_errors::imu::DEGPH_TO_RADPS;
     InsSdFilterConfig {
@@ -151,7 +151,12 @@ fn zero_one_two_and_five_landmarks() {
     let mut sigma = Vec::new();
     let mut errors = Vec::new();
     for n in [0, 1, 2, 5] {
-        let (filter, truth) = fly(config(Estimator::Kalman, Some(0.9999)), n, 60, &|_, _| {});
+        let (filter, truth) = fly(
+            config(ErrorStateEstimator::Kalman, Some(0.9999)),
+            n,
+            60,
+            &|_, _| {},
+        );
         let st = filter.statistics();
         assert_eq!(st.imu_samples, 6000);
         assert_eq!(st.epochs, if n == 0 { 0 } else { 60 });
@@ -181,7 +186,7 @@ fn zero_one_two_and_five_landmarks() {
 
 #[test]
 fn the_gate_rejects_an_outlier_exactly_as_if_it_was_never_sent() {
-    let cfg = config(Estimator::Kalman, Some(0.9999));
+    let cfg = config(ErrorStateEstimator::Kalman, Some(0.9999));
     // A 300 m gross error on the w offset of landmark 11 at epoch 30 (NIS ≫ 18.4).
     let (gated, _) = fly(cfg, 5, 40, &|epoch, s| {
         if epoch == 30 {
@@ -199,11 +204,16 @@ fn the_gate_rejects_an_outlier_exactly_as_if_it_was_never_sent() {
     assert_eq!(gated.covariance(), dropped.covariance());
     assert_eq!(gated.navigation_solution(), dropped.navigation_solution());
     // Without a gate the outlier goes in and moves the solution.
-    let (ungated, _) = fly(config(Estimator::Kalman, None), 5, 40, &|epoch, s| {
-        if epoch == 30 {
-            s[1].w_m += 300.0;
-        }
-    });
+    let (ungated, _) = fly(
+        config(ErrorStateEstimator::Kalman, None),
+        5,
+        40,
+        &|epoch, s| {
+            if epoch == 30 {
+                s[1].w_m += 300.0;
+            }
+        },
+    );
     let d = ins_errors::error_model::error_state(
         &dropped.navigation_solution(),
         &ungated.navigation_solution(),
@@ -216,7 +226,7 @@ fn a_batch_update_equals_one_landmark_at_a_time() {
     // Open loop (no feedback), KF. At 10 s, the same 5 sightings: one update with all five
     // against five updates at the same epoch (each predicts over an empty interval, Φ = I,
     // Q = 0) — the sequential form of the same Bayesian update.
-    let mut cfg = config(Estimator::Kalman, None);
+    let mut cfg = config(ErrorStateEstimator::Kalman, None);
     cfg.open_loop_until_s = f64::INFINITY;
     let mut captured = Vec::new();
     let (mut batch, _) = fly(cfg, 5, 10, &|_, _| {});
@@ -273,7 +283,7 @@ fn a_batch_update_equals_one_landmark_at_a_time() {
 fn more_landmarks_than_one_batch_equal_one_at_a_time() {
     // 10 sightings (two of each landmark) go in two batches of ≤ 8; compare with 10 sequential
     // updates.
-    let mut cfg = config(Estimator::Kalman, None);
+    let mut cfg = config(ErrorStateEstimator::Kalman, None);
     cfg.open_loop_until_s = f64::INFINITY;
     let (mut batch, _) = fly(cfg, 5, 5, &|_, _| {});
     let mut seq = batch.clone();
@@ -300,7 +310,7 @@ fn more_landmarks_than_one_batch_equal_one_at_a_time() {
 
 #[test]
 fn bad_input_is_a_typed_error_and_changes_nothing() {
-    let cfg = config(Estimator::Kalman, None);
+    let cfg = config(ErrorStateEstimator::Kalman, None);
     let (mut f, _) = fly(cfg, 2, 3, &|_, _| {});
     let before = f.clone();
     let same = |a: &InsSdFilter, b: &InsSdFilter| {
@@ -395,7 +405,7 @@ fn bad_input_is_a_typed_error_and_changes_nothing() {
 
 #[test]
 fn increments_and_rates_are_the_same_sample() {
-    let cfg = config(Estimator::Kalman, None);
+    let cfg = config(ErrorStateEstimator::Kalman, None);
     let (a, _) = fly(cfg, 3, 2, &|_, _| {});
     let mut b = a.clone();
     let mut a = a;
@@ -425,7 +435,7 @@ fn increments_and_rates_are_the_same_sample() {
 #[test]
 fn the_adaptive_filter_uses_its_estimate_once_the_window_is_full() {
     let cfg = config(
-        Estimator::MohamedSchwarz(AdaptiveQConfig {
+        ErrorStateEstimator::MohamedSchwarz(AdaptiveQConfig {
             window: 10,
             projection: QProjection::Diagonal,
             min_variance: 0.0,
@@ -441,7 +451,7 @@ fn the_adaptive_filter_uses_its_estimate_once_the_window_is_full() {
 #[test]
 fn the_gate_threshold_is_the_chi_square_quantile() {
     for p in [0.9, 0.99, 0.9999] {
-        let mut c = config(Estimator::Kalman, Some(p));
+        let mut c = config(ErrorStateEstimator::Kalman, Some(p));
         c.gate_probability = Some(p);
         let exact = c.gate_threshold().unwrap();
         // Cross-check with the Wilson–Hilferty approximation of `akf` (≤ 5 % off at 2 dof here).
@@ -463,7 +473,7 @@ fn the_interval_noise_basis_reproduces_the_model_q() {
     let psd = [9.6e-7, 2.35e-13, 1e-9, 1e-15];
     let mut with = IntervalModel::new(100, 2, 0.01, psd);
     with.enable_noise_basis();
-    let (filter, _) = fly(config(Estimator::Kalman, None), 1, 45, &|_, _| {});
+    let (filter, _) = fly(config(ErrorStateEstimator::Kalman, None), 1, 45, &|_, _| {});
     let mut ins = filter.ins().clone();
     for _ in 0..100 {
         ins.step(
@@ -491,13 +501,13 @@ fn the_interval_noise_basis_reproduces_the_model_q() {
 
 #[test]
 fn sage_husa_and_structured_filters_run_and_fit_non_negative_densities() {
-    let sh = Estimator::SageHusa(akf::SageHusaConfig {
+    let sh = ErrorStateEstimator::SageHusa(akf::SageHusaConfig {
         forgetting: 0.95,
         warmup: 10,
         projection: QProjection::Diagonal,
         min_variance: 0.0,
     });
-    let st = Estimator::MohamedSchwarz(AdaptiveQConfig {
+    let st = ErrorStateEstimator::MohamedSchwarz(AdaptiveQConfig {
         window: 10,
         projection: QProjection::Structured,
         min_variance: 0.0,
@@ -517,7 +527,7 @@ fn sage_husa_and_structured_filters_run_and_fit_non_negative_densities() {
 
 #[test]
 fn an_imu_gap_or_an_implausible_sample_is_refused_and_changes_nothing() {
-    let cfg = config(Estimator::Kalman, None);
+    let cfg = config(ErrorStateEstimator::Kalman, None);
     let (mut f, _) = fly(cfg, 2, 3, &|_, _| {});
     let (t, before) = (f.time_s(), *f.ins().state());
     let z = Vector3::zeros();

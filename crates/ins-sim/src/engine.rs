@@ -8,7 +8,7 @@ use ins_errors::imu::{ImuErrorParams, ImuErrors};
 use ins_errors::strapdown::NavState;
 use ins_errors::trajectory::{Trajectory, TruthSample};
 use ins_sd_filter::{
-    ErrorSigmas, Estimator, FilterError, InsSdFilter, InsSdFilterConfig, LandmarkEntry,
+    ErrorSigmas, ErrorStateEstimator, FilterError, InsSdFilter, InsSdFilterConfig, LandmarkEntry,
     LandmarkTable, ProcessNoisePsd, Sighting, Vec15, nav_pose,
 };
 use nalgebra::{SVector, Vector2, Vector3};
@@ -95,14 +95,14 @@ pub(crate) fn online_config(scenario: &Scenario, mode: Mode) -> InsSdFilterConfi
         gate_probability: f.gate_probability,
         estimator: {
             let ms = |projection| {
-                Estimator::MohamedSchwarz(AdaptiveQConfig {
+                ErrorStateEstimator::MohamedSchwarz(AdaptiveQConfig {
                     window: f.akf_window,
                     projection,
                     min_variance: f.akf_min_variance,
                 })
             };
             let sh = |projection| {
-                Estimator::SageHusa(SageHusaConfig {
+                ErrorStateEstimator::SageHusa(SageHusaConfig {
                     forgetting: f.sage_husa_forgetting,
                     warmup: f.akf_window,
                     projection,
@@ -110,8 +110,8 @@ pub(crate) fn online_config(scenario: &Scenario, mode: Mode) -> InsSdFilterConfi
                 })
             };
             match mode {
-                Mode::Standalone => Estimator::StandAlone,
-                Mode::Kf => Estimator::Kalman,
+                Mode::Standalone => ErrorStateEstimator::StandAlone,
+                Mode::Kf => ErrorStateEstimator::Kalman,
                 Mode::Akf => match f.akf_scheme {
                     AkfScheme::MohamedSchwarz => ms(f.akf_projection),
                     AkfScheme::SageHusa => sh(f.akf_projection),

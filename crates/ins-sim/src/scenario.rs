@@ -171,10 +171,10 @@ impl Scenario {
         for mode in [Mode::Kf, Mode::Akf, Mode::AkfSageHusa, Mode::AkfStructured] {
             let config = engine::online_config(self, mode);
             let estimator = match &config.estimator {
-                ins_sd_filter::Estimator::MohamedSchwarz(c) => {
+                ins_sd_filter::ErrorStateEstimator::MohamedSchwarz(c) => {
                     c.validate(akf::DEFAULT_WINDOW_CAPACITY)
                 }
-                ins_sd_filter::Estimator::SageHusa(c) => c.validate(),
+                ins_sd_filter::ErrorStateEstimator::SageHusa(c) => c.validate(),
                 _ => Ok(()),
             };
             if let Err(akf::AkfError::InvalidParameter { field, reason }) = estimator {

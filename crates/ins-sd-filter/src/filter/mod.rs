@@ -7,7 +7,7 @@ use nalgebra::{Matrix2, Rotation3, SMatrix, SVector, Vector2, Vector3};
 use sighting_model::{Landmark, NavPose, PaperAlphaReading};
 
 use crate::FilterError;
-use crate::config::{Estimator, InsSdFilterConfig, MeasurementJacobian};
+use crate::config::{ErrorStateEstimator, InsSdFilterConfig, MeasurementJacobian};
 use crate::interval::IntervalModel;
 use crate::landmarks::LandmarkTable;
 
@@ -223,8 +223,10 @@ impl InsSdFilter {
             interval.enable_noise_basis();
         }
         let est = match config.estimator {
-            Estimator::StandAlone => None,
-            Estimator::Kalman | Estimator::MohamedSchwarz(_) | Estimator::SageHusa(_) => {
+            ErrorStateEstimator::StandAlone => None,
+            ErrorStateEstimator::Kalman
+            | ErrorStateEstimator::MohamedSchwarz(_)
+            | ErrorStateEstimator::SageHusa(_) => {
                 let mut p0 = Mat15::zeros();
                 for (b, v) in config.p0_sigma.variances().iter().enumerate() {
                     for i in 0..3 {
@@ -235,10 +237,12 @@ impl InsSdFilter {
                     .map_err(|source| FilterError::Akf { t_s: t0_s, source })?;
                 let ae = |source| FilterError::Akf { t_s: t0_s, source };
                 let adaptive = match config.estimator {
-                    Estimator::MohamedSchwarz(c) => {
+                    ErrorStateEstimator::MohamedSchwarz(c) => {
                         Adaptive::MohamedSchwarz(AdaptiveQ::new(c).map_err(ae)?)
                     }
-                    Estimator::SageHusa(c) => Adaptive::SageHusa(SageHusaQ::new(c).map_err(ae)?),
+                    ErrorStateEstimator::SageHusa(c) => {
+                        Adaptive::SageHusa(SageHusaQ::new(c).map_err(ae)?)
+                    }
                     _ => Adaptive::None,
                 };
                 Some(Box::new(Est {

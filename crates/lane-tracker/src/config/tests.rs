@@ -1,0 +1,203 @@
+use super::*;
+
+#[test]
+fn presets_parse_and_validate() {
+    let out = TrackerConfig::outdoor().unwrap();
+    let ind = TrackerConfig::indoor().unwrap();
+    assert!(ind.gradient.magnitude_threshold < out.gradient.magnitude_threshold);
+    assert_eq!(TrackerConfig::preset("outdoor").unwrap().unwrap(), out);
+}
+
+#[test]
+fn unknown_field_is_refused_naming_it() {
+    let text = OUTDOOR_TOML.replace("[track]", "[track]\nwindow_width = 3");
+    let err = TrackerConfig::from_toml_str("x.toml", &text).unwrap_err();
+    let msg = err.to_string();
+    let line = 1 + text[..text.find("window_width").unwrap()]
+        .matches('\n')
+        .count();
+    match &err {
+        TrackerError::ConfigFile(e) => {
+            assert_eq!(
+                (e.path.as_str(), e.line, e.column),
+                ("x.toml", Some(line), Some(1))
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(
+        msg.starts_with(&format!("x.toml:{line}:1: unknown field `window_width`")),
+        "{msg}"
+    );
+}
+
+#[test]
+fn missing_field_is_refused_naming_it() {
+    let text: String = OUTDOOR_TOML
+        .lines()
+        .filter(|l| !l.starts_with("r_sigma_px"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let msg = TrackerConfig::from_toml_str("x.toml", &text)
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("r_sigma_px"), "{msg}");
+}
+
+#[test]
+fn an_out_of_range_field_in_a_file_names_the_file_line_and_column() {
+    let text = OUTDOOR_TOML.replace("r_sigma_px = 2.0", "r_sigma_px = -2.0");
+    let line = 1 + text[..text.find("r_sigma_px = -2.0").unwrap()]
+        .matches('\n')
+        .count();
+    let msg = TrackerConfig::from_toml_str("cfg/bad.toml", &text)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        msg,
+        format!("cfg/bad.toml:{line}:1: `filter.r_sigma_px` = -2: must be finite and > 0 px")
+    );
+}
+
+#[test]
+fn each_out_of_range_field_is_named() {
+    type Edit = fn(&mut TrackerConfig);
+    let cases: &[(&str, Edit)] = &[
+        ("gradient.magnitude_threshold", |c| {
+            c.gradient.magnitude_threshold = 3000
+        }),
+        ("gradient.adaptive_keep_fraction", |c| {
+            c.gradient.adaptive_keep_fraction = -0.1
+        }),
+        ("gradient.min_edge_angle_deg", |c| {
+            c.gradient.min_edge_angle_deg = -1.0
+        }),
+        ("gradient.max_edge_angle_deg", |c| {
+            c.gradient.max_edge_angle_deg = 5.0
+        }),
+        ("roi.top_row_fraction", |c| c.roi.top_row_fraction = 1.0),
+        ("roi.bottom_row_fraction", |c| {
+            c.roi.bottom_row_fraction = 0.1
+        }),
+        ("init.theta_step_deg", |c| c.init.theta_step_deg = 0.0),
+        ("init.rho_step_px", |c| c.init.rho_step_px = 51.0),
+        ("init.band_half_width_px", |c| {
+            c.init.band_half_width_px = f64::INFINITY
+        }),
+        ("init.min_points", |c| c.init.min_points = 2),
+        ("init.refit_iterations", |c| c.init.refit_iterations = 11),
+        ("track.inlier_half_width_px", |c| {
+            c.track.inlier_half_width_px = 0.0
+        }),
+        ("track.window_half_width_px", |c| {
+            c.track.window_half_width_px = 0
+        }),
+        ("track.max_points_per_lane", |c| {
+            c.track.max_points_per_lane = 2
+        }),
+        ("track.reinit_min_points", |c| {
+            c.track.reinit_min_points = 2000
+        }),
+        ("track.lost_after_frames", |c| c.track.lost_after_frames = 0),
+        ("track.max_jump_px", |c| c.track.max_jump_px = -1.0),
+        ("track.min_lane_separation_px", |c| {
+            c.track.min_lane_separation_px = f64::NAN
+        }),
+        ("filter.q_sigma_px", |c| c.filter.q_sigma_px[1] = 0.0),
+        ("filter.r_sigma_px", |c| c.filter.r_sigma_px = 0.0),
+        ("filter.p0_sigma_px", |c| c.filter.p0_sigma_px[2] = f64::NAN),
+        ("filter.wrls_lambda", |c| c.filter.wrls_lambda = 1.5),
+    ];
+    for (field, edit) in cases {
+        let mut cfg = TrackerConfig::outdoor().unwrap();
+        cfg.validate().unwrap();
+        edit(&mut cfg);
+        match cfg.validate() {
+            Err(TrackerError::ConfigField { field: f, .. }) => assert_eq!(f, *field),
+            other => panic!("{field}: expected a field error, got {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn the_configuration_and_the_components_agree_on_every_stage_one_and_two_range() {
+    // A value the configuration accepts is one the tracker's components accept, and the
+    // other way round: the ranges are checked once, by the crates that use the values.
+    let values = [
+        -1.0, 0.0, 0.005, 0.01, 0.5, 5.0, 10.0, 10.5, 45.0, 50.0, 89.0, 90.0, 1e4,
+    ];
+    type Set = fn(&mut TrackerConfig, f64);
+    let fields: &[(&str, Set)] = &[
+        ("theta_step_deg", |c, v| c.init.theta_step_deg = v),
+        ("rho_step_px", |c, v| c.init.rho_step_px = v),
+        ("band_half_width_px", |c, v| c.init.band_half_width_px = v),
+        ("min_points", |c, v| c.init.min_points = v.max(0.0) as usize),
+        ("refit_iterations", |c, v| {
+            c.init.refit_iterations = v.max(0.0) as u32
+        }),
+        ("min_edge_angle_deg", |c, v| {
+            c.gradient.min_edge_angle_deg = v
+        }),
+        ("max_edge_angle_deg", |c, v| {
+            c.gradient.max_edge_angle_deg = v
+        }),
+        ("adaptive_keep_fraction", |c, v| {
+            c.gradient.adaptive_keep_fraction = v
+        }),
+    ];
+    let mut accepted = 0;
+    for (name, set) in fields {
+        for &v in &values {
+            let mut cfg = TrackerConfig::outdoor().unwrap();
+            set(&mut cfg, v);
+            let by_config = cfg.validate().is_ok();
+            let by_components = cfg.gradient.params().validate().is_ok()
+                && cfg
+                    .gradient
+                    .hough_bands()
+                    .iter()
+                    .all(|b| b.validate().is_ok())
+                && cfg.init.hough_params().validate().is_ok()
+                && cfg.init.lane_params().validate().is_ok();
+            let tracker = crate::LaneTracker::new(&cfg, crate::Estimator::Kif, 320, 240);
+            assert_eq!(by_config, by_components, "{name} = {v}");
+            assert_eq!(by_config, tracker.is_ok(), "{name} = {v}: {tracker:?}");
+            accepted += usize::from(by_config);
+        }
+    }
+    assert!(
+        accepted > 20,
+        "the sweep must cover accepted values too ({accepted})"
+    );
+}
+
+#[test]
+fn scale_pixels_scales_pixel_fields_only() {
+    let base = TrackerConfig::outdoor().unwrap();
+    let mut c = base;
+    c.scale_pixels(4.0);
+    c.validate().unwrap();
+    assert_eq!(
+        c.track.window_half_width_px,
+        4 * base.track.window_half_width_px
+    );
+    assert_eq!(c.filter.r_sigma_px, 4.0 * base.filter.r_sigma_px);
+    assert_eq!(c.filter.q_sigma_px[0], 4.0 * base.filter.q_sigma_px[0]);
+    assert_eq!(
+        c.init.band_half_width_px,
+        4.0 * base.init.band_half_width_px
+    );
+    assert_eq!(c.gradient, base.gradient);
+    assert_eq!(c.roi, base.roi);
+    assert_eq!(c.track.max_points_per_lane, base.track.max_points_per_lane);
+}
+
+#[test]
+fn roi_rows_follow_the_fractions_and_stay_inside_tiny_images() {
+    let mut cfg = TrackerConfig::outdoor().unwrap();
+    cfg.roi.top_row_fraction = 0.5;
+    cfg.roi.bottom_row_fraction = 1.0;
+    assert_eq!(cfg.roi_rows(240), (120, 240));
+    let (t, b) = cfg.roi_rows(4);
+    assert!(t < b && b <= 4 && b - t >= 3, "{t}..{b}");
+}
