@@ -167,10 +167,76 @@ pub fn luma_bt601(r: u8, g: u8, b: u8) -> u8 {
     y as u8
 }
 
+/// Anything that carries a pixel's image coordinates, in pixels: the workspace's one point type
+/// for a pixel (what the Hough transform and the parabola fit of `hough-init`, the filters of
+/// `info-filter` and `wrls` take; `vision_gradient::EdgePixel`, `hough_init::Point` and
+/// `(column, row)` tuples and arrays implement it).
+///
+/// Convention: `col_px` grows to the right, `row_px` grows downwards, the centre of the top-left
+/// pixel is `(0, 0)`. Tuples and arrays are read as **(column, row)**, i.e. `(x, y)` of the lane
+/// paper's eq. 1, *not* `(row, column)`.
+pub trait PixelPoint {
+    /// Column coordinate `x`, pixels.
+    fn col_px(&self) -> f64;
+    /// Row coordinate `y`, pixels.
+    fn row_px(&self) -> f64;
+}
+
+impl<P: PixelPoint + ?Sized> PixelPoint for &P {
+    #[inline]
+    fn col_px(&self) -> f64 {
+        (**self).col_px()
+    }
+    #[inline]
+    fn row_px(&self) -> f64 {
+        (**self).row_px()
+    }
+}
+
+macro_rules! impl_pixel_point_pair {
+    ($($t:ty),*) => {$(
+        /// `(column, row)` in pixels.
+        impl PixelPoint for ($t, $t) {
+            #[inline]
+            fn col_px(&self) -> f64 {
+                f64::from(self.0)
+            }
+            #[inline]
+            fn row_px(&self) -> f64 {
+                f64::from(self.1)
+            }
+        }
+        /// `[column, row]` in pixels.
+        impl PixelPoint for [$t; 2] {
+            #[inline]
+            fn col_px(&self) -> f64 {
+                f64::from(self[0])
+            }
+            #[inline]
+            fn row_px(&self) -> f64 {
+                f64::from(self[1])
+            }
+        }
+    )*};
+}
+
+impl_pixel_point_pair!(f32, f64, u16, u32, i32);
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    #[test]
+    fn tuples_and_arrays_are_column_then_row() {
+        fn both<P: PixelPoint>(p: P) -> (f64, f64) {
+            (p.col_px(), p.row_px())
+        }
+        assert_eq!(both((3.5f32, 7.0f32)), (3.5, 7.0));
+        assert_eq!(both([4u16, 9]), (4.0, 9.0));
+        let borrowed: &(i32, i32) = &(-2, 5);
+        assert_eq!(both(borrowed), (-2.0, 5.0));
+    }
 
     #[test]
     fn every_constructor_and_reshape_keeps_length_equal_to_width_times_height() {

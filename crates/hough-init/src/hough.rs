@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{AngleBand, EdgePoint, HoughError, HoughParams, PointSet};
+use crate::{AngleBand, HoughError, HoughParams, PixelPoint, PointSet};
 
 /// Largest accepted image side, pixels.
 pub const MAX_IMAGE_SIDE_PX: usize = 1 << 14;
@@ -224,7 +224,7 @@ impl HoughWorkspace {
     pub fn find_line<I>(&mut self, points: I, band: &AngleBand) -> Result<HoughLine, HoughError>
     where
         I: IntoIterator + Clone,
-        I::Item: EdgePoint,
+        I::Item: PixelPoint,
     {
         let (k0, k1) = self.band_bins(band)?;
         let count = self.check_points(points.clone())?;
@@ -282,7 +282,7 @@ impl HoughWorkspace {
     ) -> Result<usize, HoughError>
     where
         I: IntoIterator + Clone,
-        I::Item: EdgePoint,
+        I::Item: PixelPoint,
     {
         for (field, value) in [("sep_theta_deg", sep_theta_deg), ("sep_rho_px", sep_rho_px)] {
             if !(value.is_finite() && value >= 0.0) {
@@ -355,7 +355,7 @@ impl HoughWorkspace {
     fn check_points<I>(&self, points: I) -> Result<usize, HoughError>
     where
         I: IntoIterator,
-        I::Item: EdgePoint,
+        I::Item: PixelPoint,
     {
         let mut count = 0;
         let col_max = self.width_px as f64 - 0.5;
@@ -386,7 +386,7 @@ impl HoughWorkspace {
     fn vote<I>(&mut self, points: I, k0: usize, k1: usize)
     where
         I: IntoIterator,
-        I::Item: EdgePoint,
+        I::Item: PixelPoint,
     {
         let nr = self.rho_bins;
         let cx = self.center_col_px;

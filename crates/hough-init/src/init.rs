@@ -4,7 +4,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::parabola::fit_impl;
 use crate::{
-    AngleBand, EdgePoint, HoughError, HoughLine, HoughWorkspace, LaneInitParams, Parabola, PointSet,
+    AngleBand, HoughError, HoughLine, HoughWorkspace, LaneInitParams, Parabola, PixelPoint,
+    PointSet,
 };
 
 /// A lane initialisation: the parabola of eq. 1 fitted to the pixels near the Hough line.
@@ -45,7 +46,7 @@ pub fn init_lane<I>(
 ) -> Result<LaneInit, HoughError>
 where
     I: IntoIterator + Clone,
-    I::Item: EdgePoint,
+    I::Item: PixelPoint,
 {
     params.validate()?;
     let count = points.clone().into_iter().count();
@@ -74,7 +75,7 @@ pub fn fit_around_line<I>(
 ) -> Result<LaneInit, HoughError>
 where
     I: IntoIterator + Clone,
-    I::Item: EdgePoint,
+    I::Item: PixelPoint,
 {
     params.validate()?;
     let band_px = params.band_px;

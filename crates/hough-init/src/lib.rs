@@ -16,7 +16,7 @@
 //!
 //! Image coordinates in pixels: `x = col_px` to the right, `y = row_px` downwards, origin at
 //! the **centre of the top-left pixel**. Point inputs are any re-iterable collection
-//! (`IntoIterator + Clone`) of [`EdgePoint`] items: slices or `&Vec` of [`Point`], of
+//! (`IntoIterator + Clone`) of [`PixelPoint`] items: slices or `&Vec` of [`Point`], of
 //! `(col, row)` tuples or `[col, row]` arrays of `f32`/`f64`/`u16`/`u32`/`i32`, or a cheap
 //! iterator chain such as `pixels.iter().filter(..).map(|p| (p.col_px, p.row_px))` (no copy
 //! needed). The points are iterated several times (Hough: check + vote; each least-squares
@@ -149,8 +149,10 @@ mod point;
 
 pub use ego::{Chord, EgoChoice, EgoPairParams, choose_ego_pair};
 pub use error::{HoughError, PointSet};
+/// The workspace's one pixel point type (crate `grey-frame`), re-exported.
+pub use grey_frame::PixelPoint;
 pub use hough::{HoughLine, HoughWorkspace, MAX_ACCUMULATOR_CELLS, MAX_IMAGE_SIDE_PX};
 pub use init::{LaneInit, fit_around_line, init_lane};
 pub use parabola::{MIN_RELATIVE_PIVOT, Parabola, ParabolaFit, fit_parabola, fit_parabola_where};
 pub use params::{AngleBand, HoughParams, LaneInitParams};
-pub use point::{EdgePoint, Point};
+pub use point::Point;

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{EdgePoint, HoughError, PointSet};
+use crate::{HoughError, PixelPoint, PointSet};
 
 /// Relative pivot threshold of the 3×3 Cholesky factorisation: pivot `k` fails when, after
 /// elimination, it is `≤ MIN_RELATIVE_PIVOT ×` the diagonal entry it started from (a
@@ -90,7 +90,7 @@ pub struct ParabolaFit {
 pub fn fit_parabola<I>(points: I) -> Result<ParabolaFit, HoughError>
 where
     I: IntoIterator + Clone,
-    I::Item: EdgePoint,
+    I::Item: PixelPoint,
 {
     fit_impl(points, |_, _| true, 3, PointSet::Fit)
 }
@@ -104,7 +104,7 @@ where
 pub fn fit_parabola_where<I, F>(points: I, keep: F) -> Result<ParabolaFit, HoughError>
 where
     I: IntoIterator + Clone,
-    I::Item: EdgePoint,
+    I::Item: PixelPoint,
     F: Fn(f64, f64) -> bool,
 {
     fit_impl(points, keep, 3, PointSet::Fit)
@@ -120,7 +120,7 @@ pub(crate) fn fit_impl<I, F>(
 ) -> Result<ParabolaFit, HoughError>
 where
     I: IntoIterator + Clone,
-    I::Item: EdgePoint,
+    I::Item: PixelPoint,
     F: Fn(f64, f64) -> bool,
 {
     let min_points = min_points.max(3);

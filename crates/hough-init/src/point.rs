@@ -1,18 +1,8 @@
-//! Edge-pixel coordinates accepted by the Hough transform and the parabola fit.
+//! The crate's own point type; every pixel point type of the workspace implements
+//! [`grey_frame::PixelPoint`], which the Hough transform and the parabola fit take.
 
+use grey_frame::PixelPoint;
 use serde::{Deserialize, Serialize};
-
-/// Anything that carries an edge pixel's image coordinates, in pixels.
-///
-/// Convention (whole crate): `col_px` grows to the right, `row_px` grows downwards, the centre of
-/// the top-left pixel is `(0, 0)`. Tuples and arrays are read as **(column, row)**, i.e. `(x, y)`
-/// of eq. 1, *not* `(row, column)`.
-pub trait EdgePoint {
-    /// Column coordinate `x`, pixels.
-    fn col_px(&self) -> f64;
-    /// Row coordinate `y`, pixels.
-    fn row_px(&self) -> f64;
-}
 
 /// The crate's own edge-pixel type: a point in image coordinates, pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -32,7 +22,7 @@ impl Point {
     }
 }
 
-impl EdgePoint for Point {
+impl PixelPoint for Point {
     #[inline]
     fn col_px(&self) -> f64 {
         self.col_px
@@ -42,43 +32,3 @@ impl EdgePoint for Point {
         self.row_px
     }
 }
-
-impl<P: EdgePoint + ?Sized> EdgePoint for &P {
-    #[inline]
-    fn col_px(&self) -> f64 {
-        (**self).col_px()
-    }
-    #[inline]
-    fn row_px(&self) -> f64 {
-        (**self).row_px()
-    }
-}
-
-macro_rules! impl_edge_point_pair {
-    ($($t:ty),*) => {$(
-        /// `(column, row)` in pixels.
-        impl EdgePoint for ($t, $t) {
-            #[inline]
-            fn col_px(&self) -> f64 {
-                f64::from(self.0)
-            }
-            #[inline]
-            fn row_px(&self) -> f64 {
-                f64::from(self.1)
-            }
-        }
-        /// `[column, row]` in pixels.
-        impl EdgePoint for [$t; 2] {
-            #[inline]
-            fn col_px(&self) -> f64 {
-                f64::from(self[0])
-            }
-            #[inline]
-            fn row_px(&self) -> f64 {
-                f64::from(self[1])
-            }
-        }
-    )*};
-}
-
-impl_edge_point_pair!(f32, f64, u16, u32, i32);

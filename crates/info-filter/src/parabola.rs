@@ -7,62 +7,8 @@ use crate::KifError;
 use crate::chol::check_finite_vec;
 use crate::generic::{InformationFilter, ProcessNoise, TimeUpdateForm};
 use crate::rownorm::{RowNorm, ThetaCov};
-
-/// A measured pixel: column `x` and row `y`, in pixels (the paper's `x = f(y)` convention).
-pub trait PixelPoint {
-    /// Column coordinate `x`, pixels.
-    fn col_px(&self) -> f64;
-    /// Row coordinate `y`, pixels.
-    fn row_px(&self) -> f64;
-}
-
-/// `(col_px, row_px)`.
-impl PixelPoint for (f32, f32) {
-    #[inline]
-    fn col_px(&self) -> f64 {
-        f64::from(self.0)
-    }
-    #[inline]
-    fn row_px(&self) -> f64 {
-        f64::from(self.1)
-    }
-}
-
-/// `(col_px, row_px)`.
-impl PixelPoint for (f64, f64) {
-    #[inline]
-    fn col_px(&self) -> f64 {
-        self.0
-    }
-    #[inline]
-    fn row_px(&self) -> f64 {
-        self.1
-    }
-}
-
-/// `[col_px, row_px]`.
-impl PixelPoint for [f32; 2] {
-    #[inline]
-    fn col_px(&self) -> f64 {
-        f64::from(self[0])
-    }
-    #[inline]
-    fn row_px(&self) -> f64 {
-        f64::from(self[1])
-    }
-}
-
-/// `[col_px, row_px]`.
-impl PixelPoint for [f64; 2] {
-    #[inline]
-    fn col_px(&self) -> f64 {
-        self[0]
-    }
-    #[inline]
-    fn row_px(&self) -> f64 {
-        self[1]
-    }
-}
+/// The workspace's one pixel point type (crate `grey-frame`), re-exported.
+pub use grey_frame::PixelPoint;
 
 /// Power sums of one frame's points in the normalised row coordinate `u`:
 /// `Σu⁰ … Σu⁴` and `Σx·u⁰ … Σx·u²`. With `R = σ²I`,

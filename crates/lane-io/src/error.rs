@@ -131,16 +131,36 @@ pub enum LaneIoError {
         /// Bytes present.
         got: usize,
     },
-    /// One frame of a sequence is unusable (corrupt image, zero size, size differing from the
-    /// sequence). Not fatal: it is reported, counted and skipped.
-    #[error("{name}: frame {frame}: skipped: {reason}")]
+    /// One frame of a sequence is unusable (unreadable, corrupt, zero size). Not fatal: it is
+    /// reported, counted and skipped; `source` is what reading it gave.
+    #[error("{name}: frame {frame}: skipped: {}", frame_reason(source))]
     BadFrame {
         /// File of the frame.
         name: String,
         /// Zero-based index of the frame in the sequence.
         frame: u64,
-        /// Why it is unusable.
-        reason: String,
+        /// Why it is unusable: the error reading or decoding it gave.
+        source: Box<LaneIoError>,
+    },
+    /// One frame of an image directory has another size than the sequence's first frame. Not
+    /// fatal: it is reported, counted and skipped.
+    #[error(
+        "{name}: frame {frame}: skipped: frame size {got_w}×{got_h} differs from the sequence's \
+         {want_w}×{want_h}"
+    )]
+    FrameSizeDiffers {
+        /// File of the frame.
+        name: String,
+        /// Zero-based index of the frame in the sequence.
+        frame: u64,
+        /// Its width, px.
+        got_w: usize,
+        /// Its height, px.
+        got_h: usize,
+        /// The sequence's width, px.
+        want_w: usize,
+        /// The sequence's height, px.
+        want_h: usize,
     },
     /// Live capture was requested but this build has none.
     #[error(
@@ -230,6 +250,7 @@ impl LaneIoError {
     pub fn is_fatal(&self) -> bool {
         match self {
             LaneIoError::BadFrame { .. }
+            | LaneIoError::FrameSizeDiffers { .. }
             | LaneIoError::ShortFrame { .. }
             | LaneIoError::Y4mResync { .. } => false,
             LaneIoError::CaptureTimeout {
@@ -240,11 +261,13 @@ impl LaneIoError {
     }
 
     /// Frames of the input this error stands for, lost (not delivered): 1 for
-    /// [`LaneIoError::BadFrame`] and [`LaneIoError::ShortFrame`], `lost_frames` for
+    /// [`LaneIoError::BadFrame`], [`LaneIoError::FrameSizeDiffers`] and [`LaneIoError::ShortFrame`], `lost_frames` for
     /// [`LaneIoError::Y4mResync`], 0 for everything else.
     pub fn lost_frames(&self) -> u64 {
         match self {
-            LaneIoError::BadFrame { .. } | LaneIoError::ShortFrame { .. } => 1,
+            LaneIoError::BadFrame { .. }
+            | LaneIoError::FrameSizeDiffers { .. }
+            | LaneIoError::ShortFrame { .. } => 1,
             LaneIoError::Y4mResync { lost_frames, .. } => *lost_frames,
             _ => 0,
         }
@@ -265,5 +288,15 @@ impl LaneIoError {
             path: path.into(),
             source,
         }
+    }
+}
+
+/// The reason a [`LaneIoError::BadFrame`] prints: what reading the frame gave, without repeating
+/// the file name the message already starts with.
+fn frame_reason(source: &LaneIoError) -> String {
+    match source {
+        LaneIoError::Io { source, .. } => source.to_string(),
+        LaneIoError::ImageDecode { source, .. } => format!("cannot decode image: {source}"),
+        other => other.to_string(),
     }
 }

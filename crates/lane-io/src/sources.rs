@@ -111,8 +111,9 @@ impl FrameSource for StillImage {
 /// Opening fails ([`LaneIoError::NotAnImage`]) if the directory holds a regular file without an
 /// image extension (hidden files, starting with `.`, and sub-directories are ignored), and
 /// ([`LaneIoError::EmptyDirectory`]) if it holds no image. While reading, an image that cannot be
-/// decoded, or whose size differs from the first frame's, is a non-fatal
-/// [`LaneIoError::BadFrame`]: reported, counted and skipped.
+/// decoded is a non-fatal [`LaneIoError::BadFrame`] (holding the decoding error), one whose size
+/// differs from the first frame's a non-fatal [`LaneIoError::FrameSizeDiffers`]: reported,
+/// counted and skipped.
 #[derive(Debug)]
 pub struct ImageDirectory {
     dir: PathBuf,
@@ -175,27 +176,26 @@ impl FrameSource for ImageDirectory {
         };
         let index = self.next as u64;
         self.next += 1;
-        let bad = |reason: String| LaneIoError::BadFrame {
-            name: path.display().to_string(),
-            frame: index,
-            reason,
-        };
-        match decode_image_file(path, &mut self.scratch) {
-            Ok(()) => {}
-            Err(LaneIoError::Io { source, .. }) => return Err(bad(source.to_string())),
-            Err(LaneIoError::ImageDecode { source, .. }) => {
-                return Err(bad(format!("cannot decode image: {source}")));
-            }
-            Err(e) => return Err(bad(e.to_string())),
+        let name = || path.display().to_string();
+        if let Err(e) = decode_image_file(path, &mut self.scratch) {
+            return Err(LaneIoError::BadFrame {
+                name: name(),
+                frame: index,
+                source: Box::new(e),
+            });
         }
         let size = (self.scratch.width(), self.scratch.height());
         match self.size {
             None => self.size = Some(size),
             Some(first) if first != size => {
-                return Err(bad(format!(
-                    "frame size {}×{} differs from the sequence's {}×{}",
-                    size.0, size.1, first.0, first.1
-                )));
+                return Err(LaneIoError::FrameSizeDiffers {
+                    name: name(),
+                    frame: index,
+                    got_w: size.0,
+                    got_h: size.1,
+                    want_w: first.0,
+                    want_h: first.1,
+                });
             }
             Some(_) => {}
         }

@@ -121,7 +121,8 @@ proptest! {
                 Err(e) => {
                     prop_assert!(!e.is_fatal(), "{}", e);
                     match &e {
-                        LaneIoError::BadFrame { name, frame, .. } => {
+                        LaneIoError::BadFrame { name, frame, .. }
+                        | LaneIoError::FrameSizeDiffers { name, frame, .. } => {
                             prop_assert!(name.ends_with(&format!("f{frame:02}.png")), "{}", e);
                             bad.push(*frame);
                         }

@@ -24,6 +24,17 @@ pub struct EdgePixel {
     pub class: EdgeClass,
 }
 
+impl grey_frame::PixelPoint for EdgePixel {
+    #[inline]
+    fn col_px(&self) -> f64 {
+        f64::from(self.col_px)
+    }
+    #[inline]
+    fn row_px(&self) -> f64 {
+        f64::from(self.row_px)
+    }
+}
+
 /// Caller-owned output list with a fixed capacity: allocated once, cleared and refilled by
 /// every call, never grown. Pixels past the capacity are counted in [`EdgeBuffer::dropped`].
 ///
@@ -128,4 +139,25 @@ pub struct EdgeStats {
     pub stored: usize,
     /// Kept pixels that did not fit in the [`EdgeBuffer`].
     pub dropped: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use grey_frame::PixelPoint;
+
+    use super::{EdgeClass, EdgePixel};
+
+    #[test]
+    fn an_edge_pixel_is_the_workspaces_pixel_point() {
+        let p = EdgePixel {
+            col_px: 17,
+            row_px: 203,
+            magnitude: 90,
+            class: EdgeClass::RightLane,
+        };
+        assert_eq!((p.col_px(), p.row_px()), (17.0, 203.0));
+        // Taken as is where a point set is expected (a slice of edge pixels).
+        let mean_col = [p, p].iter().map(PixelPoint::col_px).sum::<f64>() / 2.0;
+        assert_eq!(mean_col, 17.0);
+    }
 }
