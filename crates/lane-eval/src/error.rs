@@ -34,10 +34,32 @@ pub enum EvalError {
         /// What it is, relative to the data root.
         what: String,
     },
+    /// A `labels.json` is not valid JSON or does not match the schema; serde_json locates it.
+    #[error("{path}:{line}:{column}: bad lane labels: {}", json_reason(source))]
+    LabelsJson {
+        /// The label file.
+        path: String,
+        /// Line of the error, 1-based.
+        line: usize,
+        /// Column of the error, 1-based.
+        column: usize,
+        /// What serde_json said.
+        source: serde_json::Error,
+    },
     /// A frame source or a frame file failed (crate `lane-io`).
     #[error(transparent)]
     Source(#[from] lane_io::LaneIoError),
     /// The tracker refused its configuration or a frame (crate `lane-tracker`).
     #[error(transparent)]
     Tracker(#[from] lane_tracker::TrackerError),
+}
+
+/// serde_json's message without its own " at line L column C" (the message names them once, in
+/// the `file:line:column` prefix).
+fn json_reason(e: &serde_json::Error) -> String {
+    let msg = e.to_string();
+    match msg.rfind(" at line ") {
+        Some(i) => msg[..i].to_owned(),
+        None => msg,
+    }
 }

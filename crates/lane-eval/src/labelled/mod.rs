@@ -135,10 +135,11 @@ impl LabelSet {
             path: name.to_owned(),
             reason,
         };
-        let set: LabelSet = serde_json::from_str(text).map_err(|e| EvalError::Labels {
-            // serde_json locates syntax and schema errors: name the line and column once.
-            path: format!("{name}:{}:{}", e.line(), e.column()),
-            reason: strip_location(&e.to_string()),
+        let set: LabelSet = serde_json::from_str(text).map_err(|source| EvalError::LabelsJson {
+            path: name.to_owned(),
+            line: source.line(),
+            column: source.column(),
+            source,
         })?;
         if set.schema != LABEL_SCHEMA {
             return Err(bad(format!(
@@ -204,14 +205,6 @@ impl LabelSet {
     /// Number of consecutive labelled frames in the longest clip.
     pub fn longest_clip(&self) -> usize {
         self.clips().iter().map(|c| c.len()).max().unwrap_or(0)
-    }
-}
-
-/// serde_json's message without its trailing " at line L column C" (the location goes in the path).
-fn strip_location(msg: &str) -> String {
-    match msg.rfind(" at line ") {
-        Some(i) => msg[..i].to_owned(),
-        None => msg.to_owned(),
     }
 }
 
