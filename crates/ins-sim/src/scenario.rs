@@ -7,7 +7,10 @@ use ins_errors::config::{ImuConfig, TrajectoryConfig};
 use ins_errors::trajectory::Trajectory;
 use sighting_model::{SightingConfig, SightingError};
 
-use super::*;
+use crate::config::{
+    self, AkfScheme, MeasurementJacobian, MismatchConfig, MonteCarloConfig, ScenarioFilterConfig,
+};
+use crate::{Mode, SimError, engine};
 
 /// A complete scenario: the sections of `configs/paper.toml`.
 #[derive(Clone, Debug, PartialEq)]

@@ -36,23 +36,6 @@
 //! the logs reproduces that solution to round-off (`tests/ins_sd_replay.rs`: the IMU samples go
 //! through Δv/Δt once more).
 
-use std::fs::File;
-use std::io::{BufRead, BufReader, BufWriter, Write};
-use std::path::{Path, PathBuf};
-
-use ins_errors::earth::Geodetic;
-use ins_errors::error_model;
-use ins_errors::strapdown::NavState;
-use ins_sd_filter::{
-    FilterError, InsSdFilter, InsSdFilterConfig, LandmarkEntry, LandmarkTable, Sighting,
-};
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use serde::{Deserialize, Serialize};
-use toml_config::TomlDoc;
-
-use super::engine::{self, RunObserver};
-use super::{Mode, Sample, Scenario, SimError, SimRunOutcome};
-
 /// Header of the IMU log.
 pub const IMU_HEADER: &str =
     "t_s,dv_x_mps,dv_y_mps,dv_z_mps,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad";

@@ -1,7 +1,19 @@
 //! Reading the logs: the CSV reader (header check, located errors), the landmark table and the
 //! initial state (TOML), and the truth and solution files.
 
-use super::*;
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+
+use ins_errors::earth::Geodetic;
+use ins_errors::strapdown::NavState;
+use ins_sd_filter::{FilterError, LandmarkEntry, LandmarkTable};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+use toml_config::TomlDoc;
+
+use super::{SOLUTION_HEADER, TRUTH_HEADER};
+use crate::SimError;
 
 pub(super) fn io_err(path: &Path) -> impl Fn(std::io::Error) -> SimError + '_ {
     move |source| SimError::LogIo {

@@ -1,7 +1,18 @@
 //! Replaying logs through the online filter ([`replay`]) and comparing a solution with the truth
 //! ([`compare_with_truth`]).
 
-use super::*;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use ins_errors::error_model;
+use ins_errors::strapdown::NavState;
+use ins_sd_filter::{InsSdFilter, InsSdFilterConfig, Sighting};
+use nalgebra::Vector3;
+
+use super::read::{CsvReader, Record, io_err, read_initial, read_landmarks, read_truth};
+use super::write::write_solution;
+use super::{IMU_HEADER, SIGHTINGS_HEADER, SOLUTION_HEADER};
+use crate::SimError;
 
 /// The log files and filter settings of a replay.
 #[derive(Clone, Debug)]

@@ -1,7 +1,18 @@
 //! Writing the logs: navigation and solution rows, and the export of a simulated run
 //! ([`export_run`]) through a [`RunObserver`] that records what the closed loop sees.
 
-use super::*;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use ins_errors::strapdown::NavState;
+use ins_sd_filter::{InsSdFilter, Sighting};
+use nalgebra::Vector3;
+
+use super::read::{InitialState, LandmarkFile, io_err};
+use super::{IMU_HEADER, SIGHTINGS_HEADER, SOLUTION_HEADER, TRUTH_HEADER, names};
+use crate::engine::{self, RunObserver};
+use crate::{Mode, Sample, Scenario, SimError, SimRunOutcome};
 
 pub(super) fn write_nav<W: Write + ?Sized>(
     w: &mut W,
