@@ -45,11 +45,12 @@ enum Cmd {
     Fixtures(fixtures::FixturesArgs),
     /// Run the lane tracker over every fixture and compare with the recorded expectations.
     Regress(regress::RegressArgs),
-    /// Score the lane tracker on the real labelled sets (fixtures/real/), beside the presets and
-    /// the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
+    /// Score the lane tracker on the real labelled sets (--data, default ../shared/data/lanes),
+    /// beside the ceiling, the presets and the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
     EvalLanes(eval_lanes::EvalLanesArgs),
-    /// Check that nav-app's lane half builds alone and pulls in no INS,
-    /// V4L2 or CLI crate, and that ins-sim builds without rayon or plotters.
+    /// Check the crate boundaries: lane-tracker pulls in no image codec, V4L2, CLI, Monte Carlo or
+    /// INS crate; lane-io and lane-eval no INS, V4L2, CLI or Monte Carlo crate; ins-sim neither
+    /// rayon nor plotters.
     Halves,
     /// Build the `ita_nav` Python wheel into target/py-venv and run its pytest suite.
     Python(python::PythonArgs),

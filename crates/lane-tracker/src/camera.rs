@@ -47,7 +47,7 @@ use crate::{LaneTracker, Side, TrackReport, TrackerError};
 
 /// The robot preset (`configs/camera-robot.toml`).
 pub const CAMERA_ROBOT_TOML: &str = include_str!("../../../configs/camera-robot.toml");
-/// The highway preset for the bundled udacity clip (`configs/camera-highway.toml`).
+/// The highway preset for the real udacity clip (`../shared/data/udacity`) (`configs/camera-highway.toml`).
 pub const CAMERA_HIGHWAY_TOML: &str = include_str!("../../../configs/camera-highway.toml");
 
 /// `[intrinsics]`.

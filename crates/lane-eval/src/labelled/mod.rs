@@ -1,4 +1,5 @@
-//! Real labelled frames (`fixtures/real/<set>/labels.json`, schema 1) and the standard lane
+//! Real labelled frames (`<data root>/lanes/<set>/labels.json`, schema 1, documented in
+//! `fixtures/real/README.md`; the data itself stays outside the repository) and the standard lane
 //! scoring rules, ego lanes only.
 //!
 //! ## The label format
