@@ -116,7 +116,7 @@ const STEPS: &[Step] = &[
         run: Run::Cargo(&["test", "-p", "nav-app", "--no-default-features"]),
     },
     Step {
-        // nav-app's lane and INS halves build alone; the lane half has no INS/V4L2/CLI crate.
+        // The crate boundaries: lane-tracker, lane-io, lane-eval and ins-sim pull in nothing they must not.
         name: "halves",
         run: Run::Xtask(&["halves"]),
     },
