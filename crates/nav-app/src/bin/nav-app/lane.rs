@@ -68,8 +68,8 @@ enum EstimatorArg {
 )]
 struct Args {
     /// Image (PNG/JPEG/PGM), directory of images, .y4m file, or `-` for a YUV4MPEG2 stream on stdin
-    /// [default, with neither --input nor --device: the bundled 30-frame sample, udacity
-    /// solidWhiteRight, MIT].
+    /// [default, with neither --input nor --device: a rendered sample, the project's own scene
+    /// curve_left_dashed, 24 frames].
     #[arg(long, value_name = "PATH", conflicts_with = "device")]
     input: Option<PathBuf>,
     /// Capture device (e.g. /dev/video0).

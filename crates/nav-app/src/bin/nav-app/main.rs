@@ -9,8 +9,9 @@
 //!         [--camera robot|highway|FILE.toml [--birdseye DIR]]
 //!         [--input-name NAME | --input-index N] [--std ntsc|pal|…] [--size WxH] [--max-timeouts N]
 //! ```
-//! With neither `--input` nor `--device` it runs on the bundled 30-frame sample (real highway
-//! video, udacity/CarND-LaneLines-P1, MIT). `--input -` reads a YUV4MPEG2 stream on stdin.
+//! With neither `--input` nor `--device` it runs on a rendered sample (the project's own
+//! deterministic scene `curve_left_dashed`, `lane_eval::synth`). `--input -` reads a YUV4MPEG2
+//! stream on stdin.
 //!
 //! ## Live capture (`--device`, feature `capture`)
 //! `--device /dev/video0 --input-name S-Video --std ntsc --size 320x240` streams grey frames from
