@@ -1,4 +1,4 @@
-"""Track the bundled real highway frames and print both lanes' bottom-row columns.
+"""Track the real udacity highway frames (from the data root, ../shared/data) and print both lanes' bottom-row columns.
 
     python crates/ita-nav-py/examples/track_clip.py [CLIP.y4m]
 """

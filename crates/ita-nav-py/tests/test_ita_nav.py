@@ -1,4 +1,4 @@
-"""The Python package against the Rust binary, on the bundled sample; and its error cases.
+"""The Python package against the Rust binary, on the real udacity clip (from the data root) and a rendered curve; and its error cases.
 
 Run by `cargo xtask test` (step `python`), which builds the wheel into target/py-venv and sets
 NAV_APP_BIN to the nav-app binary of the same checkout. By hand:

@@ -222,7 +222,7 @@ struct SummaryJson<'a> {
 
 #[derive(Serialize)]
 struct SummaryBody<'a> {
-    /// The `--input` (file, directory, `stdin` or the bundled sample); absent with `--device`.
+    /// The `--input` (file, directory, `stdin` or the rendered sample); absent with `--device`.
     #[serde(skip_serializing_if = "Option::is_none")]
     input: Option<String>,
     /// With `--device`: the device setup (`null` when it could not be opened).
