@@ -45,6 +45,9 @@
 //! # Ok::<(), toml_config::TomlError>(())
 //! ```
 
+#[cfg(feature = "proptest")]
+pub mod mutate;
+
 use serde::de::DeserializeOwned;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
