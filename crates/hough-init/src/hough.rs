@@ -226,41 +226,9 @@ impl HoughWorkspace {
         I: IntoIterator + Clone,
         I::Item: PixelPoint,
     {
-        let (k0, k1) = self.band_bins(band)?;
-        let count = self.check_points(points.clone())?;
-        if count > u32::MAX as usize {
-            return Err(HoughError::TooManyPoints {
-                found: count,
-                limit: u32::MAX as usize,
-            });
-        }
-        if count < 2 {
-            return Err(HoughError::TooFewPoints {
-                set: PointSet::Candidates,
-                found: count,
-                required: 2,
-            });
-        }
-        self.vote(points, k0, k1);
-        let (k, r) = if self.params.peak_smoothing {
-            self.peak_smoothed(k0, k1)
-        } else {
-            self.peak_raw(k0, k1)
-        };
-        let (dk, dr) = if self.params.subbin_refinement {
-            self.refine(k, r, k0, k1)
-        } else {
-            (0.0, 0.0)
-        };
-        let theta_rad = self.theta_deg_of_bin(k as f64 + dk).to_radians();
-        let rho_c_px = (r as f64 + dr - self.rho_zero_bin as f64) * self.params.rho_step_px;
-        let (s, c) = theta_rad.sin_cos();
-        let rho_px = rho_c_px + self.center_col_px * c + self.center_row_px * s;
-        Ok(HoughLine {
-            rho_px,
-            theta_rad,
-            votes: self.acc[k * self.rho_bins + r],
-        })
+        let (k0, k1) = self.vote_checked(points, band)?;
+        let (k, r) = self.peak(k0, k1);
+        Ok(self.refined_line(k, r, k0, k1))
     }
 
     /// The `out.len()` strongest, mutually separated lines of `points` in `band` (an addition
@@ -293,6 +261,33 @@ impl HoughWorkspace {
                 });
             }
         }
+        let (k0, k1) = self.vote_checked(points, band)?;
+        let dk = (sep_theta_deg / self.params.theta_step_deg).round() as usize;
+        let dr = (sep_rho_px / self.params.rho_step_px).round() as usize;
+        let nr = self.rho_bins;
+        let mut n = 0;
+        for slot in out.iter_mut() {
+            let (k, r) = self.peak(k0, k1);
+            if self.score(k, r, k0, k1) <= 0.0 {
+                break;
+            }
+            *slot = self.refined_line(k, r, k0, k1);
+            n += 1;
+            for kk in k.saturating_sub(dk).max(k0)..=(k + dk).min(k1) {
+                let lo = kk * nr + r.saturating_sub(dr);
+                let hi = kk * nr + (r + dr).min(nr - 1);
+                self.acc[lo..=hi].fill(0);
+            }
+        }
+        Ok(n)
+    }
+
+    /// Check the band and the points, then vote; returns the band's θ bins `(k0, k1)`.
+    fn vote_checked<I>(&mut self, points: I, band: &AngleBand) -> Result<(usize, usize), HoughError>
+    where
+        I: IntoIterator + Clone,
+        I::Item: PixelPoint,
+    {
         let (k0, k1) = self.band_bins(band)?;
         let count = self.check_points(points.clone())?;
         if count > u32::MAX as usize {
@@ -309,34 +304,30 @@ impl HoughWorkspace {
             });
         }
         self.vote(points, k0, k1);
-        let dk = (sep_theta_deg / self.params.theta_step_deg).round() as usize;
-        let dr = (sep_rho_px / self.params.rho_step_px).round() as usize;
-        let nr = self.rho_bins;
-        let mut n = 0;
-        for slot in out.iter_mut() {
-            let (k, r) = if self.params.peak_smoothing {
-                self.peak_smoothed(k0, k1)
-            } else {
-                self.peak_raw(k0, k1)
-            };
-            let votes = self.acc[k * nr + r];
-            if self.score(k, r, k0, k1) <= 0.0 {
-                break;
-            }
-            let (ek, er) = if self.params.subbin_refinement {
-                self.refine(k, r, k0, k1)
-            } else {
-                (0.0, 0.0)
-            };
-            *slot = self.line_of(k as f64 + ek, r as f64 + er, votes);
-            n += 1;
-            for kk in k.saturating_sub(dk).max(k0)..=(k + dk).min(k1) {
-                let lo = kk * nr + r.saturating_sub(dr);
-                let hi = kk * nr + (r + dr).min(nr - 1);
-                self.acc[lo..=hi].fill(0);
-            }
+        Ok((k0, k1))
+    }
+
+    /// The accumulator's peak cell in θ bins `k0..=k1` (raw or 3×3-smoothed votes).
+    fn peak(&mut self, k0: usize, k1: usize) -> (usize, usize) {
+        if self.params.peak_smoothing {
+            self.peak_smoothed(k0, k1)
+        } else {
+            self.peak_raw(k0, k1)
         }
-        Ok(n)
+    }
+
+    /// The line of peak cell `(k, r)`, sub-bin refined when `subbin_refinement` is on.
+    fn refined_line(&self, k: usize, r: usize, k0: usize, k1: usize) -> HoughLine {
+        let (dk, dr) = if self.params.subbin_refinement {
+            self.refine(k, r, k0, k1)
+        } else {
+            (0.0, 0.0)
+        };
+        self.line_of(
+            k as f64 + dk,
+            r as f64 + dr,
+            self.acc[k * self.rho_bins + r],
+        )
     }
 
     /// The line of (fractional) bin `(k, r)`, top-left origin.
