@@ -30,10 +30,12 @@ use crate::paths::workspace_root;
 /// Arguments of `cargo xtask eval-lanes`.
 #[derive(clap::Args, Debug)]
 pub struct EvalLanesArgs {
-    /// Data root of labelled sets (one sub-directory per set with a `labels.json`); relative
-    /// paths are taken from the workspace root. Third-party data, never in the repository.
-    #[arg(long = "data", alias = "sets", default_value = "../shared/data/lanes")]
-    data: PathBuf,
+    /// Directory of labelled sets (one sub-directory per set with a `labels.json`); relative
+    /// paths are taken from the workspace root. Default: `lanes/` under the data root
+    /// (`$ITA_NAV_DATA`, else `../shared/data`; `lane_eval::data`). Third-party data, never in
+    /// the repository.
+    #[arg(long = "data", alias = "sets")]
+    data: Option<PathBuf>,
     /// Configurations scored beside the default: preset names or TOML files.
     #[arg(long = "config", default_values_t = ["outdoor".to_owned(), "indoor".to_owned()])]
     configs: Vec<String>,
@@ -245,12 +247,15 @@ fn run_peer(root: &Path, set_dir: &Path, out: &Path) -> Result<Option<Vec<(u64, 
 /// Run `cargo xtask eval-lanes`.
 pub fn run(args: EvalLanesArgs) -> Result<()> {
     let root = workspace_root();
-    let sets_dir = resolve(&root, &args.data);
+    let sets_dir = match &args.data {
+        Some(dir) => resolve(&root, dir),
+        None => lane_eval::data::data_root().join(lane_eval::data::LANE_SETS),
+    };
     if !sets_dir.is_dir() {
         bail!(
             "{}: missing the labelled lane sets (third-party evaluation data, not in the \
-             repository): put the shared data root beside the checkout as ../shared/data, or \
-             pass --data DIR",
+             repository): put the shared data root beside the checkout as ../shared/data, name it \
+             with ITA_NAV_DATA, or pass --data DIR",
             sets_dir.display()
         );
     }
