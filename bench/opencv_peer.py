@@ -10,10 +10,10 @@ nav-app: `nav-app --input CLIP --json` reports `track_us` (wall time of LaneTrac
 frame; median over the same frames.
 
 Setup (once):  python3 -m venv target/opencv-venv && target/opencv-venv/bin/pip install "opencv-python-headless<5"
-Run:           cargo build --release -p nav-app && target/opencv-venv/bin/python bench/opencv_peer.py [CLIP.y4m]
+Run:           cargo build --release -p nav-app --no-default-features && target/opencv-venv/bin/python bench/opencv_peer.py [CLIP.y4m]
 
-Accuracy mode (`cargo xtask eval-lanes` runs it when the venv exists):
-               bench/opencv_peer.py --predict-set fixtures/real/SET --out PRED.json
+Accuracy mode (`cargo xtask eval-lanes` runs it, in the venv it makes on first use):
+               bench/opencv_peer.py --predict-set ../shared/data/lanes/SET --out PRED.json
 writes, for every frame of the labelled set in order, the peer's ego lanes as
 `{"frames": [{"index": i, "lanes": [[a1, a2, a3] | null, [a1, a2, a3] | null]}]}` (left, right;
 x = a1*y^2 + a2*y + a3 in the frame's pixels), which the xtask scores with the same rules as nav-app.
