@@ -134,6 +134,7 @@ pub use config::{
 pub use error::FilterError;
 pub use filter::{
     FilterStatistics, InsSdFilter, MAX_ANGULAR_RATE_RADPS, MAX_BATCH, MAX_SPECIFIC_FORCE_MPS2,
-    Sighting, UpdateReport, Vec15, nav_pose,
+    PointedSighting, Sighting, UpdateReport, Vec15, nav_pose,
 };
 pub use landmarks::{LandmarkEntry, LandmarkTable};
+pub use sighting_model::LosFrame;

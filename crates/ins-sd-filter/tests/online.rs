@@ -11,7 +11,8 @@ use ins_errors::strapdown::NavState;
 use ins_errors::trajectory::Trajectory;
 use ins_sd_filter::{
     ErrorSigmas, ErrorStateEstimator, FilterError, InsSdFilter, InsSdFilterConfig, LandmarkEntry,
-    LandmarkTable, MeasurementJacobian, ProcessNoisePsd, Sighting, nav_pose,
+    LandmarkTable, LosFrame, MeasurementJacobian, PointedSighting, ProcessNoisePsd, Sighting,
+    nav_pose,
 };
 use nalgebra::Vector3;
 use rand::SeedableRng;
@@ -79,6 +80,18 @@ fn fly(
     seconds: usize,
     tamper: &dyn Fn(usize, &mut Vec<Sighting>),
 ) -> (InsSdFilter, NavState) {
+    fly_with(cfg, n, seconds, tamper, false)
+}
+
+/// As [`fly`]; with `pointed`, each epoch's offsets are sent as body directions
+/// (`los_from_offsets` at the filter's pointing pose) through `update_pointed`.
+fn fly_with(
+    cfg: InsSdFilterConfig,
+    n: usize,
+    seconds: usize,
+    tamper: &dyn Fn(usize, &mut Vec<Sighting>),
+    pointed: bool,
+) -> (InsSdFilter, NavState) {
     let mut tc = TrajectoryConfig::paper();
     tc.end_time_s = seconds as f64;
     // The first segments (straight, then a right turn), cut at `seconds`.
@@ -134,7 +147,25 @@ fn fly(
                 });
             }
             tamper(k / 100, &mut sightings);
-            let report = filter.update(t, &sightings).unwrap();
+            let report = if pointed {
+                let pose = filter.pointing_pose();
+                let directions: Vec<PointedSighting> = sightings
+                    .iter()
+                    .map(|s| PointedSighting {
+                        landmark_id: s.landmark_id,
+                        frame: LosFrame::Body,
+                        los: sighting_model::los_from_offsets(
+                            &pose,
+                            filter.landmarks().get(s.landmark_id).unwrap(),
+                            &nalgebra::Vector2::new(s.w_m, s.h_m),
+                        )
+                        .unwrap(),
+                    })
+                    .collect();
+                filter.update_pointed(t, &directions).unwrap()
+            } else {
+                filter.update(t, &sightings).unwrap()
+            };
             assert_eq!(report.used + report.rejected, sightings.len());
         }
     }
@@ -547,4 +578,57 @@ fn an_imu_gap_or_an_implausible_sample_is_refused_and_changes_nothing() {
     ));
     assert_eq!(f.time_s(), t);
     assert_eq!(*f.ins().state(), before);
+}
+
+#[test]
+fn body_directions_made_from_the_offsets_give_the_same_estimate() {
+    let cfg = config(ErrorStateEstimator::Kalman, Some(0.9999));
+    let (offsets, _) = fly_with(cfg, 3, 30, &|_, _| {}, false);
+    let (pointed, _) = fly_with(cfg, 3, 30, &|_, _| {}, true);
+    assert_eq!(offsets.statistics(), pointed.statistics());
+    let (a, b) = (offsets.navigation_solution(), pointed.navigation_solution());
+    let e = ins_errors::error_model::error_state(&a, &b);
+    assert!(e.fixed_rows::<3>(0).norm() < 1e-6, "{e}");
+    let (pa, pb) = (offsets.covariance().unwrap(), pointed.covariance().unwrap());
+    assert!((pa - pb).norm() < 1e-9 * pa.norm(), "{}", (pa - pb).norm());
+}
+
+#[test]
+fn a_direction_pointing_away_from_its_landmark_is_refused_before_anything_changes() {
+    let cfg = config(ErrorStateEstimator::Kalman, None);
+    let (mut filter, _) = fly(cfg, 3, 2, &|_, _| {});
+    let before = filter.clone();
+    let pose = filter.pointing_pose();
+    let lm = *filter.landmarks().get(10).unwrap();
+    let towards = sighting_model::los_from_truth(
+        &pose,
+        &lm,
+        LosFrame::LocalLevel,
+        &nalgebra::Vector2::zeros(),
+    )
+    .unwrap();
+    let t = filter.time_s();
+    let bad = [
+        PointedSighting {
+            landmark_id: 10,
+            frame: LosFrame::LocalLevel,
+            los: towards,
+        },
+        PointedSighting {
+            landmark_id: 11,
+            frame: LosFrame::LocalLevel,
+            los: -towards * 5.0,
+        },
+    ];
+    // Landmark 11 is elsewhere, but −towards points away from every landmark here.
+    let e = filter.update_pointed(t, &bad).unwrap_err();
+    assert!(
+        matches!(e, FilterError::Sighting { landmark: 11, .. }),
+        "{e}"
+    );
+    assert_eq!(filter.statistics(), before.statistics());
+    assert_eq!(filter.covariance(), before.covariance());
+    // A local-level direction with the offsets of the truth is used.
+    let report = filter.update_pointed(t, &bad[..1]).unwrap();
+    assert_eq!(report.used, 1);
 }

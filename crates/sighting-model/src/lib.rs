@@ -13,6 +13,9 @@
 //!   central finite differences of the nonlinear model (`tests/jacobian_fd.rs`);
 //! * the paper's H **as printed** (eqs. 15–18 read literally, for comparison runs only):
 //!   [`paper_printed_jacobian`], [`paper_printed_jacobian3`], [`paper_printed_blocks`];
+//! * sightings that carry their pointing (a measured direction in body or local-level axes, so
+//!   that any filter state predicts them): [`offsets_from_los`], [`los_from_offsets`],
+//!   [`los_from_truth`], [`jacobian_for_frame`] (module `pointed`);
 //! * the `[sighting]` configuration section [`SightingConfig`] and geometry checks.
 //!
 //! # Frames and conventions (shared contract with `ins-errors`)
@@ -189,6 +192,7 @@ mod error;
 mod jacobian;
 mod model;
 mod paper_printed;
+mod pointed;
 
 pub use config::{LandmarkConfig, SightingConfig};
 pub use error::SightingError;
@@ -204,4 +208,7 @@ pub use model::{
 pub use paper_printed::{
     PaperAlphaReading, PaperPrintedBlocks, paper_eq15_jacobian, paper_eq15_jacobian3,
     paper_printed_blocks, paper_printed_jacobian, paper_printed_jacobian3,
+};
+pub use pointed::{
+    LosFrame, jacobian_for_frame, los_from_offsets, los_from_truth, offsets_from_los,
 };

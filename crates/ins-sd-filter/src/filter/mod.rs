@@ -4,7 +4,7 @@ use akf::{AdaptiveQ, KalmanFilter, QProjection, SageHusaQ};
 use ins_errors::error_model::Mat15;
 use ins_errors::strapdown::{NavState, Strapdown};
 use nalgebra::{Matrix2, Rotation3, SMatrix, SVector, Vector2, Vector3};
-use sighting_model::{Landmark, NavPose, PaperAlphaReading};
+use sighting_model::{Landmark, LosFrame, NavPose, PaperAlphaReading};
 
 use crate::FilterError;
 use crate::config::{ErrorStateEstimator, InsSdFilterConfig, MeasurementJacobian};
@@ -40,6 +40,81 @@ pub struct Sighting {
     pub w_m: f64,
     /// Offset along the image's vertical axis (down), m at the landmark.
     pub h_m: f64,
+}
+
+/// One sighting that carries its pointing: the direction in which the device saw the landmark,
+/// resolved in body or local-level axes (`sighting_model::pointed`). Any filter predicts it from
+/// its own state ([`InsSdFilter::update_pointed`]), whoever recorded it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointedSighting {
+    /// Id in the [`LandmarkTable`].
+    pub landmark_id: u32,
+    /// The frame `los` is resolved in.
+    pub frame: LosFrame,
+    /// Measured line of sight to the landmark (any length > 0).
+    pub los: Vector3<f64>,
+}
+
+/// The sightings of one epoch, as the paper's offsets or as pointed directions.
+#[derive(Clone, Copy)]
+enum Epoch<'a> {
+    Offsets(&'a [Sighting]),
+    Pointed(&'a [PointedSighting]),
+}
+
+impl Epoch<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Epoch::Offsets(s) => s.len(),
+            Epoch::Pointed(s) => s.len(),
+        }
+    }
+
+    /// Sighting `i` as (landmark id, offsets z, frame of H), checked.
+    fn get(
+        &self,
+        i: usize,
+        t_s: f64,
+        landmarks: &LandmarkTable,
+        pose: &NavPose,
+    ) -> Result<(u32, Vector2<f64>, LosFrame), FilterError> {
+        let id = match self {
+            Epoch::Offsets(s) => s[i].landmark_id,
+            Epoch::Pointed(s) => s[i].landmark_id,
+        };
+        let Some(lm) = landmarks.get(id) else {
+            return Err(FilterError::UnknownLandmark { t_s, id });
+        };
+        match self {
+            Epoch::Offsets(s) => {
+                let s = &s[i];
+                if !(s.w_m.is_finite() && s.h_m.is_finite()) {
+                    return Err(FilterError::NonFiniteInput {
+                        what: "sighting w/h",
+                        t_s,
+                    });
+                }
+                Ok((id, Vector2::new(s.w_m, s.h_m), LosFrame::Body))
+            }
+            Epoch::Pointed(s) => {
+                let s = &s[i];
+                if !s.los.iter().all(|v| v.is_finite()) {
+                    return Err(FilterError::NonFiniteInput {
+                        what: "sighting direction",
+                        t_s,
+                    });
+                }
+                let z = sighting_model::offsets_from_los(pose, lm, s.frame, &s.los).map_err(
+                    |source| FilterError::Sighting {
+                        t_s,
+                        landmark: id,
+                        source,
+                    },
+                )?;
+                Ok((id, z, s.frame))
+            }
+        }
+    }
 }
 
 /// What one [`InsSdFilter::update`] did.
@@ -414,6 +489,31 @@ impl InsSdFilter {
         t_s: f64,
         sightings: &[Sighting],
     ) -> Result<UpdateReport, FilterError> {
+        self.update_epoch(t_s, Epoch::Offsets(sightings))
+    }
+
+    /// As [`InsSdFilter::update`] with sightings that carry their pointing: each direction is
+    /// turned into the offsets a camera pointed with this filter's INS would have seen
+    /// (`sighting_model::offsets_from_los`), and linearised with H of its frame (ψ columns zero
+    /// for local-level directions, `sighting_model::jacobian_for_frame`). Allocation-free.
+    ///
+    /// # Errors
+    /// As [`InsSdFilter::update`]; also [`FilterError::Sighting`] (checked before anything
+    /// changes) for a direction that points away from its landmark as seen from the INS, and
+    /// [`FilterError::NonFiniteInput`] for a NaN/∞ direction.
+    pub fn update_pointed(
+        &mut self,
+        t_s: f64,
+        sightings: &[PointedSighting],
+    ) -> Result<UpdateReport, FilterError> {
+        self.update_epoch(t_s, Epoch::Pointed(sightings))
+    }
+
+    fn update_epoch(
+        &mut self,
+        t_s: f64,
+        sightings: Epoch<'_>,
+    ) -> Result<UpdateReport, FilterError> {
         if !t_s.is_finite() {
             return Err(FilterError::NonFiniteInput {
                 what: "time stamp",
@@ -435,22 +535,12 @@ impl InsSdFilter {
                 tolerance_s: tol,
             });
         }
-        for s in sightings {
-            if self.landmarks.get(s.landmark_id).is_none() {
-                return Err(FilterError::UnknownLandmark {
-                    t_s,
-                    id: s.landmark_id,
-                });
-            }
-            if !(s.w_m.is_finite() && s.h_m.is_finite()) {
-                return Err(FilterError::NonFiniteInput {
-                    what: "sighting w/h",
-                    t_s,
-                });
-            }
+        let pose = nav_pose(self.ins.state());
+        for i in 0..sightings.len() {
+            sightings.get(i, t_s, &self.landmarks, &pose)?;
         }
         let mut report = UpdateReport::default();
-        if sightings.is_empty() {
+        if sightings.len() == 0 {
             return Ok(report);
         }
         self.last_epoch_s = t_s;
@@ -487,18 +577,22 @@ impl InsSdFilter {
         let mut n = 0usize;
         let mut nis_sum = 0.0;
         let mut any_used = false;
-        for s in sightings {
-            let Some(lm) = self.landmarks.get(s.landmark_id) else {
+        for i in 0..sightings.len() {
+            let (id, z, frame) = sightings.get(i, t_s, &self.landmarks, &pose)?;
+            let Some(lm) = self.landmarks.get(id) else {
                 continue; // checked above
             };
-            let h = jacobian(self.config.jacobian, &pos, lm).map_err(|source| {
+            let mut h = jacobian(self.config.jacobian, &pos, lm).map_err(|source| {
                 FilterError::Sighting {
                     t_s,
-                    landmark: s.landmark_id,
+                    landmark: id,
                     source,
                 }
             })?;
-            let z = Vector2::new(s.w_m, s.h_m);
+            if frame == LosFrame::LocalLevel {
+                h.fixed_view_mut::<2, 3>(0, sighting_model::PSI_COL)
+                    .fill(0.0);
+            }
             if let Some(threshold) = self.gate_threshold {
                 let nu = z - h * x_prior;
                 let s2: Matrix2<f64> = h * p_prior * h.transpose() + Matrix2::identity() * r;
