@@ -135,6 +135,14 @@ pub enum SimError {
         #[source]
         error: toml_config::TomlError,
     },
+    /// The settings of a filter file make a filter configuration the filter refuses
+    /// ([`crate::filter_file::FilterFile::filter_config`]).
+    #[error("filter file: {source}")]
+    FilterFileConfig {
+        /// The filter's error.
+        #[source]
+        source: ins_sd_filter::FilterError,
+    },
     /// The filter rejected the record of this line of a log.
     #[error("{}:{line}: {source}", path.display())]
     LogFilter {

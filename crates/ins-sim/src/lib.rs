@@ -217,6 +217,7 @@
 mod config;
 mod engine;
 mod error;
+pub mod filter_file;
 pub mod logs;
 mod mismatch;
 pub mod runs;
