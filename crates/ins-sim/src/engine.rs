@@ -33,6 +33,8 @@ pub trait RunObserver {
         _ang_rate_body_radps: &Vector3<f64>,
     ) {
     }
+    /// Just before a sighting epoch's update: the filter as it points the device.
+    fn before_epoch(&mut self, _filter: &InsSdFilter) {}
     /// A sighting epoch: the sightings handed to the filter and the filter after its update.
     fn epoch(&mut self, _t_s: f64, _sightings: &[Sighting], _filter: &InsSdFilter) {}
     /// The truth at a 1 Hz record time (t = 0, 1, …).
@@ -446,6 +448,7 @@ pub(crate) fn run_observed<O: RunObserver>(
         }
         let truth = nav_state(&s);
         if update_due {
+            obs.before_epoch(&lp.filter);
             last_nis = Some(lp.sd_update(t_s, &truth)?);
             obs.epoch(t_s, &lp.sightings, &lp.filter);
         }

@@ -135,6 +135,14 @@ pub enum SimError {
         #[source]
         error: toml_config::TomlError,
     },
+    /// A replay needs the reference trajectory at a time it does not cover.
+    #[error("reference trajectory at t = {t_s} s: {what}")]
+    ReferenceSpan {
+        /// The time asked for, s.
+        t_s: f64,
+        /// What was needed.
+        what: &'static str,
+    },
     /// The settings of a filter file make a filter configuration the filter refuses
     /// ([`crate::filter_file::FilterFile::filter_config`]).
     #[error("filter file: {source}")]

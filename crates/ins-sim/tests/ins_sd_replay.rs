@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use ins_errors::error_model;
 use ins_sim::SimError;
-use ins_sim::logs::{self, ReplayInputs, names};
+use ins_sim::logs::{self, ReplayInputs, SolutionRate, names};
 use ins_sim::{Mode, Scenario, run_seed};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -23,10 +23,12 @@ fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
     let sc = Scenario::from_toml_str(&text).unwrap();
     ReplayInputs {
         imu: dir.join(names::IMU),
-        sightings: dir.join(names::SIGHTINGS),
-        landmarks: dir.join(names::LANDMARKS),
-        initial: dir.join(names::INITIAL),
+        sightings: Some((dir.join(names::SIGHTINGS), dir.join(names::LANDMARKS))),
+        initial: logs::read_initial(&dir.join(names::INITIAL)).unwrap(),
         config: sc.online_filter_config(mode),
+        max_gap_s: 1.0,
+        rate: SolutionRate::Epochs,
+        reference: None,
     }
 }
 
@@ -66,9 +68,11 @@ fn replay_of_an_export_reproduces_the_run() {
             mode.name()
         );
         // Round-off: the IMU samples go through Δv = f·T_s and back Δv/T_s, the quaternion
-        // through its text form (measured: 0 m and ≤ 4e-18 rad).
-        assert!(dp < 1e-9, "position differs by {dp} m");
-        assert!(dpsi < 1e-15, "attitude differs by {dpsi} rad");
+        // through its text form, and each sighting through a body direction and back
+        // (sighting_model::los_from_offsets, offsets_from_los; measured: ≈ 1e-9 m, 1e-14 rad,
+        // against errors of metres and milliradians).
+        assert!(dp < 1e-7, "position differs by {dp} m");
+        assert!(dpsi < 1e-12, "attitude differs by {dpsi} rad");
         // With --truth: the errors of the replayed solution are the Monte Carlo's records (in
         // feedback x̂ = 0 after each reset, so the navigation output is the INS itself).
         let c = logs::compare_with_truth(&dir.join(names::TRUTH), &summary.solution).unwrap();
@@ -187,17 +191,18 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     );
 
     // A sighting of a landmark that is not in the table: the filter's error, with the line.
-    let s_text = std::fs::read_to_string(&inp.sightings).unwrap();
+    let (s_path, lm_path) = inp.sightings.clone().unwrap();
+    let s_text = std::fs::read_to_string(&s_path).unwrap();
     let mut s_lines: Vec<String> = s_text.lines().map(str::to_string).collect();
     let row4 = s_lines[4].clone();
     let f: Vec<&str> = row4.split(',').collect();
-    s_lines[4] = format!("{},{},{},{}", f[0], 7, f[2], f[3]);
+    s_lines[4] = format!("{},{},{}", f[0], 7, f[2..].join(","));
     let path = dir.join("sightings_bad.csv");
     std::fs::write(&path, s_lines.join("\n")).unwrap();
     match replay_to(
         &dir,
         &ReplayInputs {
-            sightings: path.clone(),
+            sightings: Some((path.clone(), lm_path.clone())),
             ..inp.clone()
         },
     ) {
@@ -218,13 +223,13 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     }
 
     // A non-integer landmark id is a parse error at its column.
-    s_lines[4] = format!("{},{},{},{}", f[0], "x1", f[2], f[3]);
+    s_lines[4] = format!("{},{},{}", f[0], "x1", f[2..].join(","));
     std::fs::write(&path, s_lines.join("\n")).unwrap();
     expect_parse(
         replay_to(
             &dir,
             &ReplayInputs {
-                sightings: path.clone(),
+                sightings: Some((path.clone(), lm_path.clone())),
                 ..inp.clone()
             },
         ),
@@ -235,12 +240,12 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
 
     // The landmark table: an unknown key, reported with its TOML line.
     let path = dir.join("landmarks_bad.toml");
-    let lm = std::fs::read_to_string(&inp.landmarks).unwrap();
+    let lm = std::fs::read_to_string(&lm_path).unwrap();
     std::fs::write(&path, lm.replacen("alt_m", "height_m", 1)).unwrap();
     match replay_to(
         &dir,
         &ReplayInputs {
-            landmarks: path.clone(),
+            sightings: Some((s_path.clone(), path.clone())),
             ..inp.clone()
         },
     ) {

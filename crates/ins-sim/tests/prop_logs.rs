@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use ins_sim::SimError;
-use ins_sim::logs::{self, InitialState, ReplayInputs, names};
+use ins_sim::logs::{self, InitialState, ReplayInputs, SolutionRate, names};
 use ins_sim::{Mode, Scenario};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
@@ -180,29 +180,36 @@ fn check_located(e: &SimError, inputs: &[PathBuf]) -> Result<(), TestCaseError> 
 fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Result<(), SimError>) {
     let (dir, sc) = exported();
     std::fs::create_dir_all(case_dir).unwrap();
-    let mut inputs = ReplayInputs {
-        imu: dir.join(names::IMU),
-        sightings: dir.join(names::SIGHTINGS),
-        landmarks: dir.join(names::LANDMARKS),
-        initial: dir.join(names::INITIAL),
-        config: sc.online_filter_config(Mode::Kf),
-    };
+    let mut files = [
+        dir.join(names::IMU),
+        dir.join(names::SIGHTINGS),
+        dir.join(names::LANDMARKS),
+        dir.join(names::INITIAL),
+    ];
     let path = case_dir.join(which);
     std::fs::write(&path, bytes).unwrap();
     match which {
-        names::IMU => inputs.imu = path,
-        names::SIGHTINGS => inputs.sightings = path,
-        names::LANDMARKS => inputs.landmarks = path,
-        _ => inputs.initial = path,
+        names::IMU => files[0] = path,
+        names::SIGHTINGS => files[1] = path,
+        names::LANDMARKS => files[2] = path,
+        _ => files[3] = path,
     }
     let out = case_dir.join("solution.csv");
     let mut w = std::io::BufWriter::new(std::fs::File::create(&out).unwrap());
-    let read = vec![
-        inputs.imu.clone(),
-        inputs.sightings.clone(),
-        inputs.landmarks.clone(),
-        inputs.initial.clone(),
-    ];
+    let read = files.to_vec();
+    let initial = match logs::read_initial(&files[3]) {
+        Ok(i) => i,
+        Err(e) => return (read, Err(e)),
+    };
+    let inputs = ReplayInputs {
+        imu: files[0].clone(),
+        sightings: Some((files[1].clone(), files[2].clone())),
+        initial,
+        config: sc.online_filter_config(Mode::Kf),
+        max_gap_s: 1.0,
+        rate: SolutionRate::Epochs,
+        reference: None,
+    };
     (read, logs::replay(&inputs, &mut w, &out).map(|_| ()))
 }
 

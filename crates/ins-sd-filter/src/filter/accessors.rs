@@ -52,12 +52,21 @@ impl InsSdFilter {
     }
 
     /// (x̂, P) predicted from the last sighting epoch to the INS time with the a-priori model
-    /// (or Q̂): what the next update starts from. `None` without an estimator.
+    /// (or the adaptive Q̂, scaled to the fraction of the update interval elapsed): what the
+    /// next update starts from, and the σ a solution at the INS time is reported with. `None`
+    /// without an estimator.
     pub fn predicted(&self) -> Option<(Vec15, Mat15)> {
         let est = self.est.as_deref()?;
+        if self.interval.steps_done() == 0 {
+            // Nothing propagated since the epoch: x̂ and P as updated.
+            return Some((*est.kf.state(), *est.kf.covariance()));
+        }
         let (phi, q_model) = self.interval.peek();
-        // (Structured: the last fitted Σ q̂_k B_k, an approximation for a partial interval.)
-        let q = est.q_estimate().copied().unwrap_or(q_model);
+        // The adaptive Q̂ is for one whole update interval: scaled to the part elapsed
+        // (structured: the last fitted Σ q̂_k B_k, likewise).
+        let elapsed =
+            (self.interval.steps_done() as f64 / self.config.steps_per_update() as f64).min(1.0);
+        let q = est.q_estimate().map_or(q_model, |q_hat| q_hat * elapsed);
         let x = phi * est.kf.state();
         let mut p = phi * est.kf.covariance() * phi.transpose() + q;
         p = 0.5 * (p + p.transpose());

@@ -41,11 +41,20 @@ pub const IMU_HEADER: &str =
     "t_s,dv_x_mps,dv_y_mps,dv_z_mps,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad";
 /// Header of the sightings log.
 pub const SIGHTINGS_HEADER: &str = "t_s,landmark_id,w_m,h_m";
+/// Header of an IMU log of rates: angular rate (rad/s) and specific force (m/s²) in body FRD,
+/// each row the mean over (previous t, t] (what most IMUs write; the data sets' `imu.csv`).
+pub const IMU_RATES_HEADER: &str =
+    "t_s,gyro_x_radps,gyro_y_radps,gyro_z_radps,accel_x_mps2,accel_y_mps2,accel_z_mps2";
+/// Header of the sightings log with pointing (format 2): the measured line of sight to the
+/// landmark, `frame` `body` (FRD) or `ned` (local level), any length > 0.
+pub const POINTED_SIGHTINGS_HEADER: &str = "t_s,landmark_id,frame,los_x,los_y,los_z";
+/// Header of a reference trajectory in degrees, attitude optional (the data sets' `truth.csv`).
+pub const REFERENCE_DEG_HEADER: &str = "t_s,lat_deg,lon_deg,alt_m,vn_mps,ve_mps,vd_mps,qw,qx,qy,qz";
 /// Header of the truth log (and the first columns of the solution).
 pub const TRUTH_HEADER: &str =
     "t_s,lat_rad,lon_rad,alt_m,vel_n_mps,vel_e_mps,vel_d_mps,q_w,q_x,q_y,q_z";
 /// Header of the solution written by the replay and by the export.
-pub const SOLUTION_HEADER: &str = "t_s,lat_rad,lon_rad,alt_m,vel_n_mps,vel_e_mps,vel_d_mps,q_w,q_x,q_y,q_z,sigma_n_m,sigma_e_m,sigma_d_m,nis,used,rejected";
+pub const SOLUTION_HEADER: &str = "t_s,lat_rad,lon_rad,alt_m,vel_n_mps,vel_e_mps,vel_d_mps,q_w,q_x,q_y,q_z,sigma_n_m,sigma_e_m,sigma_d_m,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,sigma_psi_n_rad,sigma_psi_e_rad,sigma_psi_d_rad,nis,used,rejected";
 
 /// File names [`export_run`] writes in its directory.
 pub mod names {
@@ -66,9 +75,13 @@ pub mod names {
 }
 
 mod read;
+mod reference;
 mod replay;
+mod sightings;
 mod write;
 
 pub use read::*;
+pub use reference::*;
 pub use replay::*;
+pub use sightings::*;
 pub use write::*;

@@ -38,6 +38,55 @@ pub(super) struct CsvReader {
 }
 
 impl CsvReader {
+    /// Opens a file whose header is one of `headers`; returns the reader and the index of the
+    /// header found. The error for another header lists the accepted ones.
+    pub(super) fn open_any(path: &Path, headers: &[&str]) -> Result<(Self, usize), SimError> {
+        let file = File::open(path).map_err(io_err(path))?;
+        let mut r = Self {
+            path: path.to_path_buf(),
+            lines: BufReader::new(file).lines(),
+            line: 0,
+            fields: 0,
+        };
+        let accepted = headers
+            .iter()
+            .map(|h| format!("`{h}`"))
+            .collect::<Vec<_>>()
+            .join(" or ");
+        let Some(first) = r.next_raw()? else {
+            return Err(r.parse_err(1, 1, format!("empty file, expected the header {accepted}")));
+        };
+        let got: Vec<&str> = first.text.split(',').map(str::trim).collect();
+        for (i, h) in headers.iter().enumerate() {
+            if got.iter().copied().eq(h.split(',')) {
+                r.fields = h.split(',').count();
+                return Ok((r, i));
+            }
+        }
+        // Name the first field that differs from the closest accepted header.
+        let common = |h: &str| {
+            got.iter()
+                .zip(h.split(','))
+                .take_while(|(a, b)| *a == b)
+                .count()
+        };
+        let closest = headers
+            .iter()
+            .copied()
+            .max_by_key(|h| common(h))
+            .unwrap_or("");
+        let k = common(closest);
+        let column = first.starts.get(k).map_or(first.text.len(), |s| *s) + 1;
+        let message = match (got.get(k), closest.split(',').nth(k)) {
+            (Some(g), Some(want)) => {
+                format!("header field `{g}`, expected `{want}` (header {accepted})")
+            }
+            (None, Some(want)) => format!("header ends before `{want}` (header {accepted})"),
+            _ => format!("header has extra fields (header {accepted})"),
+        };
+        Err(r.parse_err(first.line, column, message))
+    }
+
     pub(super) fn open(path: &Path, header: &str) -> Result<Self, SimError> {
         let file = File::open(path).map_err(io_err(path))?;
         let mut r = Self {
@@ -308,7 +357,7 @@ pub fn read_solution(path: &Path) -> Result<Vec<(f64, NavState)>, SimError> {
     let mut out = Vec::new();
     while let Some(rec) = r.next()? {
         out.push(read_nav(&r, &rec)?);
-        r.opt_f64(&rec, 14, "nis")?;
+        r.opt_f64(&rec, 20, "nis")?;
     }
     Ok(out)
 }

@@ -1,32 +1,124 @@
-//! Replaying logs through the online filter ([`replay`]) and comparing a solution with the truth
+//! Replaying logs through the online filter ([`replay`]), with the errors against a reference
+//! trajectory computed on the way ([`ReplayMetrics`]), and comparing a solution with the truth
 //! ([`compare_with_truth`]).
+//!
+//! ## Time
+//!
+//! IMU time stamps are used as logged (any rate, any jitter). A sighting epoch at t is applied
+//! at t exactly: the IMU sample that spans t is cut there (its mean rates held on both sides), so
+//! a sighting is never applied late. A sample more than [`GAP_FACTOR`] nominal steps after the
+//! previous one is a **gap**: it is bridged by propagating its mean rates in nominal steps (the
+//! covariance grows with the model's Q over the gap), counted and reported, and refused only
+//! when longer than `max_gap_s`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use ins_errors::error_model;
 use ins_errors::strapdown::NavState;
-use ins_sd_filter::{InsSdFilter, InsSdFilterConfig, Sighting};
-use nalgebra::Vector3;
+use ins_sd_filter::{InsSdFilter, InsSdFilterConfig, PointedSighting, Sighting, UpdateReport};
+use nalgebra::{SMatrix, Vector3};
 
-use super::read::{CsvReader, Record, io_err, read_initial, read_landmarks, read_truth};
+use super::read::{CsvReader, InitialState, Record, io_err, read_landmarks, read_truth};
+use super::reference::{ReferenceRow, interpolate};
 use super::write::write_solution;
-use super::{IMU_HEADER, SIGHTINGS_HEADER, SOLUTION_HEADER};
+use super::{
+    IMU_HEADER, IMU_RATES_HEADER, POINTED_SIGHTINGS_HEADER, SIGHTINGS_HEADER, SOLUTION_HEADER,
+};
 use crate::SimError;
 
-/// The log files and filter settings of a replay.
+/// A sample later than this many nominal IMU steps after the previous one is a gap.
+pub const GAP_FACTOR: f64 = 2.0;
+
+/// When the replay writes a solution row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SolutionRate {
+    /// After every sighting epoch only.
+    Epochs,
+    /// After every IMU sample (and at every epoch).
+    EveryImu,
+    /// At this rate, Hz (the first IMU time at or after each multiple of 1/rate).
+    Hz(f64),
+}
+
+/// The inputs and settings of a replay.
 #[derive(Clone, Debug)]
 pub struct ReplayInputs {
-    /// IMU log.
+    /// IMU log (increments or rates, declared by its header).
     pub imu: PathBuf,
-    /// Sightings log.
-    pub sightings: PathBuf,
-    /// Landmark table.
-    pub landmarks: PathBuf,
-    /// Initial state.
-    pub initial: PathBuf,
+    /// Sightings log (offsets, format 1, or pointed, format 2) and its landmark table; `None`:
+    /// unaided.
+    pub sightings: Option<(PathBuf, PathBuf)>,
+    /// Initial state; IMU samples and sightings at or before its time are skipped.
+    pub initial: InitialState,
     /// Filter settings.
     pub config: InsSdFilterConfig,
+    /// The longest IMU gap bridged, s.
+    pub max_gap_s: f64,
+    /// When solution rows are written.
+    pub rate: SolutionRate,
+    /// Reference trajectory for [`ReplayMetrics`].
+    pub reference: Option<Vec<ReferenceRow>>,
+}
+
+/// Error statistics of one 3-vector quantity (position m, velocity m/s, attitude rad).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ErrorStats {
+    /// RMS of the 3-D error norm.
+    pub rms: f64,
+    /// Largest 3-D error norm.
+    pub max: f64,
+    /// 3-D error norm at the last compared time.
+    pub last: f64,
+    /// RMS per axis (N, E, D).
+    pub rms_axis: [f64; 3],
+    /// Fraction of (time, axis) pairs with |error| ≤ 2σ.
+    pub inside_2sigma: f64,
+}
+
+/// One compared time: error (solution − reference: δp NED m, δv NED m/s, ψ rad; ψ NaN without
+/// a reference attitude) and the filter's 1σ of each.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorSample {
+    /// Time, s.
+    pub t_s: f64,
+    /// Errors.
+    pub error: [f64; 9],
+    /// 1σ (NaN without an estimator).
+    pub sigma: [f64; 9],
+}
+
+/// Errors of a replayed solution against a reference, and the filter's consistency.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ReplayMetrics {
+    /// Compared times (reference rows inside the replay).
+    pub compared: usize,
+    /// First and last compared time, s.
+    pub span_s: [f64; 2],
+    /// Position error, m.
+    pub position_m: ErrorStats,
+    /// Velocity error, m/s.
+    pub velocity_mps: ErrorStats,
+    /// Attitude error ψ, rad (`None` without reference attitude).
+    pub attitude_rad: Option<ErrorStats>,
+    /// Mean NEES per degree of freedom over the compared times (position and velocity, and
+    /// attitude when the reference has it); 1 for a consistent filter.
+    pub nees_per_dof: Option<f64>,
+    /// Degrees of freedom of one NEES (6 or 9).
+    pub nees_dof: usize,
+    /// Two-sided 95 % χ² band of the mean NEES per dof if the compared times were independent
+    /// (they are not: consecutive errors are correlated, so this band is only a guide).
+    pub nees_band_95: Option<[f64; 2]>,
+    /// Mean NIS per degree of freedom over the sighting epochs (Σ NIS / Σ 2·used).
+    pub nis_per_dof: Option<f64>,
+    /// Degrees of freedom summed over the epochs.
+    pub nis_dof: u64,
+    /// Two-sided 95 % χ² band of the mean NIS per dof (epochs' innovations are independent for a
+    /// consistent filter).
+    pub nis_band_95: Option<[f64; 2]>,
+    /// The compared times (for plots; not serialised).
+    #[serde(skip)]
+    pub series: Vec<ErrorSample>,
 }
 
 /// What a replay did.
@@ -34,118 +126,516 @@ pub struct ReplayInputs {
 pub struct ReplaySummary {
     /// IMU samples propagated.
     pub imu_samples: u64,
+    /// IMU samples at or before the initial time, skipped.
+    pub imu_skipped: u64,
     /// Sighting epochs applied.
     pub epochs: u64,
     /// Sightings used.
     pub sightings_used: u64,
     /// Sightings rejected by the gate.
     pub sightings_rejected: u64,
-    /// The solution after each epoch (as written).
+    /// Sightings at or before the initial time, skipped.
+    pub sightings_skipped: u64,
+    /// True when the sightings were offsets (format 1): meaningful only to the filter that
+    /// pointed the device.
+    pub offset_sightings: bool,
+    /// IMU gaps bridged.
+    pub gaps: u64,
+    /// The longest gap, s.
+    pub longest_gap_s: f64,
+    /// Time of the last IMU sample, s.
+    pub end_t_s: f64,
+    /// The solution after each epoch.
     pub solution: Vec<(f64, NavState)>,
+    /// Against the reference, when one was given.
+    pub metrics: Option<ReplayMetrics>,
 }
 
-/// Replays logs through the online filter, writing the solution CSV to `out`.
+/// The next sighting epoch, read ahead.
+struct SightingStream {
+    path: PathBuf,
+    reader: CsvReader,
+    pointed: bool,
+    pending: Option<Record>,
+    offsets: Vec<Sighting>,
+    directions: Vec<PointedSighting>,
+    last_epoch_s: f64,
+}
+
+impl SightingStream {
+    fn open(path: &Path) -> Result<Self, SimError> {
+        let (mut reader, which) =
+            CsvReader::open_any(path, &[SIGHTINGS_HEADER, POINTED_SIGHTINGS_HEADER])?;
+        let pending = reader.next()?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            reader,
+            pointed: which == 1,
+            pending,
+            offsets: Vec::new(),
+            directions: Vec::new(),
+            last_epoch_s: f64::NEG_INFINITY,
+        })
+    }
+
+    fn next_time(&self) -> Result<Option<f64>, SimError> {
+        match &self.pending {
+            Some(rec) => self.reader.f64(rec, 0, "t_s").map(Some),
+            None => Ok(None),
+        }
+    }
+
+    /// Reads every row of the next epoch into the buffers; returns (t, first line).
+    fn take_epoch(&mut self) -> Result<Option<(f64, usize)>, SimError> {
+        let Some(rec) = self.pending.as_ref() else {
+            return Ok(None);
+        };
+        let r = &self.reader;
+        let t = r.f64(rec, 0, "t_s")?;
+        if t < self.last_epoch_s {
+            return Err(r.parse_err(
+                rec.line,
+                1,
+                format!(
+                    "epoch t = {t} s is before the previous one ({} s)",
+                    self.last_epoch_s
+                ),
+            ));
+        }
+        self.last_epoch_s = t;
+        let first_line = rec.line;
+        self.offsets.clear();
+        self.directions.clear();
+        while let Some(rec) = self.pending.as_ref() {
+            let r = &self.reader;
+            if r.f64(rec, 0, "t_s")? != t {
+                break;
+            }
+            let landmark_id = r.u32(rec, 1, "landmark_id")?;
+            if self.pointed {
+                let name = r.field(rec, 2).trim();
+                let Some(frame) = ins_sd_filter::LosFrame::parse(name) else {
+                    return Err(r.parse_err(
+                        rec.line,
+                        rec.starts[2] + 1,
+                        format!("field `frame`: `{name}` is not body or ned"),
+                    ));
+                };
+                let los = Vector3::new(
+                    r.f64(rec, 3, "los_x")?,
+                    r.f64(rec, 4, "los_y")?,
+                    r.f64(rec, 5, "los_z")?,
+                );
+                if los.norm() == 0.0 {
+                    return Err(r.parse_err(
+                        rec.line,
+                        rec.starts[3] + 1,
+                        "the line of sight (los_x, los_y, los_z) is zero".into(),
+                    ));
+                }
+                self.directions.push(PointedSighting {
+                    landmark_id,
+                    frame,
+                    los,
+                });
+            } else {
+                self.offsets.push(Sighting {
+                    landmark_id,
+                    w_m: r.f64(rec, 2, "w_m")?,
+                    h_m: r.f64(rec, 3, "h_m")?,
+                });
+            }
+            self.pending = self.reader.next()?;
+        }
+        Ok(Some((t, first_line)))
+    }
+}
+
+/// Accumulates [`ReplayMetrics`].
+struct MetricsAcc {
+    reference: Vec<ReferenceRow>,
+    next: usize,
+    cursor: usize,
+    max_ref_gap_s: f64,
+    sum2: [[f64; 3]; 3],
+    sum2_norm: [f64; 3],
+    max: [f64; 3],
+    last: [f64; 3],
+    inside: [u64; 3],
+    sigma_count: [u64; 3],
+    nees_sum: f64,
+    nees_n: u64,
+    nis_sum: f64,
+    nis_dof: u64,
+    out: ReplayMetrics,
+}
+
+impl MetricsAcc {
+    fn new(reference: Vec<ReferenceRow>) -> Self {
+        let n = reference.len();
+        Self {
+            reference,
+            next: 0,
+            cursor: 0,
+            max_ref_gap_s: 1.0,
+            sum2: [[0.0; 3]; 3],
+            sum2_norm: [0.0; 3],
+            max: [0.0; 3],
+            last: [0.0; 3],
+            inside: [0; 3],
+            sigma_count: [0; 3],
+            nees_sum: 0.0,
+            nees_n: 0,
+            nis_sum: 0.0,
+            nis_dof: 0,
+            out: ReplayMetrics {
+                series: Vec::with_capacity(n),
+                ..Default::default()
+            },
+        }
+    }
+
+    /// Compares the filter at its time with the reference, once per reference row passed.
+    fn observe(&mut self, filter: &InsSdFilter) {
+        let t = filter.time_s();
+        let mut due = false;
+        while self.next < self.reference.len() && self.reference[self.next].t_s <= t {
+            self.next += 1;
+            due = true;
+        }
+        if !due {
+            return;
+        }
+        let Some(at) = interpolate(&self.reference, t, self.max_ref_gap_s, &mut self.cursor) else {
+            return;
+        };
+        let sol = filter.navigation_solution();
+        let has_att = at.att_b_to_n.is_some();
+        let e = error_model::error_state(&at.nav_state(sol.att_b_to_n), &sol);
+        let p = filter.predicted().map(|(_, p)| p);
+        let mut sample = ErrorSample {
+            t_s: t,
+            error: [f64::NAN; 9],
+            sigma: [f64::NAN; 9],
+        };
+        let blocks = if has_att { 3 } else { 2 };
+        for b in 0..blocks {
+            let mut norm2 = 0.0;
+            for i in 0..3 {
+                let k = 3 * b + i;
+                let v = e[k];
+                sample.error[k] = v;
+                self.sum2[b][i] += v * v;
+                norm2 += v * v;
+                if let Some(p) = &p {
+                    let s = p[(k, k)].max(0.0).sqrt();
+                    sample.sigma[k] = s;
+                    self.sigma_count[b] += 1;
+                    if v.abs() <= 2.0 * s {
+                        self.inside[b] += 1;
+                    }
+                }
+            }
+            let norm = norm2.sqrt();
+            self.sum2_norm[b] += norm2;
+            self.max[b] = self.max[b].max(norm);
+            self.last[b] = norm;
+        }
+        if let Some(p) = &p {
+            let nees = if has_att {
+                let sub: SMatrix<f64, 9, 9> = p.fixed_view::<9, 9>(0, 0).into_owned();
+                let ev: SMatrix<f64, 9, 1> = e.fixed_rows::<9>(0).into_owned();
+                sub.cholesky()
+                    .map(|c| (ev.transpose() * c.solve(&ev))[(0, 0)])
+            } else {
+                let sub: SMatrix<f64, 6, 6> = p.fixed_view::<6, 6>(0, 0).into_owned();
+                let ev: SMatrix<f64, 6, 1> = e.fixed_rows::<6>(0).into_owned();
+                sub.cholesky()
+                    .map(|c| (ev.transpose() * c.solve(&ev))[(0, 0)])
+            };
+            if let Some(n) = nees {
+                self.nees_sum += n;
+                self.nees_n += 1;
+            }
+        }
+        self.out.nees_dof = 3 * blocks;
+        if self.out.compared == 0 {
+            self.out.span_s[0] = t;
+        }
+        self.out.span_s[1] = t;
+        self.out.compared += 1;
+        self.out.series.push(sample);
+    }
+
+    fn epoch(&mut self, report: &UpdateReport) {
+        if let Some(nis) = report.nis {
+            self.nis_sum += nis;
+            self.nis_dof += 2 * report.used as u64;
+        }
+    }
+
+    fn finish(mut self) -> ReplayMetrics {
+        let n = self.out.compared.max(1) as f64;
+        let stats = |b: usize, acc: &Self| ErrorStats {
+            rms: (acc.sum2_norm[b] / n).sqrt(),
+            max: acc.max[b],
+            last: acc.last[b],
+            rms_axis: [
+                (acc.sum2[b][0] / n).sqrt(),
+                (acc.sum2[b][1] / n).sqrt(),
+                (acc.sum2[b][2] / n).sqrt(),
+            ],
+            inside_2sigma: if acc.sigma_count[b] > 0 {
+                acc.inside[b] as f64 / acc.sigma_count[b] as f64
+            } else {
+                f64::NAN
+            },
+        };
+        self.out.position_m = stats(0, &self);
+        self.out.velocity_mps = stats(1, &self);
+        self.out.attitude_rad = (self.out.nees_dof == 9).then(|| stats(2, &self));
+        let band = |dof: f64| -> Option<[f64; 2]> {
+            let lo = akf::chi_square_quantile(0.025, dof).ok()? / dof;
+            let hi = akf::chi_square_quantile(0.975, dof).ok()? / dof;
+            Some([lo, hi])
+        };
+        if self.nees_n > 0 {
+            let dof = (self.nees_n * self.out.nees_dof as u64) as f64;
+            self.out.nees_per_dof = Some(self.nees_sum / dof);
+            self.out.nees_band_95 = band(dof);
+        }
+        if self.nis_dof > 0 {
+            self.out.nis_per_dof = Some(self.nis_sum / self.nis_dof as f64);
+            self.out.nis_dof = self.nis_dof;
+            self.out.nis_band_95 = band(self.nis_dof as f64);
+        }
+        self.out
+    }
+}
+
+/// Mutable state of one replay besides the filter.
+struct Run<'a, W: Write> {
+    inputs: &'a ReplayInputs,
+    out: &'a mut W,
+    out_path: &'a Path,
+    sightings: Option<SightingStream>,
+    metrics: Option<MetricsAcc>,
+    summary: ReplaySummary,
+    next_output_s: f64,
+    tol: f64,
+}
+
+impl<W: Write> Run<'_, W> {
+    /// After the filter reached a new time: applies the epochs due, writes the row, compares.
+    fn after(&mut self, filter: &mut InsSdFilter) -> Result<(), SimError> {
+        let now = filter.time_s();
+        let mut report = None;
+        if let Some(s) = self.sightings.as_mut() {
+            while let Some(t) = s.next_time()? {
+                if t > now + self.tol {
+                    break;
+                }
+                let Some((t, line)) = s.take_epoch()? else {
+                    break;
+                };
+                if t <= self.inputs.initial.t_s {
+                    self.summary.sightings_skipped += (s.offsets.len() + s.directions.len()) as u64;
+                    continue;
+                }
+                let r = if s.pointed {
+                    filter.update_pointed(now, &s.directions)
+                } else {
+                    filter.update(now, &s.offsets)
+                }
+                .map_err(|source| SimError::LogFilter {
+                    path: s.path.clone(),
+                    line,
+                    source,
+                })?;
+                self.summary.epochs += 1;
+                self.summary.sightings_used += r.used as u64;
+                self.summary.sightings_rejected += r.rejected as u64;
+                self.summary
+                    .solution
+                    .push((now, filter.navigation_solution()));
+                if let Some(m) = self.metrics.as_mut() {
+                    m.epoch(&r);
+                }
+                report = Some(r);
+            }
+        }
+        let write = match self.inputs.rate {
+            SolutionRate::Epochs => report.is_some(),
+            SolutionRate::EveryImu => true,
+            SolutionRate::Hz(hz) => {
+                let due = now + self.tol >= self.next_output_s;
+                if due {
+                    while self.next_output_s <= now + self.tol {
+                        self.next_output_s += 1.0 / hz;
+                    }
+                }
+                due || report.is_some()
+            }
+        };
+        if write {
+            write_solution(self.out, now, filter, report.as_ref())
+                .map_err(io_err(self.out_path))?;
+        }
+        if let Some(m) = self.metrics.as_mut() {
+            m.observe(filter);
+        }
+        Ok(())
+    }
+
+    /// Time of the next sighting epoch strictly inside (now, t − tol), if any.
+    fn epoch_inside(&self, now: f64, t: f64) -> Result<Option<f64>, SimError> {
+        let Some(s) = self.sightings.as_ref() else {
+            return Ok(None);
+        };
+        Ok(s.next_time()?
+            .filter(|&te| te > now + self.tol && te < t - self.tol))
+    }
+}
+
+/// Replays logs through the online filter, writing the solution CSV to `out` (module
+/// documentation for the time handling).
 ///
 /// # Errors
-/// [`SimError`] naming the file, line and column of the first bad record, or the line whose
-/// record the filter rejected.
+/// [`SimError`] naming the file, line and column of the first bad record, the line whose record
+/// the filter rejected, or the IMU line after a gap longer than `max_gap_s`.
 pub fn replay(
     inputs: &ReplayInputs,
     out: &mut impl Write,
     out_path: &Path,
 ) -> Result<ReplaySummary, SimError> {
-    let table = read_landmarks(&inputs.landmarks)?;
-    let init = read_initial(&inputs.initial)?;
+    let (table, sightings) = match &inputs.sightings {
+        Some((log, landmarks)) => (read_landmarks(landmarks)?, Some(SightingStream::open(log)?)),
+        None => (
+            ins_sd_filter::LandmarkTable::new(&[]).map_err(|source| SimError::LogFilter {
+                path: inputs.imu.clone(),
+                line: 0,
+                source,
+            })?,
+            None,
+        ),
+    };
+    let init = &inputs.initial;
     let mut filter =
         InsSdFilter::new(inputs.config, table, init.nav_state(), init.t_s).map_err(|source| {
             SimError::LogFilter {
-                path: inputs.initial.clone(),
-                line: 1,
+                path: inputs.imu.clone(),
+                line: 0,
                 source,
             }
         })?;
-    let wio = io_err(out_path);
-    writeln!(out, "{SOLUTION_HEADER}").map_err(&wio)?;
-    let mut imu = CsvReader::open(&inputs.imu, IMU_HEADER)?;
-    let mut sr = CsvReader::open(&inputs.sightings, SIGHTINGS_HEADER)?;
-    let tol = inputs.config.timestamp_tolerance_s.max(1e-9);
-    let mut summary = ReplaySummary::default();
-    // The next sighting record (read ahead) and the current epoch's sightings.
-    let mut pending = sr.next()?;
-    let mut epoch: Vec<Sighting> = Vec::new();
-    let mut last_epoch_t = f64::NEG_INFINITY;
-    let mut flush = |filter: &mut InsSdFilter,
-                     pending: &mut Option<Record>,
-                     summary: &mut ReplaySummary,
-                     out: &mut dyn Write|
-     -> Result<(), SimError> {
-        loop {
-            let Some(rec) = pending.as_ref() else {
-                return Ok(());
-            };
-            let t = sr.f64(rec, 0, "t_s")?;
-            if t > filter.time_s() + tol {
-                return Ok(());
-            }
-            if t < last_epoch_t {
-                return Err(sr.parse_err(
-                    rec.line,
-                    1,
-                    format!("epoch t = {t} s is before the previous one ({last_epoch_t} s)"),
-                ));
-            }
-            last_epoch_t = t;
-            // Gather every row with this time stamp.
-            epoch.clear();
-            let first_line = rec.line;
-            while let Some(rec) = pending.as_ref() {
-                if sr.f64(rec, 0, "t_s")? != t {
-                    break;
-                }
-                epoch.push(Sighting {
-                    landmark_id: sr.u32(rec, 1, "landmark_id")?,
-                    w_m: sr.f64(rec, 2, "w_m")?,
-                    h_m: sr.f64(rec, 3, "h_m")?,
-                });
-                *pending = sr.next()?;
-            }
-            let now = filter.time_s();
-            let report = filter
-                .update(now, &epoch)
-                .map_err(|source| SimError::LogFilter {
-                    path: inputs.sightings.clone(),
-                    line: first_line,
-                    source,
-                })?;
-            summary.epochs += 1;
-            summary.sightings_used += report.used as u64;
-            summary.sightings_rejected += report.rejected as u64;
-            write_solution(out, now, filter).map_err(io_err(out_path))?;
-            summary.solution.push((now, filter.navigation_solution()));
-        }
+    writeln!(out, "{SOLUTION_HEADER}").map_err(io_err(out_path))?;
+    let (mut imu, which) = CsvReader::open_any(&inputs.imu, &[IMU_HEADER, IMU_RATES_HEADER])?;
+    let rates = which == 1;
+    let names: Vec<&str> = [IMU_HEADER, IMU_RATES_HEADER][which].split(',').collect();
+    let step = inputs.config.imu_step_s;
+    let mut run = Run {
+        inputs,
+        out,
+        out_path,
+        summary: ReplaySummary {
+            offset_sightings: sightings.as_ref().is_some_and(|s| !s.pointed),
+            ..Default::default()
+        },
+        sightings,
+        metrics: inputs.reference.clone().map(MetricsAcc::new),
+        next_output_s: init.t_s,
+        tol: inputs.config.timestamp_tolerance_s.max(1e-9),
     };
-    flush(&mut filter, &mut pending, &mut summary, out)?;
-    let names: Vec<&str> = IMU_HEADER.split(',').collect();
+    run.after(&mut filter)?;
     while let Some(rec) = imu.next()? {
         let mut v = [0.0; 7];
         for (i, x) in v.iter_mut().enumerate() {
             *x = imu.f64(&rec, i, names[i])?;
         }
-        filter
-            .propagate(
-                v[0],
-                &Vector3::new(v[1], v[2], v[3]),
-                &Vector3::new(v[4], v[5], v[6]),
+        let t = v[0];
+        if t <= init.t_s {
+            run.summary.imu_skipped += 1;
+            continue;
+        }
+        // (specific force or Δv, angular rate or Δθ)
+        let (a, b) = if rates {
+            (
+                Vector3::new(v[4], v[5], v[6]),
+                Vector3::new(v[1], v[2], v[3]),
             )
-            .map_err(|source| SimError::LogFilter {
-                path: inputs.imu.clone(),
-                line: rec.line,
-                source,
-            })?;
-        summary.imu_samples += 1;
-        flush(&mut filter, &mut pending, &mut summary, out)?;
+        } else {
+            (
+                Vector3::new(v[1], v[2], v[3]),
+                Vector3::new(v[4], v[5], v[6]),
+            )
+        };
+        let now = filter.time_s();
+        let dt = t - now;
+        if dt > inputs.max_gap_s {
+            return Err(imu.parse_err(
+                rec.line,
+                1,
+                format!(
+                    "IMU gap of {dt} s after t = {now} s is longer than the {} s bridged (max_gap_s)",
+                    inputs.max_gap_s
+                ),
+            ));
+        }
+        let gap = dt > GAP_FACTOR * step;
+        if gap {
+            run.summary.gaps += 1;
+            run.summary.longest_gap_s = run.summary.longest_gap_s.max(dt);
+        }
+        let filter_err = |source| SimError::LogFilter {
+            path: inputs.imu.clone(),
+            line: rec.line,
+            source,
+        };
+        if !gap && run.epoch_inside(now, t)?.is_none() {
+            // One step, as logged.
+            if rates {
+                filter.propagate_rates(t, &a, &b).map_err(filter_err)?;
+            } else {
+                filter.propagate(t, &a, &b).map_err(filter_err)?;
+            }
+            run.summary.imu_samples += 1;
+            run.after(&mut filter)?;
+            continue;
+        }
+        // Cut at the epochs inside the sample and, in a gap, every nominal step; the sample's
+        // mean rates are held across the cuts.
+        let (f, w) = if rates {
+            (a, b)
+        } else if dt > 0.0 {
+            (a / dt, b / dt)
+        } else {
+            (a, b) // t ≤ now: the filter refuses it below
+        };
+        loop {
+            let now = filter.time_s();
+            let mut cut = t;
+            if gap {
+                cut = cut.min(now + step);
+            }
+            if let Some(te) = run.epoch_inside(now, t)? {
+                cut = cut.min(te);
+            }
+            if t - cut <= run.tol {
+                cut = t;
+            }
+            filter.propagate_rates(cut, &f, &w).map_err(filter_err)?;
+            if cut >= t {
+                break;
+            }
+            run.after(&mut filter)?;
+        }
+        run.summary.imu_samples += 1;
+        run.after(&mut filter)?;
     }
-    out.flush().map_err(io_err(out_path))?;
+    run.summary.end_t_s = filter.time_s();
+    run.out.flush().map_err(io_err(out_path))?;
+    let mut summary = run.summary;
+    summary.metrics = run.metrics.map(MetricsAcc::finish);
     Ok(summary)
 }
 

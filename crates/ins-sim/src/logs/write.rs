@@ -6,11 +6,12 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use ins_errors::strapdown::NavState;
-use ins_sd_filter::{InsSdFilter, Sighting};
-use nalgebra::Vector3;
+use ins_sd_filter::{InsSdFilter, Sighting, UpdateReport};
+use nalgebra::{Vector2, Vector3};
+use sighting_model::NavPose;
 
 use super::read::{InitialState, LandmarkFile, io_err};
-use super::{IMU_HEADER, SIGHTINGS_HEADER, SOLUTION_HEADER, TRUTH_HEADER, names};
+use super::{IMU_HEADER, POINTED_SIGHTINGS_HEADER, SOLUTION_HEADER, TRUTH_HEADER, names};
 use crate::engine::{self, RunObserver};
 use crate::{Mode, Sample, Scenario, SimError, SimRunOutcome};
 
@@ -37,25 +38,31 @@ pub(super) fn write_nav<W: Write + ?Sized>(
     )
 }
 
-/// Writes the solution row of the filter after an epoch at `t_s`.
+/// Writes the solution row of the filter at `t_s`: the navigation solution, the 1σ of the
+/// position, velocity and attitude errors from P at that time (empty without an estimator), and,
+/// after an epoch (`report`), its NIS, used and rejected counts (empty otherwise).
 pub(super) fn write_solution<W: Write + ?Sized>(
     w: &mut W,
     t_s: f64,
     filter: &InsSdFilter,
+    report: Option<&UpdateReport>,
 ) -> std::io::Result<()> {
     write_nav(w, t_s, &filter.navigation_solution())?;
-    let sigma = |i: usize| filter.covariance().map_or(f64::NAN, |p| p[(i, i)].sqrt());
-    let r = filter.last_report();
-    let nis = r.nis.map(|v| format!("{v:e}")).unwrap_or_default();
-    writeln!(
-        w,
-        ",{:e},{:e},{:e},{nis},{},{}",
-        sigma(0),
-        sigma(1),
-        sigma(2),
-        r.used,
-        r.rejected
-    )
+    match filter.predicted() {
+        Some((_, p)) => {
+            for i in 0..9 {
+                write!(w, ",{:e}", p[(i, i)].max(0.0).sqrt())?;
+            }
+        }
+        None => write!(w, ",,,,,,,,,")?,
+    }
+    match report {
+        Some(r) => {
+            let nis = r.nis.map(|v| format!("{v:e}")).unwrap_or_default();
+            writeln!(w, ",{nis},{},{}", r.used, r.rejected)
+        }
+        None => writeln!(w, ",,,"),
+    }
 }
 
 /// The observer that writes a simulated run as logs.
@@ -67,6 +74,7 @@ pub(super) struct LogWriter {
     pub(super) solution: BufWriter<File>,
     pub(super) step_s: f64,
     pub(super) initial: Option<InitialState>,
+    pub(super) pointing: Option<NavPose>,
     pub(super) error: Option<SimError>,
 }
 
@@ -82,11 +90,12 @@ impl LogWriter {
         Ok(Self {
             dir: dir.to_path_buf(),
             imu: open(names::IMU, IMU_HEADER)?,
-            sightings: open(names::SIGHTINGS, SIGHTINGS_HEADER)?,
+            sightings: open(names::SIGHTINGS, POINTED_SIGHTINGS_HEADER)?,
             truth: open(names::TRUTH, TRUTH_HEADER)?,
             solution: open(names::SOLUTION, SOLUTION_HEADER)?,
             step_s,
             initial: None,
+            pointing: None,
             error: None,
         })
     }
@@ -116,16 +125,43 @@ impl RunObserver for LogWriter {
         self.keep(names::IMU, r);
     }
 
+    fn before_epoch(&mut self, filter: &InsSdFilter) {
+        self.pointing = Some(filter.pointing_pose());
+    }
+
     fn epoch(&mut self, t_s: f64, sightings: &[Sighting], filter: &InsSdFilter) {
+        // The offsets the simulated device measured with the camera pointed by this filter's
+        // INS, written as body directions (format 2): any filter can replay them.
         for s in sightings {
-            let r = writeln!(
-                self.sightings,
-                "{:e},{},{:e},{:e}",
-                t_s, s.landmark_id, s.w_m, s.h_m
-            );
+            let u = match (
+                self.pointing.as_ref(),
+                filter.landmarks().get(s.landmark_id),
+            ) {
+                (Some(pose), Some(lm)) => {
+                    sighting_model::los_from_offsets(pose, lm, &Vector2::new(s.w_m, s.h_m))
+                        .map_err(|source| SimError::Sighting { t_s, source })
+                }
+                _ => Err(SimError::ReferenceSpan {
+                    t_s,
+                    what: "sighting epoch without the pointing pose or landmark",
+                }),
+            };
+            let r = match u {
+                Ok(u) => writeln!(
+                    self.sightings,
+                    "{:e},{},body,{:e},{:e},{:e}",
+                    t_s, s.landmark_id, u.x, u.y, u.z
+                ),
+                Err(e) => {
+                    if self.error.is_none() {
+                        self.error = Some(e);
+                    }
+                    Ok(())
+                }
+            };
             self.keep(names::SIGHTINGS, r);
         }
-        let r = write_solution(&mut self.solution, t_s, filter);
+        let r = write_solution(&mut self.solution, t_s, filter, Some(filter.last_report()));
         self.keep(names::SOLUTION, r);
     }
 
