@@ -274,6 +274,13 @@ impl Strapdown {
         let new_pos = earth::displace_by_ned_m(&old.pos, &(-pos_err_ned_m));
         let c_c_to_t = earth::ned_from_ecef(new_pos.lat_rad, new_pos.lon_rad)
             * earth::ned_from_ecef(old.pos.lat_rad, old.pos.lon_rad).transpose();
+        if !(c_c_to_t.iter().all(|x| x.is_finite()) && psi_rad.iter().all(|x| x.is_finite())) {
+            // A non-finite correction (a diverged filter): the state becomes non-finite, which
+            // every caller checks, instead of `from_matrix` iterating on NaN forever.
+            self.state.pos.lat_rad = f64::NAN;
+            self.state.vel_ned_mps = Vector3::from_element(f64::NAN);
+            return;
+        }
         let q_ct = UnitQuaternion::from_matrix(&c_c_to_t);
         let v_new = c_c_to_t * (old.vel_ned_mps - vel_err_ned_mps);
         let q_fix = q_ct * UnitQuaternion::from_scaled_axis(*psi_rad);

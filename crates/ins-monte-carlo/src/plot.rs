@@ -140,10 +140,12 @@ where
         .draw()?;
     for (name, colour, pts) in data {
         let c = *colour;
-        chart
-            .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))?
-            .label(*name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        let drawn = chart.draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))?;
+        if !name.is_empty() {
+            drawn.label(*name).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+            });
+        }
     }
     chart
         .configure_series_labels()
@@ -581,4 +583,95 @@ pub fn sweep_figure(
     )
     .map_err(|e| plot_error("PNG sweep figure", e))?;
     Ok((svg, encode_png(rgb)?))
+}
+
+const REPLAY_AXES: [(&str, &str, RGBColor, RGBColor); 3] = [
+    ("N", "±3σ N", RGBColor(200, 30, 30), RGBColor(240, 160, 160)),
+    ("E", "±3σ E", RGBColor(30, 140, 30), RGBColor(150, 215, 150)),
+    ("D", "±3σ D", RGBColor(30, 60, 200), RGBColor(150, 170, 240)),
+];
+
+/// The curves of one block (0 position, 1 velocity, 2 attitude) of a replay: the error on each
+/// axis and its ±3σ envelope, time from the first sample, values × `scale`.
+fn replay_series(series: &[ins_sim::logs::ErrorSample], block: usize, scale: f64) -> Vec<Series> {
+    let t0 = series.first().map_or(0.0, |s| s.t_s);
+    let mut out = Vec::new();
+    for (axis, (name, band, colour, light)) in REPLAY_AXES.iter().enumerate() {
+        let k = 3 * block + axis;
+        let pts = |f: &dyn Fn(&ins_sim::logs::ErrorSample) -> f64| -> Vec<(f64, f64)> {
+            series
+                .iter()
+                .filter(|s| f(s).is_finite())
+                .map(|s| (s.t_s - t0, f(s) * scale))
+                .collect()
+        };
+        out.push((*name, *colour, pts(&|s| s.error[k])));
+        out.push((*band, *light, pts(&|s| 3.0 * s.sigma[k])));
+        out.push(("", *light, pts(&|s| -3.0 * s.sigma[k])));
+    }
+    out.retain(|(_, _, p)| !p.is_empty());
+    out
+}
+
+fn draw_replay<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    series: &[ins_sim::logs::ErrorSample],
+    title: &str,
+    with_attitude: bool,
+) -> Result<(), Box<dyn Error + Send + Sync>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let t_end = match (series.first(), series.last()) {
+        (Some(a), Some(b)) => b.t_s - a.t_s,
+        _ => 1.0,
+    };
+    let panels: Vec<(&str, &str, usize, f64)> = if with_attitude {
+        vec![
+            ("position error", "m", 0, 1.0),
+            ("velocity error", "m/s", 1, 1.0),
+            ("attitude error ψ", "mrad", 2, 1e3),
+        ]
+    } else {
+        vec![
+            ("position error", "m", 0, 1.0),
+            ("velocity error", "m/s", 1, 1.0),
+        ]
+    };
+    let areas = root.split_evenly((panels.len(), 1));
+    for (area, (what, unit, block, scale)) in areas.iter().zip(panels) {
+        let data = replay_series(series, block, scale);
+        panel(
+            area,
+            &format!("{title}: {what}"),
+            &format!("{what} ({unit})"),
+            t_end,
+            &data,
+        )?;
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// The errors of a replayed solution against its reference with their ±3σ envelopes (position,
+/// velocity, and attitude when the reference has it), as PNG bytes.
+///
+/// # Errors
+/// [`McError::Plot`] when drawing or encoding fails.
+pub fn replay_figure(
+    series: &[ins_sim::logs::ErrorSample],
+    title: &str,
+) -> Result<Vec<u8>, McError> {
+    register_font()?;
+    let with_attitude = series.iter().any(|s| s.error[6].is_finite());
+    let mut rgb = vec![0u8; (W * H * 3) as usize];
+    draw_replay(
+        BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area(),
+        series,
+        title,
+        with_attitude,
+    )
+    .map_err(|e| plot_error("replay errors", e))?;
+    encode_png(rgb)
 }

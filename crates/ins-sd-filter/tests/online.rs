@@ -594,10 +594,9 @@ fn body_directions_made_from_the_offsets_give_the_same_estimate() {
 }
 
 #[test]
-fn a_direction_pointing_away_from_its_landmark_is_refused_before_anything_changes() {
+fn a_direction_pointing_away_from_its_landmark_is_rejected_not_used() {
     let cfg = config(ErrorStateEstimator::Kalman, None);
     let (mut filter, _) = fly(cfg, 3, 2, &|_, _| {});
-    let before = filter.clone();
     let pose = filter.pointing_pose();
     let lm = *filter.landmarks().get(10).unwrap();
     let towards = sighting_model::los_from_truth(
@@ -608,27 +607,34 @@ fn a_direction_pointing_away_from_its_landmark_is_refused_before_anything_change
     )
     .unwrap();
     let t = filter.time_s();
-    let bad = [
+    let sightings = [
         PointedSighting {
             landmark_id: 10,
             frame: LosFrame::LocalLevel,
             los: towards,
         },
+        // −towards points away from every landmark here.
         PointedSighting {
             landmark_id: 11,
             frame: LosFrame::LocalLevel,
             los: -towards * 5.0,
         },
     ];
-    // Landmark 11 is elsewhere, but −towards points away from every landmark here.
-    let e = filter.update_pointed(t, &bad).unwrap_err();
-    assert!(
-        matches!(e, FilterError::Sighting { landmark: 11, .. }),
-        "{e}"
-    );
-    assert_eq!(filter.statistics(), before.statistics());
-    assert_eq!(filter.covariance(), before.covariance());
-    // A local-level direction with the offsets of the truth is used.
-    let report = filter.update_pointed(t, &bad[..1]).unwrap();
-    assert_eq!(report.used, 1);
+    let mut only_first = filter.clone();
+    let report = filter.update_pointed(t, &sightings).unwrap();
+    assert_eq!((report.used, report.rejected), (1, 1));
+    only_first.update_pointed(t, &sightings[..1]).unwrap();
+    assert_eq!(filter.covariance(), only_first.covariance());
+    // A NaN direction is an error, before anything changes.
+    let before = *filter.statistics();
+    let nan = [PointedSighting {
+        landmark_id: 10,
+        frame: LosFrame::Body,
+        los: nalgebra::Vector3::new(f64::NAN, 0.0, 1.0),
+    }];
+    assert!(matches!(
+        filter.update_pointed(t, &nan),
+        Err(FilterError::NonFiniteInput { .. })
+    ));
+    assert_eq!(filter.statistics(), &before);
 }

@@ -4,8 +4,8 @@
 //! ```toml
 //! preset = "mems"            # optional: "mems" (default) or "paper"; the keys below override it
 //! [imu]
-//! gyro_arw_deg_per_rt_h = 1.0             # angle random walk N_g, °/√h
-//! accel_vrw_mps_per_rt_h = 0.3            # velocity random walk N_a, m/s/√h
+//! gyro_arw_deg_per_rt_h = 10.0            # angle random walk N_g, °/√h
+//! accel_vrw_mps_per_rt_h = 1.0            # velocity random walk N_a, m/s/√h
 //! gyro_bias_instability_deg_per_h = 20.0  # bias instability B_g, °/h (0: random constant)
 //! gyro_bias_corr_time_s = 300.0           # its correlation time τ_g, s
 //! accel_bias_instability_mg = 0.5         # B_a, mg (1 mg = 9.80665e-3 m/s²)

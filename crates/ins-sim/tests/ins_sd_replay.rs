@@ -29,6 +29,8 @@ fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
         max_gap_s: 1.0,
         rate: SolutionRate::Epochs,
         reference: None,
+        align_s: 0.0,
+        level: false,
     }
 }
 

@@ -209,6 +209,8 @@ fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Res
         max_gap_s: 1.0,
         rate: SolutionRate::Epochs,
         reference: None,
+        align_s: 0.0,
+        level: false,
     };
     (read, logs::replay(&inputs, &mut w, &out).map(|_| ()))
 }

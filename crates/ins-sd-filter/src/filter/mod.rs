@@ -104,14 +104,20 @@ impl Epoch<'_> {
                         t_s,
                     });
                 }
-                let z = sighting_model::offsets_from_los(pose, lm, s.frame, &s.los).map_err(
-                    |source| FilterError::Sighting {
+                match sighting_model::offsets_from_los(pose, lm, s.frame, &s.los) {
+                    Ok(z) => Ok((id, z, s.frame)),
+                    // Seen from this INS the direction points away from the landmark: the
+                    // INS is far off, or the record is wrong. Not a usable measurement:
+                    // rejected like a gated outlier (NaN offsets).
+                    Err(sighting_model::SightingError::BehindCamera { .. }) => {
+                        Ok((id, Vector2::new(f64::NAN, f64::NAN), s.frame))
+                    }
+                    Err(source) => Err(FilterError::Sighting {
                         t_s,
                         landmark: id,
                         source,
-                    },
-                )?;
-                Ok((id, z, s.frame))
+                    }),
+                }
             }
         }
     }
@@ -498,9 +504,9 @@ impl InsSdFilter {
     /// for local-level directions, `sighting_model::jacobian_for_frame`). Allocation-free.
     ///
     /// # Errors
-    /// As [`InsSdFilter::update`]; also [`FilterError::Sighting`] (checked before anything
-    /// changes) for a direction that points away from its landmark as seen from the INS, and
-    /// [`FilterError::NonFiniteInput`] for a NaN/∞ direction.
+    /// As [`InsSdFilter::update`]; also [`FilterError::NonFiniteInput`] for a NaN/∞ direction.
+    /// A direction that points away from its landmark as seen from the INS (behind the camera)
+    /// is not an error: it is counted as rejected, like a gated outlier.
     pub fn update_pointed(
         &mut self,
         t_s: f64,
@@ -593,6 +599,11 @@ impl InsSdFilter {
                 h.fixed_view_mut::<2, 3>(0, sighting_model::PSI_COL)
                     .fill(0.0);
             }
+            if z.x.is_nan() {
+                // A pointed sighting behind the camera (Epoch::get).
+                report.rejected += 1;
+                continue;
+            }
             if let Some(threshold) = self.gate_threshold {
                 let nu = z - h * x_prior;
                 let s2: Matrix2<f64> = h * p_prior * h.transpose() + Matrix2::identity() * r;
@@ -659,6 +670,30 @@ impl InsSdFilter {
         }
         self.last_report = report;
         Ok(report)
+    }
+
+    /// Replaces the INS's sensor corrections (accelerometer bias, body m/s², and gyro bias,
+    /// body rad/s, subtracted from every IMU sample): e.g. biases measured during a static
+    /// alignment before the replay. The filter's bias states keep estimating what is left.
+    ///
+    /// # Errors
+    /// [`FilterError::NonFiniteInput`] for a NaN/∞ component (nothing changes).
+    pub fn set_sensor_corrections(
+        &mut self,
+        accel_bias_body_mps2: &Vector3<f64>,
+        gyro_bias_body_radps: &Vector3<f64>,
+    ) -> Result<(), FilterError> {
+        if !(accel_bias_body_mps2.iter().all(|v| v.is_finite())
+            && gyro_bias_body_radps.iter().all(|v| v.is_finite()))
+        {
+            return Err(FilterError::NonFiniteInput {
+                what: "sensor corrections",
+                t_s: self.t_s,
+            });
+        }
+        self.ins
+            .set_sensor_corrections(accel_bias_body_mps2, gyro_bias_body_radps);
+        Ok(())
     }
 
     /// Feedback now: the estimated δp, δv, ψ are removed from the INS, ∇̂, ε̂ added to its

@@ -361,3 +361,51 @@ pub fn read_solution(path: &Path) -> Result<Vec<(f64, NavState)>, SimError> {
     }
     Ok(out)
 }
+
+/// The nominal step of an IMU log (either header): the median interval of its first 200
+/// samples, s.
+///
+/// # Errors
+/// [`SimError::LogIo`], [`SimError::LogParse`] for a bad header or time field, or fewer than two
+/// samples.
+pub fn imu_nominal_step_s(path: &Path) -> Result<f64, SimError> {
+    let (mut r, _) = CsvReader::open_any(path, &[super::IMU_HEADER, super::IMU_RATES_HEADER])?;
+    let mut times = Vec::with_capacity(201);
+    while times.len() < 201 {
+        let Some(rec) = r.next()? else { break };
+        times.push(r.f64(&rec, 0, "t_s")?);
+    }
+    let mut dts: Vec<f64> = times
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .collect();
+    if dts.is_empty() {
+        return Err(r.parse_err(
+            r.line.max(1),
+            1,
+            "fewer than two increasing IMU time stamps: no sample rate".into(),
+        ));
+    }
+    dts.sort_by(f64::total_cmp);
+    Ok(dts[dts.len() / 2])
+}
+
+/// Writes a landmark table file (the format [`read_landmarks`] reads).
+///
+/// # Errors
+/// [`SimError::LogWrite`] or [`SimError::LogIo`].
+pub fn write_landmarks(path: &Path, entries: &[LandmarkEntry]) -> Result<(), SimError> {
+    let file = LandmarkFile {
+        landmarks: entries.to_vec(),
+    };
+    let text = toml::to_string(&file).map_err(|source| SimError::LogWrite {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    std::fs::write(
+        path,
+        format!("# Landmark table (WGS-84): id, latitude/longitude in degrees, height above the ellipsoid in m.\n{text}"),
+    )
+    .map_err(io_err(path))
+}

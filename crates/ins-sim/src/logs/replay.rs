@@ -59,6 +59,98 @@ pub struct ReplayInputs {
     pub rate: SolutionRate,
     /// Reference trajectory for [`ReplayMetrics`].
     pub reference: Option<Vec<ReferenceRow>>,
+    /// Static alignment: the vehicle is at rest for this long after the initial time, s (0:
+    /// none). The mean angular rate over it, less the Earth rate, is the initial gyro bias
+    /// ([`align_at_rest`]).
+    pub align_s: f64,
+    /// With `align_s`: also take roll and pitch from the mean specific force (keeping the
+    /// initial heading): for an initial attitude that did not come from a reference attitude.
+    pub level: bool,
+}
+
+/// What a static alignment found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Alignment {
+    /// Samples averaged.
+    pub samples: u64,
+    /// Gyro bias, body rad/s (mean rate − Earth rate in body axes).
+    pub gyro_bias_body_radps: [f64; 3],
+    /// Mean specific force, body m/s².
+    pub mean_specific_force_body_mps2: [f64; 3],
+    /// Roll and pitch levelled from the specific force, rad (when levelled).
+    pub roll_pitch_rad: Option<[f64; 2]>,
+}
+
+/// Static alignment over `(t0, t0 + duration_s]` of the IMU log: the mean angular rate less the
+/// Earth rate resolved in body axes with `initial`'s attitude is the gyro bias; with `level`, roll
+/// and pitch come from the mean specific force f̄ (at rest f = −g in body axes:
+/// roll = atan2(−f̄_y, −f̄_z), pitch = atan2(f̄_x, √(f̄_y² + f̄_z²))) and the heading is kept;
+/// `initial` is updated in place. The accelerometer bias cannot be told from a tilt at rest and is
+/// left to the filter.
+///
+/// # Errors
+/// [`SimError::LogIo`], [`SimError::LogParse`] for a bad record or no sample in the window.
+pub fn align_at_rest(
+    imu_path: &Path,
+    initial: &mut InitialState,
+    duration_s: f64,
+    level: bool,
+) -> Result<Alignment, SimError> {
+    let (mut imu, which) = CsvReader::open_any(imu_path, &[IMU_HEADER, IMU_RATES_HEADER])?;
+    let names: Vec<&str> = [IMU_HEADER, IMU_RATES_HEADER][which].split(',').collect();
+    let (t0, t1) = (initial.t_s, initial.t_s + duration_s);
+    let (mut sum_f, mut sum_w, mut sum_dt, mut n) = (Vector3::zeros(), Vector3::zeros(), 0.0, 0u64);
+    let mut prev = f64::NAN;
+    while let Some(rec) = imu.next()? {
+        let mut v = [0.0; 7];
+        for (i, x) in v.iter_mut().enumerate() {
+            *x = imu.f64(&rec, i, names[i])?;
+        }
+        let t = v[0];
+        if t > t1 {
+            break;
+        }
+        if t > t0 && prev.is_finite() && t > prev {
+            let dt = t - prev;
+            if which == 1 {
+                sum_f += Vector3::new(v[4], v[5], v[6]) * dt;
+                sum_w += Vector3::new(v[1], v[2], v[3]) * dt;
+            } else {
+                sum_f += Vector3::new(v[1], v[2], v[3]);
+                sum_w += Vector3::new(v[4], v[5], v[6]);
+            }
+            sum_dt += dt;
+            n += 1;
+        }
+        prev = t;
+    }
+    if n == 0 || sum_dt <= 0.0 {
+        return Err(imu.parse_err(
+            imu.line.max(1),
+            1,
+            format!("no IMU sample between t = {t0} s and {t1} s to align on"),
+        ));
+    }
+    let f = sum_f / sum_dt;
+    let w = sum_w / sum_dt;
+    let mut out = Alignment {
+        samples: n,
+        mean_specific_force_body_mps2: [f.x, f.y, f.z],
+        ..Default::default()
+    };
+    let mut state = initial.nav_state();
+    if level {
+        let roll = (-f.y).atan2(-f.z);
+        let pitch = f.x.atan2(f.y.hypot(f.z));
+        let (_, _, yaw) = state.att_b_to_n.euler_angles();
+        state.att_b_to_n = nalgebra::UnitQuaternion::from_euler_angles(roll, pitch, yaw);
+        out.roll_pitch_rad = Some([roll, pitch]);
+        *initial = InitialState::new(initial.t_s, &state);
+    }
+    let w_ie_n = ins_errors::earth::earth_rate_ned_radps(state.pos.lat_rad);
+    let bias = w - state.att_b_to_n.inverse() * w_ie_n;
+    out.gyro_bias_body_radps = [bias.x, bias.y, bias.z];
+    Ok(out)
 }
 
 /// Error statistics of one 3-vector quantity (position m, velocity m/s, attitude rad).
@@ -149,6 +241,10 @@ pub struct ReplaySummary {
     pub solution: Vec<(f64, NavState)>,
     /// Against the reference, when one was given.
     pub metrics: Option<ReplayMetrics>,
+    /// The static alignment, when asked for.
+    pub alignment: Option<Alignment>,
+    /// The initial state used (after levelling).
+    pub initial: Option<InitialState>,
 }
 
 /// The next sighting epoch, read ahead.
@@ -423,6 +519,7 @@ struct Run<'a, W: Write> {
     summary: ReplaySummary,
     next_output_s: f64,
     tol: f64,
+    t0_s: f64,
 }
 
 impl<W: Write> Run<'_, W> {
@@ -438,7 +535,7 @@ impl<W: Write> Run<'_, W> {
                 let Some((t, line)) = s.take_epoch()? else {
                     break;
                 };
-                if t <= self.inputs.initial.t_s {
+                if t <= self.t0_s {
                     self.summary.sightings_skipped += (s.offsets.len() + s.directions.len()) as u64;
                     continue;
                 }
@@ -519,15 +616,30 @@ pub fn replay(
             None,
         ),
     };
-    let init = &inputs.initial;
+    let mut initial = inputs.initial;
+    let alignment = if inputs.align_s > 0.0 {
+        Some(align_at_rest(
+            &inputs.imu,
+            &mut initial,
+            inputs.align_s,
+            inputs.level,
+        )?)
+    } else {
+        None
+    };
+    let init = &initial;
+    let filter_err0 = |source| SimError::LogFilter {
+        path: inputs.imu.clone(),
+        line: 0,
+        source,
+    };
     let mut filter =
-        InsSdFilter::new(inputs.config, table, init.nav_state(), init.t_s).map_err(|source| {
-            SimError::LogFilter {
-                path: inputs.imu.clone(),
-                line: 0,
-                source,
-            }
-        })?;
+        InsSdFilter::new(inputs.config, table, init.nav_state(), init.t_s).map_err(filter_err0)?;
+    if let Some(a) = &alignment {
+        filter
+            .set_sensor_corrections(&Vector3::zeros(), &Vector3::from(a.gyro_bias_body_radps))
+            .map_err(filter_err0)?;
+    }
     writeln!(out, "{SOLUTION_HEADER}").map_err(io_err(out_path))?;
     let (mut imu, which) = CsvReader::open_any(&inputs.imu, &[IMU_HEADER, IMU_RATES_HEADER])?;
     let rates = which == 1;
@@ -544,6 +656,7 @@ pub fn replay(
         sightings,
         metrics: inputs.reference.clone().map(MetricsAcc::new),
         next_output_s: init.t_s,
+        t0_s: init.t_s,
         tol: inputs.config.timestamp_tolerance_s.max(1e-9),
     };
     run.after(&mut filter)?;
@@ -636,6 +749,8 @@ pub fn replay(
     run.out.flush().map_err(io_err(out_path))?;
     let mut summary = run.summary;
     summary.metrics = run.metrics.map(MetricsAcc::finish);
+    summary.alignment = alignment;
+    summary.initial = Some(initial);
     Ok(summary)
 }
 

@@ -1,106 +1,391 @@
-//! `nav-app ins`: replays IMU and sighting logs through the online INS/SD filter.
+//! `nav-app ins`: replays an IMU log (with sightings, or unaided) through the online INS/SD
+//! filter; `nav-app ins sightings`: writes sightings from a reference trajectory.
 
 use std::io::BufWriter;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::Parser;
+use ins_sim::filter_file::FilterFile;
+use ins_sim::logs::{self, ReplayMetrics, ReplaySummary, SightingPlan, SolutionRate};
+use ins_sim::{Mode, Scenario};
 
-/// `nav-app ins`: replay IMU and sighting logs through the online INS/SD filter.
+/// `nav-app ins`: replay an IMU log through the INS/SD filter.
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app ins",
-    about = "Replays IMU and sighting logs through the INS/SD filter (formats: ins_sim::logs)",
-    after_help = "All of --imu, --sightings, --landmarks, --init and --out are required (there is no \
-                  bundled flight; `nav-app monte-carlo --export-logs DIR` writes one). \
-                  --config defaults to configs/paper.toml.\n\n\
-                  Exit codes: 0 success; 1 error (a malformed log names its file, line and column); \
-                  2 bad command line."
+    about = "Replays an IMU log, with landmark sightings or unaided, through the INS/SD filter \
+             (formats: ins_sim::logs; `nav-app ins sightings --help` writes sightings from a \
+             reference trajectory)",
+    after_help = "The filter settings come from --config (a filter file in datasheet units, \
+                  ins_sim::filter_file) or --preset (compiled in: mems, the default, or paper). \
+                  The initial state comes from --init, or from the reference (--truth) at \
+                  --start-s (default: its first row).\n\n\
+                  Exit codes: 0 success; 1 error (a malformed log names its file, line and \
+                  column); 2 bad command line."
 )]
 struct InsArgs {
-    /// IMU log (CSV: t_s, Δv body m/s, Δθ body rad).
+    /// IMU log (CSV; header `t_s,dv_x_mps,…,dtheta_z_rad` for increments or
+    /// `t_s,gyro_x_radps,…,accel_z_mps2` for rates; body FRD).
     #[arg(long, value_name = "FILE")]
     imu: PathBuf,
-    /// Sightings log (CSV: t_s, landmark_id, w_m, h_m).
-    #[arg(long, value_name = "FILE")]
-    sightings: PathBuf,
+    /// Sightings log (CSV: `t_s,landmark_id,frame,los_x,los_y,los_z`, or the older
+    /// `t_s,landmark_id,w_m,h_m`). Without it the INS runs unaided.
+    #[arg(long, value_name = "FILE", requires = "landmarks")]
+    sightings: Option<PathBuf>,
     /// Landmark table (TOML, [[landmarks]] id, lat_deg, lon_deg, alt_m).
     #[arg(long, value_name = "FILE")]
-    landmarks: PathBuf,
-    /// Initial INS state (TOML: t_s, lat_rad, lon_rad, alt_m, vel_ned_mps, att_quat_wxyz).
+    landmarks: Option<PathBuf>,
+    /// Initial INS state (TOML: t_s, lat_rad, lon_rad, alt_m, vel_ned_mps, att_quat_wxyz);
+    /// default: from --truth at --start-s.
     #[arg(long, value_name = "FILE")]
-    init: PathBuf,
-    /// Scenario file for the filter settings ([filter], [sighting] update_period_s,
-    /// [trajectory] step_s).
-    #[arg(long, value_name = "FILE", default_value = "configs/paper.toml")]
-    config: PathBuf,
-    /// Filter: kf (tuned KF) or akf (Mohamed–Schwarz adaptive KF).
-    #[arg(long, value_name = "kf|akf", default_value = "kf")]
+    init: Option<PathBuf>,
+    /// Start time of the replay when the initial state comes from --truth, s.
+    #[arg(long, value_name = "S")]
+    start_s: Option<f64>,
+    /// Static alignment: the vehicle is at rest for this long after the start, s. The mean
+    /// rate over it (less the Earth rate) is the initial gyro bias; when the attitude did not
+    /// come from a reference attitude, roll and pitch are levelled from the accelerometers.
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    align_s: f64,
+    /// Filter file (TOML, datasheet units; `preset = "mems"|"paper"` plus overrides). An older
+    /// scenario file (with [trajectory]) is still accepted.
+    #[arg(long, value_name = "FILE", conflicts_with = "preset")]
+    config: Option<PathBuf>,
+    /// Compiled-in filter settings: mems (consumer / industrial MEMS IMU) or paper.
+    #[arg(long, value_name = "NAME")]
+    preset: Option<String>,
+    /// none (unaided INS), kf, akf (Mohamed–Schwarz), akf_sage_husa, akf_structured.
+    #[arg(long, value_name = "NAME", default_value = "kf")]
     filter: String,
-    /// χ² innovation gate probability per sighting (e.g. 0.9999); no gate when absent.
+    /// χ² gate probability per sighting (overrides the filter file's; 0 = no gate).
     #[arg(long, value_name = "P")]
     gate: Option<f64>,
+    /// Longest IMU gap bridged by propagation, s (a longer one is an error).
+    #[arg(long, value_name = "S", default_value_t = 5.0)]
+    max_gap_s: f64,
+    /// Solution rows at this rate, Hz (default: after every IMU sample).
+    #[arg(long, value_name = "HZ")]
+    rate: Option<f64>,
     /// Solution CSV to write.
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
-    /// Truth CSV: print the solution's errors against it.
+    /// Reference trajectory (CSV, radians or degrees, attitude optional): print and write the
+    /// errors against it.
     #[arg(long, value_name = "FILE")]
     truth: Option<PathBuf>,
+    /// With --truth: the error statistics as JSON.
+    #[arg(long, value_name = "FILE", requires = "truth")]
+    metrics_json: Option<PathBuf>,
+    /// With --truth: a PNG of the errors and their ±3σ envelopes.
+    #[arg(long, value_name = "FILE", requires = "truth")]
+    plot: Option<PathBuf>,
+}
+
+/// `nav-app ins sightings`: write sightings from a reference trajectory.
+#[derive(Parser, Debug)]
+#[command(
+    name = "nav-app ins sightings",
+    about = "Writes a pointed-sightings log from a reference trajectory and a landmark table \
+             (ins_sim::logs::write_sightings): body directions when the reference has an \
+             attitude, local-level ones otherwise; seeded."
+)]
+struct SightingsArgs {
+    /// Reference trajectory (CSV, radians or degrees, attitude optional).
+    #[arg(long, value_name = "FILE")]
+    reference: PathBuf,
+    /// Landmark table to read, or with --make-landmarks to write.
+    #[arg(long, value_name = "FILE")]
+    landmarks: PathBuf,
+    /// Place this many landmarks around the reference (seeded) and write them to --landmarks.
+    #[arg(long, value_name = "N")]
+    make_landmarks: Option<usize>,
+    /// With --make-landmarks: their horizontal distance from the trajectory, m (MIN MAX).
+    #[arg(long, value_names = ["MIN", "MAX"], num_args = 2, default_values_t = [50.0, 300.0])]
+    landmark_range_m: Vec<f64>,
+    /// Sightings log to write.
+    #[arg(long, value_name = "FILE")]
+    out: PathBuf,
+    /// σ of w and h, m at the landmark.
+    #[arg(long, value_name = "M", default_value_t = 1.0)]
+    sigma_m: f64,
+    /// Time between epochs, s.
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    period_s: f64,
+    /// Nearest slant range sighted, m.
+    #[arg(long, value_name = "M", default_value_t = 1.0)]
+    min_range_m: f64,
+    /// Farthest slant range sighted, m.
+    #[arg(long, value_name = "M", default_value_t = 1000.0)]
+    max_range_m: f64,
+    /// Half-angle of the field of regard about the forward axis, ° (180 = all around).
+    #[arg(long, value_name = "DEG", default_value_t = 180.0)]
+    field_of_regard_deg: f64,
+    /// At most this many (the nearest) landmarks per epoch.
+    #[arg(long, value_name = "N", default_value_t = 6)]
+    max_per_epoch: usize,
+    /// Seed of the noise (and of the landmark placement).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    seed: u64,
+}
+
+fn filter_file(args: &InsArgs) -> Result<Option<FilterFile>> {
+    if let Some(path) = &args.config {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        if text.contains("[trajectory]") {
+            return Ok(None); // an older scenario file: handled by the caller
+        }
+        return Ok(Some(FilterFile::from_toml_str(
+            &text,
+            &path.display().to_string(),
+        )?));
+    }
+    Ok(Some(FilterFile::preset(
+        args.preset.as_deref().unwrap_or("mems"),
+    )?))
 }
 
 fn run_ins(args: &InsArgs) -> Result<()> {
-    use ins_sim::{Mode, Scenario, logs};
-    let text = std::fs::read_to_string(&args.config)
-        .with_context(|| format!("reading {}", args.config.display()))?;
-    let scenario = Scenario::from_toml_str(&text)
-        .with_context(|| format!("scenario {}", args.config.display()))?;
-    let mode = match args.filter.as_str() {
-        "kf" => Mode::Kf,
-        "akf" => Mode::Akf,
-        other => bail!("--filter: `{other}` is not kf or akf"),
+    let mode = Mode::from_name(&args.filter)
+        .or((args.filter == "none").then_some(Mode::Standalone))
+        .with_context(|| {
+            format!(
+                "--filter: `{}` is not none, kf, akf, akf_sage_husa or akf_structured",
+                args.filter
+            )
+        })?;
+    if let Some(rate) = args.rate
+        && !(rate.is_finite() && rate > 0.0)
+    {
+        bail!("--rate: {rate} is not a positive rate in Hz");
+    }
+    if !(args.max_gap_s.is_finite() && args.max_gap_s > 0.0) {
+        bail!(
+            "--max-gap-s: {} is not a positive time in s",
+            args.max_gap_s
+        );
+    }
+    let reference = match &args.truth {
+        Some(path) => Some(logs::read_reference(path)?),
+        None => None,
     };
-    let mut config = scenario.online_filter_config(mode);
-    config.gate_probability = args.gate;
+    if !(args.align_s.is_finite() && args.align_s >= 0.0) {
+        bail!("--align-s: {} is not a time >= 0 s", args.align_s);
+    }
+    let mut level = false;
+    let initial = match (&args.init, &reference) {
+        (Some(path), _) => logs::read_initial(path)?,
+        (None, Some(rows)) => {
+            let start = args
+                .start_s
+                .unwrap_or_else(|| rows.first().map_or(0.0, |r| r.t_s));
+            level = rows.iter().any(|r| r.att_b_to_n.is_none());
+            logs::initial_from_reference(rows, start, 1.0)?
+        }
+        (None, None) => bail!(
+            "the initial state: give --init FILE, or --truth FILE to take it from the reference"
+        ),
+    };
+    let imu_step_s = logs::imu_nominal_step_s(&args.imu)?;
+    let mut config = match filter_file(args)? {
+        Some(f) => f.filter_config(mode, imu_step_s, initial.t_s)?,
+        None => {
+            let path = args.config.as_deref().unwrap_or(Path::new(""));
+            let text = std::fs::read_to_string(path)?;
+            let scenario = Scenario::from_toml_str(&text)
+                .with_context(|| format!("scenario {}", path.display()))?;
+            let mut c = scenario.online_filter_config(if mode == Mode::Standalone {
+                Mode::Kf
+            } else {
+                mode
+            });
+            c.imu_step_s = imu_step_s;
+            c.timestamp_tolerance_s = 0.0;
+            c
+        }
+    };
+    if let Some(p) = args.gate {
+        config.gate_probability = (p != 0.0).then_some(p);
+    }
+    let sightings = match (&args.sightings, &args.landmarks, mode) {
+        (_, _, Mode::Standalone) => None,
+        (Some(s), Some(l), _) => Some((s.clone(), l.clone())),
+        (None, _, _) => bail!(
+            "--filter {}: give --sightings and --landmarks, or --filter none",
+            args.filter
+        ),
+        (Some(_), None, _) => bail!("--sightings needs --landmarks"),
+    };
     let inputs = logs::ReplayInputs {
         imu: args.imu.clone(),
-        sightings: args.sightings.clone(),
-        landmarks: args.landmarks.clone(),
-        initial: args.init.clone(),
+        sightings,
+        initial,
         config,
+        max_gap_s: args.max_gap_s,
+        rate: args.rate.map_or(SolutionRate::EveryImu, SolutionRate::Hz),
+        reference,
+        align_s: args.align_s,
+        level,
     };
     let file = std::fs::File::create(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut out = BufWriter::new(file);
     let summary = logs::replay(&inputs, &mut out, &args.out)?;
+    report(args, &summary)
+}
+
+fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
     eprintln!(
-        "nav-app ins: {} IMU samples, {} sighting epochs, {} sightings used, {} rejected by the gate; wrote {}",
-        summary.imu_samples,
-        summary.epochs,
-        summary.sightings_used,
-        summary.sightings_rejected,
+        "nav-app ins: {} IMU samples to t = {:.3} s ({} before the start skipped), {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; wrote {}",
+        s.imu_samples,
+        s.end_t_s,
+        s.imu_skipped,
+        s.gaps,
+        s.longest_gap_s,
+        s.epochs,
+        s.sightings_used,
+        s.sightings_rejected,
         args.out.display()
     );
-    if let Some(truth) = &args.truth {
-        let c = logs::compare_with_truth(truth, &summary.solution)?;
-        if c.matched == 0 {
-            bail!("{}: no truth row at the solution's times", truth.display());
-        }
-        let [n, e, d] = c.last_pos_err_ned_m;
-        let [pn, pe, pd] = c.last_psi_rad;
+    if let Some(a) = &s.alignment {
+        let [x, y, z] = a.gyro_bias_body_radps;
         eprintln!(
-            "nav-app ins: against {} ({} epochs): at t = {} s position error N {n:.3} m, E {e:.3} m, D {d:.3} m (3-D {:.3} m), misalignment {:.4} / {:.4} / {:.4} mrad; 3-D RMS {:.3} m, max {:.3} m",
-            truth.display(),
-            c.matched,
-            c.last_t_s,
-            (n * n + e * e + d * d).sqrt(),
-            pn * 1e3,
-            pe * 1e3,
-            pd * 1e3,
-            c.rms_pos_3d_m,
-            c.max_pos_3d_m
+            "nav-app ins: aligned on {} samples at rest: gyro bias ({:.4}, {:.4}, {:.4}) °/s{}",
+            a.samples,
+            x.to_degrees(),
+            y.to_degrees(),
+            z.to_degrees(),
+            a.roll_pitch_rad.map_or(String::new(), |[r, p]| format!(
+                ", levelled to roll {:.2}°, pitch {:.2}°",
+                r.to_degrees(),
+                p.to_degrees()
+            ))
         );
     }
+    if s.offset_sightings {
+        eprintln!(
+            "nav-app ins: note: the sightings are offsets (t_s,landmark_id,w_m,h_m): they mean what they say only to the filter that pointed the device"
+        );
+    }
+    let (Some(truth), Some(m)) = (&args.truth, &s.metrics) else {
+        return Ok(());
+    };
+    if m.compared == 0 {
+        bail!("{}: no reference row inside the replay", truth.display());
+    }
+    print_metrics(truth, m);
+    if let Some(path) = &args.metrics_json {
+        let json = serde_json::json!({
+            "schema": 1,
+            "filter": args.filter,
+            "imu_samples": s.imu_samples,
+            "epochs": s.epochs,
+            "sightings_used": s.sightings_used,
+            "sightings_rejected": s.sightings_rejected,
+            "gaps": s.gaps,
+            "longest_gap_s": s.longest_gap_s,
+            "metrics": m,
+        });
+        std::fs::write(path, serde_json::to_string_pretty(&json)? + "\n")
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.plot {
+        let title = format!("{} against {}", args.filter, truth.display());
+        let png = ins_monte_carlo::plot::replay_figure(&m.series, &title)?;
+        std::fs::write(path, png).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
+}
+
+fn print_metrics(truth: &Path, m: &ReplayMetrics) {
+    let line = |what: &str, unit: &str, e: &logs::ErrorStats, scale: f64| {
+        eprintln!(
+            "  {what:<9} RMS {:>9.3} {unit}, max {:>9.3} {unit}, last {:>9.3} {unit}; inside 2σ {:>5.1} %",
+            e.rms * scale,
+            e.max * scale,
+            e.last * scale,
+            100.0 * e.inside_2sigma
+        );
+    };
+    eprintln!(
+        "nav-app ins: against {} ({} times, {:.1}–{:.1} s):",
+        truth.display(),
+        m.compared,
+        m.span_s[0],
+        m.span_s[1]
+    );
+    line("position", "m", &m.position_m, 1.0);
+    line("velocity", "m/s", &m.velocity_mps, 1.0);
+    if let Some(a) = &m.attitude_rad {
+        line("attitude", "mrad", a, 1e3);
+    }
+    let band = |b: Option<[f64; 2]>| {
+        b.map_or(String::new(), |[lo, hi]| {
+            format!(" (χ² 95 % band {lo:.3}–{hi:.3})")
+        })
+    };
+    if let Some(n) = m.nees_per_dof {
+        eprintln!(
+            "  NEES per dof {n:.3} over {} dof{}",
+            m.nees_dof,
+            band(m.nees_band_95)
+        );
+    }
+    if let Some(n) = m.nis_per_dof {
+        eprintln!(
+            "  NIS per dof {n:.3} over {} dof{}",
+            m.nis_dof,
+            band(m.nis_band_95)
+        );
+    }
+}
+
+fn run_sightings(args: &SightingsArgs) -> Result<()> {
+    let reference = logs::read_reference(&args.reference)?;
+    if let Some(n) = args.make_landmarks {
+        let (lo, hi) = (args.landmark_range_m[0], args.landmark_range_m[1]);
+        let entries = logs::landmarks_around(&reference, n, lo, hi, args.seed)?;
+        logs::write_landmarks(&args.landmarks, &entries)?;
+        eprintln!(
+            "nav-app ins sightings: wrote {n} landmarks to {}",
+            args.landmarks.display()
+        );
+    }
+    let table = logs::read_landmarks(&args.landmarks)?;
+    let plan = SightingPlan {
+        sigma_m: args.sigma_m,
+        period_s: args.period_s,
+        min_range_m: args.min_range_m,
+        max_range_m: args.max_range_m,
+        field_of_regard_deg: args.field_of_regard_deg,
+        max_per_epoch: args.max_per_epoch,
+        seed: args.seed,
+        ..SightingPlan::default()
+    };
+    let file = std::fs::File::create(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let w = logs::write_sightings(
+        &reference,
+        &table,
+        &plan,
+        &mut BufWriter::new(file),
+        &args.out,
+    )?;
+    eprintln!(
+        "nav-app ins sightings: {} epochs, {} sightings ({} directions), at least {} landmarks per epoch, {} epochs with none in view; wrote {}",
+        w.epochs,
+        w.sightings,
+        if w.frame_is_body {
+            "body"
+        } else {
+            "local-level"
+        },
+        w.min_per_epoch,
+        w.empty_epochs,
+        args.out.display()
+    );
     Ok(())
 }
 
@@ -124,11 +409,17 @@ pub(crate) fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
 
 /// `nav-app ins …` (`args` from the subcommand's name on); returns the process exit code.
 pub fn main(args: impl IntoIterator<Item = std::ffi::OsString>) -> ExitCode {
-    let args = InsArgs::parse_from(args);
-    match run_ins(&args) {
+    let args: Vec<std::ffi::OsString> = args.into_iter().collect();
+    let result = if args.get(1).is_some_and(|a| a == "sightings") {
+        let parsed = SightingsArgs::parse_from(args.iter().skip(1));
+        run_sightings(&parsed).map_err(|e| ("nav-app ins sightings", e))
+    } else {
+        run_ins(&InsArgs::parse_from(&args)).map_err(|e| ("nav-app ins", e))
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("nav-app ins: error: {}", error_chain(e.as_ref()));
+        Err((who, e)) => {
+            eprintln!("{who}: error: {}", error_chain(e.as_ref()));
             ExitCode::from(1)
         }
     }
