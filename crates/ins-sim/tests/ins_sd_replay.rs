@@ -275,3 +275,116 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The exported IMU log (increments) rewritten at 104.4 Hz with ±0.4 ms of jitter and a 0.5 s
+/// gap at t ≈ 20 s: the time stamps are used as logged, the gap is bridged and reported, and the
+/// replay reaches the end; a gap beyond `max_gap_s` names its line.
+#[test]
+fn a_jittery_104_hz_log_with_a_gap_replays_to_the_end() {
+    let sc = Scenario::paper_default().truncated(40.0).unwrap();
+    let dir = temp_dir("jitter");
+    logs::export_run(&sc, Mode::Kf, 5, &dir).unwrap();
+    let text = std::fs::read_to_string(dir.join(names::IMU)).unwrap();
+    let mut lines = text.lines();
+    let mut out = vec![lines.next().unwrap().to_string()];
+    let scale = 100.0 / 104.4;
+    let mut last_t = 0.0;
+    for (k, line) in lines.enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        let t: f64 = f[0].parse().unwrap();
+        let jitter = 4e-4 * ((k as f64 * 1.7).sin());
+        let t_new = t * scale + jitter;
+        if (20.0..20.5).contains(&t_new) {
+            continue; // the gap
+        }
+        out.push(format!("{t_new:e},{}", f[1..].join(",")));
+        last_t = t_new;
+    }
+    let imu = dir.join("imu_jitter.csv");
+    std::fs::write(&imu, out.join("\n") + "\n").unwrap();
+    let mut inp = inputs(&dir, Mode::Kf);
+    inp.imu = imu.clone();
+    inp.config.imu_step_s = logs::imu_nominal_step_s(&imu).unwrap();
+    assert!(
+        (inp.config.imu_step_s - 1.0 / 104.4).abs() < 1e-3,
+        "{}",
+        inp.config.imu_step_s
+    );
+    inp.config.timestamp_tolerance_s = 0.0;
+    inp.rate = SolutionRate::EveryImu;
+    let summary = replay_to(&dir, &inp).unwrap();
+    assert_eq!(summary.gaps, 1, "{summary:?}");
+    assert!(
+        (summary.longest_gap_s - 0.5).abs() < 0.02,
+        "{}",
+        summary.longest_gap_s
+    );
+    assert_eq!(summary.end_t_s, last_t);
+    assert!(summary.epochs > 30, "{}", summary.epochs);
+    // Rows at every sample, plus the cuts inside the gap: more rows than samples.
+    let rows = std::fs::read_to_string(dir.join("solution_replayed.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    assert!(
+        rows as u64 > summary.imu_samples,
+        "{rows} rows, {} samples",
+        summary.imu_samples
+    );
+
+    // The same gap refused below it, naming the line after the gap.
+    inp.max_gap_s = 0.3;
+    match replay_to(&dir, &inp) {
+        Err(SimError::LogParse {
+            path,
+            line,
+            message,
+            ..
+        }) => {
+            assert_eq!(path, imu);
+            let t_after = l_time(&out, 20.5);
+            let at = out
+                .iter()
+                .position(|l| l.starts_with(&format!("{t_after:e},")))
+                .unwrap();
+            assert_eq!(line, at + 1, "{message}");
+            assert!(message.contains("max_gap_s"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The first time stamp in `lines` (data rows) at or after `t`.
+fn l_time(lines: &[String], t: f64) -> f64 {
+    lines[1..]
+        .iter()
+        .map(|l| l.split(',').next().unwrap().parse::<f64>().unwrap())
+        .find(|v| *v >= t)
+        .unwrap()
+}
+
+/// A sightings log exported from a KF run replays with another filter and tuning: the same
+/// measurements are used, the estimates differ.
+#[test]
+fn an_exported_sightings_log_replays_with_another_filter() {
+    let sc = Scenario::paper_default().truncated(60.0).unwrap();
+    let dir = temp_dir("other-filter");
+    logs::export_run(&sc, Mode::Kf, 9, &dir).unwrap();
+    let kf = replay_to(&dir, &inputs(&dir, Mode::Kf)).unwrap();
+    let mut other = inputs(&dir, Mode::Akf);
+    other.config.process_noise.accel_white_m2ps3 *= 10.0;
+    let akf = replay_to(&dir, &other).unwrap();
+    assert_eq!(kf.epochs, akf.epochs);
+    assert_eq!(kf.sightings_used, akf.sightings_used);
+    let (a, b) = (
+        kf.solution.last().unwrap().1,
+        akf.solution.last().unwrap().1,
+    );
+    let d = error_model::error_state(&a, &b);
+    assert!(
+        d.fixed_rows::<3>(0).norm() > 1e-6,
+        "identical estimates: {d}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
