@@ -113,10 +113,25 @@ class InsSdFilter:
         config: Optional[str] = None,
         filter: FilterName = "kf",
         gate: Optional[float] = None,
+        filter_file: Optional[str] = None,
+        preset: Optional[Literal["mems", "paper"]] = None,
+        imu_step_s: float = 0.01,
     ) -> None:
         """landmarks: TOML landmark table; initial: TOML initial state (the formats export_run
-        writes); config: a scenario file for the filter settings (None: the paper's); gate: chi-square
-        gate probability per sighting (None: no gate). Raises NavError naming the file."""
+        writes); config: a scenario file for the filter settings (None: the paper's), or instead
+        filter_file (TOML in datasheet units, ins_sim::filter_file) / preset with the IMU's
+        imu_step_s; filter "none" (or "standalone"): the unaided INS; gate: chi-square gate
+        probability per sighting (None: no gate). Raises NavError naming the file."""
+    def propagate_rates(
+        self, t_s: float, specific_force_body_mps2: list[float], ang_rate_body_radps: list[float]
+    ) -> None:
+        """One IMU sample ending at t_s as mean rates over it, body FRD."""
+    def update_pointed(
+        self, t_s: float, sightings: list[Tuple[int, Literal["body", "ned"], float, float, float]]
+    ) -> UpdateReport:
+        """Sightings that carry their pointing (landmark_id, frame, x, y, z): the measured line of
+        sight in body or local-level axes (sightings.csv format 2). A direction behind the camera
+        counts as rejected."""
     def propagate(
         self, t_s: float, dv_body_mps: list[float], dtheta_body_rad: list[float]
     ) -> None:
@@ -146,6 +161,41 @@ def export_run(
 ) -> int:
     """Simulate one flight and write its logs (imu.csv, sightings.csv, truth.csv, landmarks.toml,
     initial.toml, scenario.toml, solution.csv) into out_dir; returns the records written."""
+
+def replay(
+    imu: str,
+    out: str,
+    sightings: Optional[str] = None,
+    landmarks: Optional[str] = None,
+    initial: Optional[str] = None,
+    truth: Optional[str] = None,
+    start_s: Optional[float] = None,
+    filter: Literal["none"] | FilterName = "kf",
+    filter_file: Optional[str] = None,
+    preset: Optional[Literal["mems", "paper"]] = None,
+    gate: Optional[float] = None,
+    align_s: float = 0.0,
+    max_gap_s: float = 5.0,
+    rate_hz: Optional[float] = None,
+) -> dict:
+    """Replay an IMU log as `nav-app ins` does; returns imu_samples, epochs, sightings_used,
+    sightings_rejected, gaps, longest_gap_s, end_t_s and, with truth, metrics (as --metrics-json)."""
+
+def write_sightings(
+    reference: str,
+    landmarks: str,
+    out: str,
+    sigma_m: float = 1.0,
+    period_s: float = 1.0,
+    max_range_m: float = 1000.0,
+    max_per_epoch: int = 6,
+    field_of_regard_deg: float = 180.0,
+    make_landmarks: Optional[int] = None,
+    landmark_range_m: Tuple[float, float] = (50.0, 300.0),
+    seed: int = 1,
+) -> dict:
+    """Write pointed sightings from a reference trajectory (nav-app ins sightings); with
+    make_landmarks, place that many landmarks around it first and write them to `landmarks`."""
 
 def run_flight(
     config: Optional[str] = None,

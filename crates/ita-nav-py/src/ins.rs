@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use ins_errors::strapdown::NavState;
+use ins_sim::filter_file::FilterFile;
 use ins_sim::{Mode, Sample, Scenario, logs};
 
 use crate::NavError;
@@ -30,16 +31,43 @@ fn load_scenario(config: Option<&str>) -> PyResult<Scenario> {
     }
 }
 
+fn report_dict<'py>(
+    py: Python<'py>,
+    r: &ins_sd_filter::UpdateReport,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("used", r.used)?;
+    d.set_item("rejected", r.rejected)?;
+    d.set_item("nis", r.nis)?;
+    d.set_item("adaptive_q", r.adaptive_q)?;
+    d.set_item("fed_back", r.fed_back)?;
+    Ok(d)
+}
+
+/// A filter file by path, or a compiled-in preset by name (`mems` when neither is given).
+fn load_filter_file(path: Option<&str>, preset: Option<&str>) -> PyResult<FilterFile> {
+    match (path, preset) {
+        (Some(_), Some(_)) => Err(PyValueError::new_err(
+            "give filter_file or preset, not both",
+        )),
+        (Some(path), None) => {
+            let text = std::fs::read_to_string(path).map_err(|e| err(format!("{path}: {e}")))?;
+            FilterFile::from_toml_str(&text, path).map_err(err)
+        }
+        (None, name) => FilterFile::preset(name.unwrap_or("mems")).map_err(err),
+    }
+}
+
 fn mode_of(filter: &str) -> PyResult<Mode> {
     Ok(match filter {
-        "standalone" => Mode::Standalone,
+        "standalone" | "none" => Mode::Standalone,
         "kf" => Mode::Kf,
         "akf" => Mode::Akf,
         "akf_sage_husa" => Mode::AkfSageHusa,
         "akf_structured" => Mode::AkfStructured,
         other => {
             return Err(PyValueError::new_err(format!(
-                "filter must be one of standalone, kf, akf, akf_sage_husa, akf_structured; not {other:?}"
+                "filter must be one of none (standalone), kf, akf, akf_sage_husa, akf_structured; not {other:?}"
             )));
         }
     })
@@ -78,36 +106,86 @@ fn nav_dict<'py>(py: Python<'py>, s: &NavState) -> PyResult<Bound<'py, PyDict>> 
 pub struct InsSdFilter {
     inner: ins_sd_filter::InsSdFilter,
     sightings: Vec<ins_sd_filter::Sighting>,
+    pointed: Vec<ins_sd_filter::PointedSighting>,
 }
 
 #[pymethods]
 impl InsSdFilter {
     #[new]
-    #[pyo3(signature = (landmarks, initial, config=None, filter="kf", gate=None))]
+    #[pyo3(signature = (landmarks, initial, config=None, filter="kf", gate=None, filter_file=None, preset=None, imu_step_s=0.01))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         landmarks: &str,
         initial: &str,
         config: Option<&str>,
         filter: &str,
         gate: Option<f64>,
+        filter_file: Option<&str>,
+        preset: Option<&str>,
+        imu_step_s: f64,
     ) -> PyResult<Self> {
-        let scenario = load_scenario(config)?;
         let mode = mode_of(filter)?;
-        if mode == Mode::Standalone {
-            return Err(PyValueError::new_err(
-                "filter must be a filter (kf, akf, …), not standalone",
-            ));
-        }
-        let mut cfg = scenario.online_filter_config(mode);
-        cfg.gate_probability = gate;
         let table = logs::read_landmarks(Path::new(landmarks)).map_err(err)?;
         let init = logs::read_initial(Path::new(initial)).map_err(err)?;
+        let mut cfg = match (filter_file, preset) {
+            (None, None) => load_scenario(config)?.online_filter_config(mode),
+            (file, name) => {
+                if config.is_some() {
+                    return Err(PyValueError::new_err(
+                        "give either config (a scenario) or filter_file / preset, not both",
+                    ));
+                }
+                load_filter_file(file, name)?
+                    .filter_config(mode, imu_step_s, init.t_s)
+                    .map_err(err)?
+            }
+        };
+        cfg.gate_probability = gate;
         let inner = ins_sd_filter::InsSdFilter::new(cfg, table, init.nav_state(), init.t_s)
             .map_err(|e| err(format!("{initial}: {e}")))?;
         Ok(InsSdFilter {
             inner,
             sightings: Vec::new(),
+            pointed: Vec::new(),
         })
+    }
+
+    /// One IMU sample ending at `t_s` (s) as mean rates over it: `specific_force_body_mps2` and
+    /// `ang_rate_body_radps` (3 components each, body FRD). Raises `NavError` as `propagate`.
+    fn propagate_rates(
+        &mut self,
+        t_s: f64,
+        specific_force_body_mps2: Vec<f64>,
+        ang_rate_body_radps: Vec<f64>,
+    ) -> PyResult<()> {
+        let f = vec3("specific_force_body_mps2", &specific_force_body_mps2)?;
+        let w = vec3("ang_rate_body_radps", &ang_rate_body_radps)?;
+        self.inner.propagate_rates(t_s, &f, &w).map_err(err)
+    }
+
+    /// Sightings that carry their pointing at epoch `t_s`: `(landmark_id, frame, x, y, z)` with
+    /// `frame` `"body"` or `"ned"` and (x, y, z) the measured line of sight (format 2 of
+    /// `sightings.csv`). Returns what `update` returns; a direction behind the camera counts as
+    /// rejected.
+    fn update_pointed<'py>(
+        &mut self,
+        py: Python<'py>,
+        t_s: f64,
+        sightings: Vec<(u32, String, f64, f64, f64)>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        self.pointed.clear();
+        for (id, frame, x, y, z) in sightings {
+            let frame = ins_sd_filter::LosFrame::parse(&frame).ok_or_else(|| {
+                PyValueError::new_err(format!("frame must be \"body\" or \"ned\", not {frame:?}"))
+            })?;
+            self.pointed.push(ins_sd_filter::PointedSighting {
+                landmark_id: id,
+                frame,
+                los: Vector3::new(x, y, z),
+            });
+        }
+        let r = self.inner.update_pointed(t_s, &self.pointed).map_err(err)?;
+        report_dict(py, &r)
     }
 
     /// One IMU sample ending at `t_s` (s): `dv_body_mps` = ∫ f̃ dt and `dtheta_body_rad` = ∫ ω̃ dt
@@ -144,13 +222,7 @@ impl InsSdFilter {
                 }),
         );
         let r = self.inner.update(t_s, &self.sightings).map_err(err)?;
-        let d = PyDict::new(py);
-        d.set_item("used", r.used)?;
-        d.set_item("rejected", r.rejected)?;
-        d.set_item("nis", r.nis)?;
-        d.set_item("adaptive_q", r.adaptive_q)?;
-        d.set_item("fed_back", r.fed_back)?;
-        Ok(d)
+        report_dict(py, &r)
     }
 
     /// Time of the INS, s.
@@ -364,5 +436,124 @@ pub fn monte_carlo<'py>(
         per_mode.set_item(name, m)?;
     }
     d.set_item("modes", per_mode)?;
+    Ok(d)
+}
+
+/// Replay an IMU log (increments or rates) through the filter, as `nav-app ins` does: sightings
+/// (with `landmarks`) or unaided (`filter="none"`), the initial state from `initial` or from the
+/// reference `truth` at `start_s`, the filter settings from `filter_file` or `preset` (default
+/// mems), an optional static alignment `align_s`, solution rows into `out` at `rate_hz` (None:
+/// every sample). Returns the summary, and with `truth` the metrics (`position_m`,
+/// `velocity_mps`, `attitude_rad`, `nees_per_dof`, `nis_per_dof`, … as in `--metrics-json`).
+#[pyfunction]
+#[pyo3(signature = (imu, out, sightings=None, landmarks=None, initial=None, truth=None, start_s=None, filter="kf", filter_file=None, preset=None, gate=None, align_s=0.0, max_gap_s=5.0, rate_hz=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn replay<'py>(
+    py: Python<'py>,
+    imu: &str,
+    out: &str,
+    sightings: Option<&str>,
+    landmarks: Option<&str>,
+    initial: Option<&str>,
+    truth: Option<&str>,
+    start_s: Option<f64>,
+    filter: &str,
+    filter_file: Option<&str>,
+    preset: Option<&str>,
+    gate: Option<f64>,
+    align_s: f64,
+    max_gap_s: f64,
+    rate_hz: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let request = logs::ReplayRequest {
+        imu: imu.into(),
+        sightings: sightings.map(Into::into).zip(landmarks.map(Into::into)),
+        initial: initial.map(Into::into),
+        reference: truth.map(Into::into),
+        start_s,
+        settings: logs::FilterSettings::File(load_filter_file(filter_file, preset)?),
+        mode: mode_of(filter)?,
+        gate: gate.map(|p| (p != 0.0).then_some(p)),
+        align_s,
+        max_gap_s,
+        rate: rate_hz.map_or(logs::SolutionRate::EveryImu, logs::SolutionRate::Hz),
+    };
+    let inputs = request.inputs().map_err(err)?;
+    let summary = py
+        .detach(|| -> Result<logs::ReplaySummary, String> {
+            let file = std::fs::File::create(out).map_err(|e| format!("{out}: {e}"))?;
+            let mut w = std::io::BufWriter::new(file);
+            logs::replay(&inputs, &mut w, Path::new(out)).map_err(|e| e.to_string())
+        })
+        .map_err(err)?;
+    let d = PyDict::new(py);
+    d.set_item("imu_samples", summary.imu_samples)?;
+    d.set_item("epochs", summary.epochs)?;
+    d.set_item("sightings_used", summary.sightings_used)?;
+    d.set_item("sightings_rejected", summary.sightings_rejected)?;
+    d.set_item("gaps", summary.gaps)?;
+    d.set_item("longest_gap_s", summary.longest_gap_s)?;
+    d.set_item("end_t_s", summary.end_t_s)?;
+    if let Some(m) = &summary.metrics {
+        let json = serde_json::to_string(m).map_err(err)?;
+        let json_mod = py.import("json")?;
+        d.set_item("metrics", json_mod.call_method1("loads", (json,))?)?;
+    }
+    Ok(d)
+}
+
+/// Write a pointed-sightings log from a reference trajectory (`nav-app ins sightings`): with
+/// `make_landmarks=N`, first place N landmarks around it (`landmark_range_m`, seeded) and write
+/// them to `landmarks`. Returns `{"epochs", "sightings", "min_per_epoch", "empty_epochs",
+/// "frame"}`.
+#[pyfunction]
+#[pyo3(signature = (reference, landmarks, out, sigma_m=1.0, period_s=1.0, max_range_m=1000.0, max_per_epoch=6, field_of_regard_deg=180.0, make_landmarks=None, landmark_range_m=(50.0, 300.0), seed=1))]
+#[allow(clippy::too_many_arguments)]
+pub fn write_sightings<'py>(
+    py: Python<'py>,
+    reference: &str,
+    landmarks: &str,
+    out: &str,
+    sigma_m: f64,
+    period_s: f64,
+    max_range_m: f64,
+    max_per_epoch: usize,
+    field_of_regard_deg: f64,
+    make_landmarks: Option<usize>,
+    landmark_range_m: (f64, f64),
+    seed: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let rows = logs::read_reference(Path::new(reference)).map_err(err)?;
+    if let Some(n) = make_landmarks {
+        let entries =
+            logs::landmarks_around(&rows, n, landmark_range_m.0, landmark_range_m.1, seed)
+                .map_err(err)?;
+        logs::write_landmarks(Path::new(landmarks), &entries).map_err(err)?;
+    }
+    let table = logs::read_landmarks(Path::new(landmarks)).map_err(err)?;
+    let plan = logs::SightingPlan {
+        sigma_m,
+        period_s,
+        max_range_m,
+        max_per_epoch,
+        field_of_regard_deg,
+        seed,
+        ..logs::SightingPlan::default()
+    };
+    let file = std::fs::File::create(out).map_err(|e| err(format!("{out}: {e}")))?;
+    let w = logs::write_sightings(
+        &rows,
+        &table,
+        &plan,
+        &mut std::io::BufWriter::new(file),
+        Path::new(out),
+    )
+    .map_err(err)?;
+    let d = PyDict::new(py);
+    d.set_item("epochs", w.epochs)?;
+    d.set_item("sightings", w.sightings)?;
+    d.set_item("min_per_epoch", w.min_per_epoch)?;
+    d.set_item("empty_epochs", w.empty_epochs)?;
+    d.set_item("frame", if w.frame_is_body { "body" } else { "ned" })?;
     Ok(d)
 }

@@ -357,6 +357,8 @@ fn ita_nav(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ins::InsSdFilter>()?;
     m.add_function(wrap_pyfunction!(ins::export_run, m)?)?;
     m.add_function(wrap_pyfunction!(ins::run_flight, m)?)?;
+    m.add_function(wrap_pyfunction!(ins::replay, m)?)?;
+    m.add_function(wrap_pyfunction!(ins::write_sightings, m)?)?;
     m.add_function(wrap_pyfunction!(ins::monte_carlo, m)?)?;
     Ok(())
 }

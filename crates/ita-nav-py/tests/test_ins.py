@@ -33,8 +33,8 @@ def replay_in_python(d, gate=None):
     _, imu = read_csv(d / "imu.csv")
     _, sightings = read_csv(d / "sightings.csv")
     epochs = {}
-    for t, lm, w, h in sightings:
-        epochs.setdefault(float(t), []).append((int(lm), float(w), float(h)))
+    for t, lm, frame, x, y, z in sightings:
+        epochs.setdefault(float(t), []).append((int(lm), frame, float(x), float(y), float(z)))
     times = sorted(epochs)
     out, k = [], 0
     for row in imu:
@@ -42,7 +42,7 @@ def replay_in_python(d, gate=None):
         vals = [float(x) for x in row[1:]]
         f.propagate(t, vals[:3], vals[3:])
         while k < len(times) and times[k] <= t + 1e-6:
-            f.update(t, epochs[times[k]])
+            f.update_pointed(t, epochs[times[k]])
             nav = f.navigation()
             out.append([t, nav["lat_rad"], nav["lon_rad"], nav["alt_m"], *nav["vel_ned_mps"]])
             k += 1
@@ -59,8 +59,10 @@ def test_the_python_filter_equals_nav_app_ins_on_the_same_logs(logs, tmp_path):
          "--landmarks", str(logs / "landmarks.toml"), "--init", str(logs / "initial.toml"),
          "--config", str(logs / "scenario.toml"), "--out", str(sol)],
         check=True, capture_output=True, text=True)
-    _, rust_rows = read_csv(sol)
-    rust = np.array([[float(x) for x in r[:7]] for r in rust_rows])
+    header, rust_rows = read_csv(sol)
+    used = header.index("used")
+    # Rows at every IMU sample; the epochs' rows carry the update's counts.
+    rust = np.array([[float(x) for x in r[:7]] for r in rust_rows if r[used] != ""])
     f, py = replay_in_python(logs)
     assert py.shape == rust.shape and len(py) > 800
     # Same filter code, same parsed numbers: identical to the last bit.
@@ -83,9 +85,12 @@ def test_the_gate_rejects_an_outlier_and_bad_input_raises(logs):
         f.propagate(t, vals[:3], vals[3:])
         if t >= first_t - 1e-9:
             break
-    good = [(int(lm), float(w), float(h)) for tt, lm, w, h in sightings if float(tt) == first_t]
-    bad = good[:1] + [(good[1][0], good[1][1] + 5000.0, good[1][2])] + good[2:]
-    r = f.update(t, bad)
+    good = [(int(lm), fr, float(x), float(y), float(z))
+            for tt, lm, fr, x, y, z in sightings if float(tt) == first_t]
+    # Landmark 2's direction turned by about 0.3 rad: kilometres off at the landmark.
+    lm, fr, x, y, z = good[1]
+    bad = good[:1] + [(lm, fr, x + 0.3, y - 0.3, z)] + good[2:]
+    r = f.update_pointed(t, bad)
     assert r["rejected"] == 1 and r["used"] == len(good) - 1
     assert f.update(t, [])["used"] == 0  # no sightings: nothing happens
     with pytest.raises(ita_nav.NavError):
@@ -98,8 +103,49 @@ def test_the_gate_rejects_an_outlier_and_bad_input_raises(logs):
         f.propagate(t + 0.01, [0, 0], [0, 0, 0])
     with pytest.raises(ita_nav.NavError, match="no-such"):
         ita_nav.InsSdFilter("no-such.toml", str(logs / "initial.toml"))
-    with pytest.raises(ValueError, match="standalone"):
-        ita_nav.InsSdFilter(str(logs / "landmarks.toml"), str(logs / "initial.toml"), filter="standalone")
+    with pytest.raises(ValueError, match="filter must be"):
+        ita_nav.InsSdFilter(str(logs / "landmarks.toml"), str(logs / "initial.toml"), filter="ekf")
+    with pytest.raises(ValueError, match="frame"):
+        f.update_pointed(t, [(good[0][0], "enu", 1.0, 0.0, 0.0)])
+
+
+def test_the_filter_file_the_unaided_mode_and_sightings_from_a_reference(logs, tmp_path):
+    # Landmarks and sightings written from the exported truth (radians, with attitude: body
+    # directions), then replayed with the mems preset, the paper preset and unaided.
+    lm = tmp_path / "landmarks.toml"
+    sightings = tmp_path / "sightings.csv"
+    sigma = 40.0 ** 0.5  # the paper's sighting noise, what the paper preset assumes
+    w = ita_nav.write_sightings(str(logs / "truth.csv"), str(lm), str(sightings), sigma_m=sigma,
+                                make_landmarks=12, landmark_range_m=(3000.0, 15000.0),
+                                max_range_m=30000.0, seed=3)
+    assert w["frame"] == "body" and w["min_per_epoch"] >= 4 and w["sightings"] > 0
+    again = tmp_path / "again.csv"
+    ita_nav.write_sightings(str(logs / "truth.csv"), str(lm), str(again), sigma_m=sigma,
+                            max_range_m=30000.0, seed=3)
+    assert sightings.read_bytes() == again.read_bytes()  # seeded
+    runs = {}
+    for name, kw in {"paper": dict(preset="paper"), "none": dict(preset="paper", filter="none")}.items():
+        runs[name] = ita_nav.replay(str(logs / "imu.csv"), str(tmp_path / f"{name}.csv"),
+                                    sightings=str(sightings), landmarks=str(lm),
+                                    truth=str(logs / "truth.csv"), rate_hz=1.0, **kw)
+    aided, free = runs["paper"], runs["none"]
+    assert aided["epochs"] > 800 and free["epochs"] == 0
+    assert aided["metrics"]["position_m"]["rms"] < free["metrics"]["position_m"]["rms"]
+    assert 0.5 < aided["metrics"]["nis_per_dof"] < 2.0
+    # A filter file by path that names the preset replays exactly as the preset.
+    ff = tmp_path / "filter.toml"
+    ff.write_text('preset = "paper"\n')
+    by_file = ita_nav.replay(str(logs / "imu.csv"), str(tmp_path / "file.csv"),
+                             sightings=str(sightings), landmarks=str(lm),
+                             truth=str(logs / "truth.csv"), rate_hz=1.0, filter_file=str(ff))
+    assert by_file["metrics"] == aided["metrics"]
+    f = ita_nav.InsSdFilter(str(lm), str(logs / "initial.toml"), filter_file=str(ff), filter="none")
+    assert f.covariance is not None  # unaided with a filter file: a KF never updated, for its sigma
+    with pytest.raises(ita_nav.NavError, match="sigma_m"):
+        ff.write_text("[sighting]\nsigma_m = -1.0\n")
+        ita_nav.InsSdFilter(str(lm), str(logs / "initial.toml"), filter_file=str(ff))
+    with pytest.raises(ita_nav.NavError, match="initial"):
+        ita_nav.replay(str(logs / "imu.csv"), str(tmp_path / "x.csv"), filter="none")
 
 
 def test_a_simulated_flight_is_deterministic_and_the_filter_beats_the_free_ins():

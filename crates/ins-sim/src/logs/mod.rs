@@ -77,11 +77,13 @@ pub mod names {
 mod read;
 mod reference;
 mod replay;
+mod request;
 mod sightings;
 mod write;
 
 pub use read::*;
 pub use reference::*;
 pub use replay::*;
+pub use request::*;
 pub use sightings::*;
 pub use write::*;

@@ -373,7 +373,7 @@ impl MetricsAcc {
             reference,
             next: 0,
             cursor: 0,
-            max_ref_gap_s: 1.0,
+            max_ref_gap_s: 1.5,
             sum2: [[0.0; 3]; 3],
             sum2_norm: [0.0; 3],
             max: [0.0; 3],

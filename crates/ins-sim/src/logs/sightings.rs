@@ -58,7 +58,7 @@ impl Default for SightingPlan {
             max_range_m: 1000.0,
             field_of_regard_deg: 180.0,
             max_per_epoch: 6,
-            max_reference_gap_s: 0.5,
+            max_reference_gap_s: 1.5,
             seed: 1,
         }
     }

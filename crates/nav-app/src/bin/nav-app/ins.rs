@@ -3,12 +3,15 @@
 
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::Parser;
 use ins_sim::filter_file::FilterFile;
-use ins_sim::logs::{self, ReplayMetrics, ReplaySummary, SightingPlan, SolutionRate};
+use ins_sim::logs::{
+    self, FilterSettings, ReplayMetrics, ReplaySummary, SightingPlan, SolutionRate,
+};
 use ins_sim::{Mode, Scenario};
 
 /// `nav-app ins`: replay an IMU log through the INS/SD filter.
@@ -130,19 +133,22 @@ struct SightingsArgs {
     seed: u64,
 }
 
-fn filter_file(args: &InsArgs) -> Result<Option<FilterFile>> {
+fn filter_settings(args: &InsArgs) -> Result<FilterSettings> {
     if let Some(path) = &args.config {
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
         if text.contains("[trajectory]") {
-            return Ok(None); // an older scenario file: handled by the caller
+            // An older scenario file: its [filter] section.
+            let scenario = Scenario::from_toml_str(&text)
+                .with_context(|| format!("scenario {}", path.display()))?;
+            return Ok(FilterSettings::Scenario(Box::new(scenario)));
         }
-        return Ok(Some(FilterFile::from_toml_str(
+        return Ok(FilterSettings::File(FilterFile::from_toml_str(
             &text,
             &path.display().to_string(),
         )?));
     }
-    Ok(Some(FilterFile::preset(
+    Ok(FilterSettings::File(FilterFile::preset(
         args.preset.as_deref().unwrap_or("mems"),
     )?))
 }
@@ -156,79 +162,29 @@ fn run_ins(args: &InsArgs) -> Result<()> {
                 args.filter
             )
         })?;
-    if let Some(rate) = args.rate
-        && !(rate.is_finite() && rate > 0.0)
-    {
-        bail!("--rate: {rate} is not a positive rate in Hz");
-    }
-    if !(args.max_gap_s.is_finite() && args.max_gap_s > 0.0) {
+    if mode != Mode::Standalone && args.sightings.is_none() {
         bail!(
-            "--max-gap-s: {} is not a positive time in s",
-            args.max_gap_s
-        );
-    }
-    let reference = match &args.truth {
-        Some(path) => Some(logs::read_reference(path)?),
-        None => None,
-    };
-    if !(args.align_s.is_finite() && args.align_s >= 0.0) {
-        bail!("--align-s: {} is not a time >= 0 s", args.align_s);
-    }
-    let mut level = false;
-    let initial = match (&args.init, &reference) {
-        (Some(path), _) => logs::read_initial(path)?,
-        (None, Some(rows)) => {
-            let start = args
-                .start_s
-                .unwrap_or_else(|| rows.first().map_or(0.0, |r| r.t_s));
-            level = rows.iter().any(|r| r.att_b_to_n.is_none());
-            logs::initial_from_reference(rows, start, 1.0)?
-        }
-        (None, None) => bail!(
-            "the initial state: give --init FILE, or --truth FILE to take it from the reference"
-        ),
-    };
-    let imu_step_s = logs::imu_nominal_step_s(&args.imu)?;
-    let mut config = match filter_file(args)? {
-        Some(f) => f.filter_config(mode, imu_step_s, initial.t_s)?,
-        None => {
-            let path = args.config.as_deref().unwrap_or(Path::new(""));
-            let text = std::fs::read_to_string(path)?;
-            let scenario = Scenario::from_toml_str(&text)
-                .with_context(|| format!("scenario {}", path.display()))?;
-            let mut c = scenario.online_filter_config(if mode == Mode::Standalone {
-                Mode::Kf
-            } else {
-                mode
-            });
-            c.imu_step_s = imu_step_s;
-            c.timestamp_tolerance_s = 0.0;
-            c
-        }
-    };
-    if let Some(p) = args.gate {
-        config.gate_probability = (p != 0.0).then_some(p);
-    }
-    let sightings = match (&args.sightings, &args.landmarks, mode) {
-        (_, _, Mode::Standalone) => None,
-        (Some(s), Some(l), _) => Some((s.clone(), l.clone())),
-        (None, _, _) => bail!(
             "--filter {}: give --sightings and --landmarks, or --filter none",
             args.filter
-        ),
-        (Some(_), None, _) => bail!("--sightings needs --landmarks"),
-    };
-    let inputs = logs::ReplayInputs {
+        );
+    }
+    let request = logs::ReplayRequest {
         imu: args.imu.clone(),
-        sightings,
-        initial,
-        config,
+        sightings: args.sightings.clone().zip(args.landmarks.clone()),
+        initial: args.init.clone(),
+        reference: args.truth.clone(),
+        start_s: args.start_s,
+        settings: filter_settings(args)?,
+        mode,
+        gate: args.gate.map(|p| (p != 0.0).then_some(p)),
+        align_s: args.align_s,
         max_gap_s: args.max_gap_s,
         rate: args.rate.map_or(SolutionRate::EveryImu, SolutionRate::Hz),
-        reference,
-        align_s: args.align_s,
-        level,
     };
+    if args.init.is_none() && args.truth.is_none() {
+        bail!("the initial state: give --init FILE, or --truth FILE to take it from the reference");
+    }
+    let inputs = request.inputs()?;
     let file = std::fs::File::create(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut out = BufWriter::new(file);

@@ -1,0 +1,134 @@
+//! A replay as a user asks for it (files, a filter file or preset, a start time, an alignment)
+//! turned into [`ReplayInputs`]: what `nav-app ins` and the Python package both run.
+
+use std::path::PathBuf;
+
+use super::read::{imu_nominal_step_s, read_initial};
+use super::reference::{initial_from_reference, read_reference};
+use super::replay::{ReplayInputs, SolutionRate};
+use crate::filter_file::FilterFile;
+use crate::{Mode, Scenario, SimError};
+
+/// Where the filter settings come from.
+#[derive(Clone, Debug)]
+pub enum FilterSettings {
+    /// A filter file (datasheet units) or preset: time stamps as logged, the IMU step
+    /// estimated from the log, feedback counted from the start.
+    File(FilterFile),
+    /// A simulation scenario's `[filter]` (the older way; the scenario's IMU step and time-stamp
+    /// tolerance are kept, so an exported run replays to round-off).
+    Scenario(Box<Scenario>),
+}
+
+/// A replay request ([`ReplayRequest::inputs`]).
+#[derive(Clone, Debug)]
+pub struct ReplayRequest {
+    /// IMU log.
+    pub imu: PathBuf,
+    /// Sightings log and landmark table (ignored for `Mode::Standalone`).
+    pub sightings: Option<(PathBuf, PathBuf)>,
+    /// Initial state file; without it, the reference at `start_s`.
+    pub initial: Option<PathBuf>,
+    /// Reference trajectory (metrics, and the initial state without `initial`).
+    pub reference: Option<PathBuf>,
+    /// Start of the replay when the initial state comes from the reference, s (default: its
+    /// first row).
+    pub start_s: Option<f64>,
+    /// Filter settings.
+    pub settings: FilterSettings,
+    /// `Mode::Standalone` = unaided (a Kalman filter never updated, for its σ, with a filter
+    /// file; no estimator with a scenario).
+    pub mode: Mode,
+    /// Overrides the gate probability (`Some(None)`: no gate).
+    pub gate: Option<Option<f64>>,
+    /// Static alignment at rest after the start, s (0: none).
+    pub align_s: f64,
+    /// Longest IMU gap bridged, s.
+    pub max_gap_s: f64,
+    /// When solution rows are written.
+    pub rate: SolutionRate,
+}
+
+impl ReplayRequest {
+    /// Reads the reference and the initial state, estimates the IMU step, and builds the
+    /// filter configuration.
+    ///
+    /// # Errors
+    /// The readers' errors (file, line, column), [`SimError::ReferenceSpan`] for a start
+    /// outside the reference, [`SimError::ScenarioInvalid`] for a request without an initial
+    /// state or sightings for a filter, [`SimError::FilterFileConfig`].
+    pub fn inputs(&self) -> Result<ReplayInputs, SimError> {
+        if !(self.align_s.is_finite() && self.align_s >= 0.0) {
+            return Err(SimError::invalid(
+                "align_s",
+                "must be a time >= 0 s",
+                self.align_s,
+            ));
+        }
+        if !(self.max_gap_s.is_finite() && self.max_gap_s > 0.0) {
+            return Err(SimError::invalid(
+                "max_gap_s",
+                "must be a time > 0 s",
+                self.max_gap_s,
+            ));
+        }
+        if let SolutionRate::Hz(hz) = self.rate
+            && !(hz.is_finite() && hz > 0.0)
+        {
+            return Err(SimError::invalid("rate", "must be a rate > 0 Hz", hz));
+        }
+        let reference = match &self.reference {
+            Some(path) => Some(read_reference(path)?),
+            None => None,
+        };
+        let mut level = false;
+        let initial = match (&self.initial, &reference) {
+            (Some(path), _) => read_initial(path)?,
+            (None, Some(rows)) => {
+                let start = self
+                    .start_s
+                    .unwrap_or_else(|| rows.first().map_or(0.0, |r| r.t_s));
+                level = rows.iter().any(|r| r.att_b_to_n.is_none());
+                initial_from_reference(rows, start, 1.0)?
+            }
+            (None, None) => {
+                return Err(SimError::invalid(
+                    "initial",
+                    "an initial state file, or a reference to take it from",
+                    "none",
+                ));
+            }
+        };
+        let mut config = match &self.settings {
+            FilterSettings::File(f) => {
+                f.filter_config(self.mode, imu_nominal_step_s(&self.imu)?, initial.t_s)?
+            }
+            FilterSettings::Scenario(s) => s.online_filter_config(self.mode),
+        };
+        if let Some(gate) = self.gate {
+            config.gate_probability = gate;
+        }
+        let sightings = match (&self.sightings, self.mode) {
+            (_, Mode::Standalone) => None,
+            (Some(pair), _) => Some(pair.clone()),
+            (None, _) => {
+                return Err(SimError::invalid(
+                    "sightings",
+                    "a filter needs a sightings log and a landmark table (or the unaided mode)",
+                    self.mode.name(),
+                ));
+            }
+        };
+        Ok(ReplayInputs {
+            imu: self.imu.clone(),
+            sightings,
+            initial,
+            config,
+            max_gap_s: self.max_gap_s,
+            rate: self.rate,
+            reference,
+            align_s: self.align_s,
+            level,
+        })
+    }
+}
