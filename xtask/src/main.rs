@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 mod eval_lanes;
 mod fixtures;
 mod halves;
+mod ins_real;
 mod monte_carlo;
 mod paths;
 mod python;
@@ -58,6 +59,10 @@ enum Cmd {
     /// product binary and runs `nav-app monte-carlo …` (arguments passed through; outputs under
     /// target/monte-carlo/).
     MonteCarlo(monte_carlo::MonteCarloArgs),
+    /// The INS/SD filter on the real IMU logs (--data, default ../shared/data/ins) through
+    /// `nav-app ins`: unaided, KF and AKF with the mems and paper presets; writes summary.md,
+    /// the metrics and the KF's error plots into target/ins-real/.
+    InsReal(ins_real::InsRealArgs),
 }
 
 fn main() -> Result<()> {
@@ -71,6 +76,7 @@ fn main() -> Result<()> {
         Cmd::Python(args) => python::run(args),
         Cmd::Halves => halves::run(),
         Cmd::MonteCarlo(args) => monte_carlo::run(args),
+        Cmd::InsReal(args) => ins_real::run(args),
     }
 }
 

@@ -275,10 +275,8 @@ impl FilterFile {
             vel_sigma_mps: get(n.vel_sigma_mps, "initial.vel_sigma_mps")?,
             att_sigma_deg: get(n.att_sigma_deg, "initial.att_sigma_deg")?,
             sighting_sigma_m: get(s.sigma_m, "sighting.sigma_m")?,
-            gate_probability: match get(s.gate_probability, "sighting.gate_probability")? {
-                p if p == 0.0 => None,
-                p => Some(p),
-            },
+            gate_probability: Some(get(s.gate_probability, "sighting.gate_probability")?)
+                .filter(|p| *p != 0.0),
             update_period_s: get(f.update_period_s, "filter.update_period_s")?,
             phi_subintervals: f
                 .phi_subintervals

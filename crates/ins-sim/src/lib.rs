@@ -220,6 +220,7 @@ mod error;
 pub mod filter_file;
 pub mod logs;
 mod mismatch;
+pub mod real_sets;
 pub mod runs;
 mod scenario;
 pub mod stats;

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use ins_sim::Mode;
 use ins_sim::filter_file::FilterFile;
 use ins_sim::logs::{self, ReplayInputs, ReplaySummary, SightingPlan, SolutionRate};
+use ins_sim::real_sets::{REAL_SEED, REAL_SETS, RealSet};
 
 fn data_root() -> PathBuf {
     match std::env::var_os("ITA_NAV_DATA") {
@@ -19,40 +20,8 @@ fn data_root() -> PathBuf {
     }
 }
 
-/// One real set and how it is replayed.
-struct Set {
-    name: &'static str,
-    /// Replay start, s (after the hand-held part of EuRoC).
-    start_s: Option<f64>,
-    /// At rest for this long after the start, s.
-    align_s: f64,
-    /// Landmarks placed at these horizontal distances from the trajectory, m.
-    landmark_range_m: (f64, f64),
-    landmarks: usize,
-    max_range_m: f64,
-}
-
-const SETS: [Set; 2] = [
-    Set {
-        name: "euroc_mh01",
-        start_s: Some(21.0),
-        align_s: 20.0,
-        landmark_range_m: (5.0, 20.0),
-        landmarks: 12,
-        max_range_m: 40.0,
-    },
-    Set {
-        name: "rtkexp_drive0708",
-        start_s: None,
-        align_s: 30.0,
-        landmark_range_m: (30.0, 200.0),
-        landmarks: 60,
-        max_range_m: 500.0,
-    },
-];
-
 fn replay(
-    set: &Set,
+    set: &RealSet,
     dir: &Path,
     preset: &str,
     mode: Mode,
@@ -88,7 +57,7 @@ fn replay(
 fn real_imu_logs_kf_on_the_mems_preset_is_accurate_and_consistent() {
     let root = data_root().join("ins");
     let mut ran = 0;
-    for set in &SETS {
+    for set in &REAL_SETS {
         let d = root.join(set.name);
         if !d.join("imu.csv").is_file() || !d.join("truth.csv").is_file() {
             eprintln!(
@@ -108,7 +77,7 @@ fn real_imu_logs_kf_on_the_mems_preset_is_accurate_and_consistent() {
             set.landmarks,
             set.landmark_range_m.0,
             set.landmark_range_m.1,
-            7,
+            REAL_SEED,
         )
         .unwrap();
         logs::write_landmarks(&dir.join("landmarks.toml"), &entries).unwrap();
@@ -118,7 +87,7 @@ fn real_imu_logs_kf_on_the_mems_preset_is_accurate_and_consistent() {
             period_s: 1.0,
             max_range_m: set.max_range_m,
             max_per_epoch: 6,
-            seed: 7,
+            seed: REAL_SEED,
             ..SightingPlan::default()
         };
         let path = dir.join("sightings.csv");

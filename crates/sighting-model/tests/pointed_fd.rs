@@ -66,7 +66,7 @@ fn worst(h: &SMatrix<f64, 2, STATE_DIM>, fd: &SMatrix<f64, 2, STATE_DIM>, floor_
 
 #[test]
 fn body_direction_h_matches_central_differences() {
-    let mut rng = ChaCha8Rng::seed_from_u64(0x9017_ed);
+    let mut rng = ChaCha8Rng::seed_from_u64(0x0090_17ed);
     for i in 0..200 {
         let (computed, lm) = random_geometry(&mut rng, i);
         let h = jacobian_for_frame(&computed, &lm, LosFrame::Body).unwrap();

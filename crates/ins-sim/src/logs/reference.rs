@@ -182,11 +182,9 @@ pub fn initial_from_reference(
     min_speed_mps: f64,
 ) -> Result<InitialState, SimError> {
     let mut cursor = 0;
-    let at = interpolate(rows, t_s, f64::INFINITY, &mut cursor).ok_or_else(|| {
-        SimError::ReferenceSpan {
-            t_s,
-            what: "the start of the replay is outside the reference's time span",
-        }
+    let at = interpolate(rows, t_s, f64::INFINITY, &mut cursor).ok_or(SimError::ReferenceSpan {
+        t_s,
+        what: "the start of the replay is outside the reference's time span",
     })?;
     let att = match at.att_b_to_n {
         Some(q) => q,

@@ -248,7 +248,10 @@ fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        let title = format!("{} against {}", args.filter, truth.display());
+        // The reference named by its last two path components (e.g. `euroc_mh01/truth.csv`).
+        let parts: Vec<_> = truth.components().rev().take(2).collect();
+        let name: PathBuf = parts.iter().rev().collect();
+        let title = format!("--filter {} against {}", args.filter, name.display());
         let png = ins_monte_carlo::plot::replay_figure(&m.series, &title)?;
         std::fs::write(path, png).with_context(|| format!("writing {}", path.display()))?;
     }
