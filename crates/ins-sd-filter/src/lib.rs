@@ -34,9 +34,21 @@
 //!   into z = H x + v, R = r I, and applied with the Joseph-form update; the reported NIS is
 //!   νᵀ S⁻¹ ν of the stack (χ² with 2·used dof). The Mohamed–Schwarz estimator is then pushed
 //!   Δx = x̂⁺ − x̂⁻, P⁺, the previous P⁺ and Φ since that push.
+//! * **Pointed sightings** ([`InsSdFilter::update_pointed`]): a sighting that carries its
+//!   pointing (the measured line of sight in body or local-level axes, [`PointedSighting`]) is
+//!   turned into the offsets a camera pointed with this filter's INS would have seen
+//!   (`sighting_model::offsets_from_los`) and used as above; local-level directions do not see
+//!   the attitude (H's ψ columns zero). Such a record means the same to any filter, whoever
+//!   recorded it; a direction that points away from its landmark as seen from the INS is
+//!   rejected. The paper's offsets ([`InsSdFilter::update`]) are the special case the Monte
+//!   Carlo uses (the device pointed by the filter's own INS).
 //! * **Feedback** at epochs t ≥ `open_loop_until_s`: δp̂, δv̂, ψ̂ are removed from the INS,
 //!   ∇̂, ε̂ added to its sensor corrections, x̂ ← 0, P kept.
 //! * 0 sightings at an epoch: nothing happens (the interval continues to the next epoch).
+//! * Between epochs, [`InsSdFilter::predicted`] gives (x̂, P) at the INS time (the a-priori Q
+//!   of the part of the interval elapsed, or the adaptive Q̂ scaled to it): the σ a solution
+//!   is reported with at any IMU sample. Sensor biases known beforehand (a static alignment)
+//!   are set with [`InsSdFilter::set_sensor_corrections`].
 //!
 //! ## Estimators ([`ErrorStateEstimator`])
 //!

@@ -1,5 +1,5 @@
-//! Log formats of the INS/SD filter, export of a simulated run, and replay through the online
-//! filter (`nav-app ins`).
+//! Log formats of the INS/SD filter, export of a simulated run, sightings written from a
+//! reference, and replay through the online filter (`nav-app ins`).
 //!
 //! ## Files
 //!
@@ -10,31 +10,46 @@
 //!
 //! | file | header | rows |
 //! |---|---|---|
-//! | IMU | `t_s,dv_x_mps,dv_y_mps,dv_z_mps,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad` | one per IMU sample: time stamp of the end of the sample interval, then the integrated specific force Δv = ∫f̃ dt (m/s) and angle Δθ = ∫ω̃_ib dt (rad) over (previous t, t], body axes FRD; strictly increasing t |
-//! | sightings | `t_s,landmark_id,w_m,h_m` | one per sighting: epoch time, landmark id (integer, in the landmark table), offsets w (image right) and h (image down) of the landmark from the image centre, m at the landmark, with the camera pointed by the INS's own position and attitude; the rows of one epoch share t; epochs non-decreasing |
-//! | truth | `t_s,lat_rad,lon_rad,alt_m,vel_n_mps,vel_e_mps,vel_d_mps,q_w,q_x,q_y,q_z` | true navigation state (WGS-84 geodetic, NED velocity, body→NED quaternion) at any times (the simulator writes 1 Hz) |
-//! | solution (output) | the truth header plus `,sigma_n_m,sigma_e_m,sigma_d_m,nis,used,rejected` | the filter's navigation solution after each sighting epoch, its 1σ position uncertainty (NED, m), the epoch's NIS (empty when no sighting was used), sightings used and rejected by the gate |
+//! | IMU, increments | `t_s,dv_x_mps,dv_y_mps,dv_z_mps,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad` | one per IMU sample: time stamp of the end of the sample interval, then the integrated specific force Δv = ∫f̃ dt (m/s) and angle Δθ = ∫ω̃_ib dt (rad) over (previous t, t], body axes FRD; strictly increasing t, any rate and jitter |
+//! | IMU, rates | `t_s,gyro_x_radps,gyro_y_radps,gyro_z_radps,accel_x_mps2,accel_y_mps2,accel_z_mps2` | the same as mean angular rate (rad/s) and specific force (m/s²) over (previous t, t] (what most IMUs and the data sets write) |
+//! | sightings, format 2 | `t_s,landmark_id,frame,los_x,los_y,los_z` | one per sighting: epoch time, landmark id (in the landmark table), `frame` `body` (FRD) or `ned` (local level), and the measured line of sight to the landmark in that frame (any length > 0): the device's pointing and image offset combined (`sighting_model::pointed`), so any filter predicts it from its own state; rows of one epoch share t; epochs non-decreasing |
+//! | sightings, format 1 | `t_s,landmark_id,w_m,h_m` | the paper's offsets w (image right), h (image down) of the landmark from the image centre, m at the landmark, with the camera pointed by the recording INS's own position and attitude: still read, but meaningful only to the filter that recorded them (the replay says so) |
+//! | truth / reference | `t_s,lat_rad,lon_rad,alt_m,vel_n_mps,vel_e_mps,vel_d_mps,q_w,q_x,q_y,q_z` or `t_s,lat_deg,lon_deg,alt_m,vn_mps,ve_mps,vd_mps,qw,qx,qy,qz` | navigation state (WGS-84 geodetic, NED velocity, body→NED quaternion) at any increasing times; in the degrees form the four quaternion fields may all be empty (no attitude) |
+//! | solution (output) | the truth header plus `,sigma_n_m,sigma_e_m,sigma_d_m,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,sigma_psi_n_rad,sigma_psi_e_rad,sigma_psi_d_rad,nis,used,rejected` | the navigation solution at every IMU sample, at a rate, or after each epoch ([`SolutionRate`]), with the 1σ of its position, velocity and attitude (ψ) errors from P at that time (empty without an estimator); `nis`, `used`, `rejected` after an epoch, empty otherwise |
 //!
 //! The landmark table is TOML, one `[[landmarks]]` table per landmark with `id` (integer),
 //! `lat_deg`, `lon_deg` (WGS-84, degrees) and `alt_m` (above the ellipsoid, m). The INS's
 //! initial state is TOML too: `t_s`, `lat_rad`, `lon_rad`, `alt_m`, `vel_ned_mps = [n, e, d]`,
-//! `att_quat_wxyz = [w, x, y, z]` (body FRD → NED). The filter's settings come from a scenario
-//! file (`[filter]`, `[sighting] update_period_s`, `[trajectory] step_s`; `configs/paper.toml`).
+//! `att_quat_wxyz = [w, x, y, z]` (body FRD → NED), or is taken from the reference
+//! ([`initial_from_reference`]). The filter's settings come from a filter file
+//! ([`crate::filter_file`]) or, the older way, a scenario's `[filter]` ([`FilterSettings`]).
 //!
 //! ## Replay
 //!
-//! [`replay`] reads the IMU log sample by sample and hands each to
-//! [`ins_sd_filter::InsSdFilter::propagate`]; a sighting epoch is applied at the first IMU time
-//! at or after its time stamp (within the filter's time-stamp tolerance it is the same time).
-//! Every malformed field, short line or filter rejection is an error naming the file, the line
-//! (1-based) and the column (1-based start of the field).
+//! [`replay`] reads the IMU log sample by sample and hands each to the online filter
+//! ([`ins_sd_filter::InsSdFilter`]); a sighting epoch is applied at its own time (the sample that
+//! spans it is cut there), gaps are bridged ([`GAP_FACTOR`]), the solution is written at the
+//! requested rate and compared with a reference on the way ([`ReplayMetrics`]); an optional
+//! static alignment ([`align_at_rest`]) takes the gyro bias (and without a reference attitude,
+//! roll and pitch) from a rest period. [`ReplayRequest`] turns what a user gives (`nav-app ins`,
+//! the Python package) into [`ReplayInputs`]. Every malformed field, short line or filter
+//! rejection is an error naming the file, the line (1-based) and the column (1-based start of
+//! the field).
+//!
+//! ## Sightings from a reference
+//!
+//! [`write_sightings`] writes a format-2 sightings log from a reference trajectory and a
+//! landmark table (σ, period, ranges, field of regard, seed); [`landmarks_around`] places a
+//! seeded table around a reference (`nav-app ins sightings`).
 //!
 //! ## Export
 //!
 //! [`export_run`] simulates one run of a scenario (exactly [`super::run`]'s run) and writes the
-//! logs its filter saw, the truth, and the solution the simulated filter computed. Replaying
-//! the logs reproduces that solution to round-off (`tests/ins_sd_replay.rs`: the IMU samples go
-//! through Δv/Δt once more).
+//! logs its filter saw, the truth, and the solution the simulated filter computed. The
+//! sightings are written in format 2 (the simulated offsets as body directions through the
+//! pointing of the simulated INS, `sighting_model::los_from_offsets`), so any filter can replay
+//! them; the same filter reproduces the simulated solution to round-off
+//! (`tests/ins_sd_replay.rs`).
 
 /// Header of the IMU log.
 pub const IMU_HEADER: &str =

@@ -32,11 +32,17 @@
 //! `--device` fails saying capture is not in this build.
 //!
 //! ## INS/SD log replay
-//! `nav-app ins --imu imu.csv --sightings sightings.csv --landmarks landmarks.toml --init
-//! initial.toml [--config configs/paper.toml] [--filter kf|akf] [--gate P] --out solution.csv
-//! [--truth truth.csv]` replays logs through the online filter (`ins_sd_filter`); the formats are
-//! in `ins_sim::logs`, and `nav-app monte-carlo --export-logs DIR` writes a
-//! simulated run in them.
+//! `nav-app ins --imu imu.csv [--sightings sightings.csv --landmarks landmarks.toml]
+//! [--init initial.toml | --truth reference.csv [--start-s T]] [--config filter.toml | --preset
+//! mems|paper] [--filter none|kf|akf|akf_sage_husa|akf_structured] [--align-s S] [--gate P]
+//! [--max-gap-s S] [--rate HZ] --out solution.csv [--truth reference.csv [--metrics-json FILE]
+//! [--plot FILE.png]]` replays an IMU log (increments or rates) through the online filter
+//! (`ins_sd_filter`), aided by sightings or unaided; the filter settings come from a filter file
+//! in datasheet units or a compiled-in preset (`ins_sim::filter_file`; default `mems`, so it runs
+//! from any directory). `nav-app ins sightings --reference reference.csv --landmarks
+//! landmarks.toml [--make-landmarks N] --out sightings.csv` writes sightings from a reference
+//! trajectory. The formats are in `ins_sim::logs`; `nav-app monte-carlo --export-logs DIR` writes
+//! a simulated run in them.
 //!
 //! ## The INS/SD Monte Carlo
 //! `nav-app monte-carlo [--config configs/paper.toml] [--runs N] [--seed S] [--out DIR]
