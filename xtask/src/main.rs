@@ -38,7 +38,8 @@ enum Cmd {
     /// Every check CI runs: formatting, clippy with warnings denied, all tests and doc tests,
     /// the lane regression, the real-data lane evaluation and the vivid V4L2 VM test.
     Test,
-    /// Install the system packages a full build needs (Debian `libclang-dev`, for V4L2 capture).
+    /// Install the system packages a full build and the tests need (Debian `libclang-dev` for
+    /// V4L2 capture, `ffmpeg` for video inputs).
     Setup,
     /// Boot Debian's kernel under qemu with the vivid V4L2 driver and run the capture cases.
     Vivid(vivid::VividArgs),
@@ -68,7 +69,7 @@ enum Cmd {
 fn main() -> Result<()> {
     match Cli::parse().cmd {
         Cmd::Test => test(),
-        Cmd::Setup => vivid::ensure_libclang(),
+        Cmd::Setup => vivid::ensure_test_packages(),
         Cmd::Vivid(args) => vivid::run(args),
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
@@ -152,12 +153,13 @@ const STEPS: &[Step] = &[
 
 /// `cargo xtask test`: the README's test command and `.ci/run`'s.
 ///
-/// First makes sure the one system package the workspace build needs is present (Debian
-/// `libclang-dev`, for the `v4l` crate's bindgen step; installed with apt-get when missing and
-/// running as root or under CI with passwordless sudo), then runs every step and closes with one
-/// `xtask: N passed, M failed` line.
+/// First makes sure the system packages the workspace build and tests need are present (Debian
+/// `libclang-dev`, for the `v4l` crate's bindgen step, and `ffmpeg`, for video inputs; installed
+/// with apt-get when missing and running as root or under CI with passwordless sudo), then runs
+/// every step and closes with one `xtask: N passed, M failed` line.
 fn test() -> Result<()> {
-    vivid::ensure_libclang().context("the workspace build needs libclang (Debian libclang-dev)")?;
+    vivid::ensure_test_packages()
+        .context("the workspace build and tests need libclang-dev and ffmpeg (Debian)")?;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let this = std::env::current_exe().context("cannot locate the xtask binary")?;
     let mut failed = Vec::new();

@@ -313,3 +313,42 @@ fn every_real_udacity_frame_initialised_alone_gives_both_lanes_with_the_default(
     // Measured 220/221 (the paper's initialisation: 221); a few frames of margin.
     assert!(both >= 215, "both lanes on {both} of {frames} stills");
 }
+
+#[test]
+fn the_real_udacity_clip_as_an_mp4_keeps_both_lanes_on_every_frame() {
+    // Encoded with ffmpeg (MPEG-4 part 2, q 2) from the y4m clip and read back through ffmpeg
+    // (`lane_io::video`): the default configuration tracks both lanes on all 221 frames, as on
+    // the y4m.
+    let ffmpeg_ok = std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ffmpeg_ok {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "ffmpeg is missing under CI"
+        );
+        eprintln!("SKIPPED: ffmpeg is not installed");
+        return;
+    }
+    let clip = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).unwrap();
+    let mp4 = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("udacity.mp4");
+    let out = std::process::Command::new("ffmpeg")
+        .args(["-hide_banner", "-v", "error", "-y", "-i"])
+        .arg(&clip)
+        .args(["-c:v", "mpeg4", "-q:v", "2", "-pix_fmt", "yuv420p"])
+        .arg(&mp4)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut source = lane_io::sources::open_input(&mp4, 0.0).unwrap();
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let run = run_tracker(&mut source, &cfg, Estimator::Kif, None).unwrap();
+    let c = continuity(&run.reports, 239.0);
+    assert_eq!(c.frames, 221, "{c:?}");
+    assert_eq!(c.frames_both_reported, 221, "{c:?}");
+}

@@ -18,6 +18,27 @@ pub enum LaneIoError {
         #[source]
         source: io::Error,
     },
+    /// ffmpeg, needed to decode a video file, could not be started.
+    #[error(
+        "{input}: cannot start `{program}` to decode this video ({source}); install ffmpeg (Debian: apt-get install ffmpeg), set ITA_NAV_FFMPEG to its path, or convert the video to .y4m"
+    )]
+    FfmpegMissing {
+        /// The video file.
+        input: String,
+        /// The program tried.
+        program: String,
+        /// Why it could not be started.
+        #[source]
+        source: io::Error,
+    },
+    /// ffmpeg could not decode a video file, or stopped part-way.
+    #[error("{input}: ffmpeg cannot decode it: {reason}")]
+    VideoDecode {
+        /// The video file.
+        input: String,
+        /// ffmpeg's exit status and last message.
+        reason: String,
+    },
     /// A still image could not be decoded (truncated, corrupt or of an unknown format).
     #[error("{path}: cannot decode image: {source}")]
     ImageDecode {

@@ -29,6 +29,7 @@ mod frame;
 pub mod frame_loop;
 pub mod overlay;
 pub mod sources;
+pub mod video;
 pub mod y4m;
 
 /// The capture layer's option types (`--input-select`, `--std`, `--format`, `--size`), re-exported

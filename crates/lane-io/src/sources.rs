@@ -218,8 +218,9 @@ impl FrameSource for ImageDirectory {
 }
 
 /// Open `--input PATH`: `-` is a YUV4MPEG2 stream on stdin, a directory is an image sequence
-/// (at `dir_fps` frames/s), a `.y4m` file (or any file starting with `YUV4MPEG2`) is a stream,
-/// anything else a still image.
+/// (at `dir_fps` frames/s), a video file (by its extension, [`crate::video::VIDEO_EXTENSIONS`])
+/// is decoded by ffmpeg ([`crate::video`]), a `.y4m` file (or any file starting with
+/// `YUV4MPEG2`) is a stream, anything else a still image.
 pub fn open_input(path: &Path, dir_fps: f64) -> Result<Box<dyn FrameSource>, LaneIoError> {
     if path.as_os_str() == "-" {
         let stdin = BufReader::with_capacity(1 << 16, std::io::stdin());
@@ -229,6 +230,9 @@ pub fn open_input(path: &Path, dir_fps: f64) -> Result<Box<dyn FrameSource>, Lan
     let meta = std::fs::metadata(path).map_err(|e| LaneIoError::io(name.clone(), e))?;
     if meta.is_dir() {
         return Ok(Box::new(ImageDirectory::open(path, dir_fps)?));
+    }
+    if crate::video::is_video(path) {
+        return Ok(Box::new(crate::video::VideoSource::open(path)?));
     }
     let mut magic = [0u8; 9];
     let n = File::open(path)

@@ -486,18 +486,34 @@ fn ins_replays_exported_logs_prints_truth_errors_and_names_bad_lines() {
     let e = stderr(&o);
     assert!(o.status.success(), "{e}");
     assert!(
-        e.contains("2000 IMU samples, 20 sighting epochs, 60 sightings used"),
+        e.contains("2000 IMU samples to t = 20.000 s")
+            && e.contains("20 sighting epochs, 60 sightings used"),
         "{e}"
     );
-    // The printed final error is the simulated run's record at 20 s (open loop until 195 s:
+    // The printed last error is the simulated run's record at 20 s (open loop until 195 s:
     // the solution is the INS corrected by x̂, the record INS − x̂, equal to round-off).
-    let n = records[20].pos_err_ned_m[0];
-    assert!(e.contains(&format!("N {n:.3} m")), "{e} (N {n:.3})");
+    let r = records[20].pos_err_ned_m;
+    let n = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    assert!(e.contains(&format!("last {n:>9.3} m")), "{e} (last {n:.3})");
+    // A row at the start and after every IMU sample; the 20 epochs' rows carry their counts.
+    let text = std::fs::read_to_string(&out).unwrap();
     assert_eq!(
-        std::fs::read_to_string(&out).unwrap().lines().count(),
-        21,
-        "header + 20 epochs"
+        text.lines().count(),
+        1 + 1 + 2000,
+        "header, start, 2000 samples"
     );
+    assert_eq!(
+        text.lines().skip(1).filter(|l| !l.ends_with(",,,")).count(),
+        20
+    );
+    // From another directory with no --config: the compiled-in mems preset.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_nav-app"))
+        .current_dir("/")
+        .args(&args[..9])
+        .args(["--out", &p("solution_mems.csv")])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
     // A malformed IMU line: exit 1, the message names file:line:column.
     let imu = std::fs::read_to_string(p(names::IMU)).unwrap();
     let bad = dir.join("imu_bad.csv");

@@ -20,7 +20,7 @@ pub(super) fn dpkg_installed(pkg: &str) -> bool {
 /// Install the Debian packages that are missing (as root), or fail saying which are.
 ///
 /// `libclang-dev` is what the `v4l` crate's bindgen build script needs; the test gate can call
-/// [`ensure_libclang`] for just that one.
+/// [`ensure_test_packages`] for the workspace's.
 pub fn ensure_host_packages(pkgs: &[&str]) -> Result<()> {
     let missing: Vec<&str> = pkgs
         .iter()
@@ -72,10 +72,10 @@ pub fn ensure_host_packages(pkgs: &[&str]) -> Result<()> {
     Ok(())
 }
 
-/// Make sure libclang (Debian `libclang-dev`) is present for the `v4l` crate's bindgen build.
-/// Meant to be called by the test gate before building the workspace.
-pub fn ensure_libclang() -> Result<()> {
-    ensure_host_packages(&["libclang-dev"])
+/// The system packages the workspace's tests need: `libclang-dev` (the `v4l` crate's bindgen
+/// step) and `ffmpeg` (video inputs, `lane_io::video`).
+pub fn ensure_test_packages() -> Result<()> {
+    ensure_host_packages(&["libclang-dev", "ffmpeg"])
 }
 
 pub(super) fn cargo() -> String {

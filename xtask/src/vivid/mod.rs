@@ -101,7 +101,7 @@ mod tests;
 use cases::*;
 use guest::*;
 use host::*;
-pub use host::{ensure_host_packages, ensure_libclang};
+pub use host::{ensure_host_packages, ensure_test_packages};
 use judge::*;
 
 /// Run `cargo xtask vivid`.
