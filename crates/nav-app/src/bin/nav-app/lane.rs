@@ -15,6 +15,9 @@ use lane_io::capture_source::{
     self, CaptureMonitor, DeviceFrameInfo, DeviceOptions, DeviceSetup, DeviceStats,
     parse_control_spec,
 };
+use std::io::IsTerminal;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use lane_io::frame_loop::{FrameLoop, Step, Tracked};
 use lane_io::overlay::{OverlaySink, render_overlay};
 use lane_io::sources::open_input;
@@ -329,6 +332,8 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
     let mut track_time = Duration::ZERO;
     let started = Instant::now();
     let mut last_states = [LaneState::Initialising; 2];
+    let bar = progress_bar(!quiet && args.device.is_none());
+    let mut shown_lost = 0u64;
     while args.max_frames.is_none_or(|m| stats.frames < m) {
         let Tracked {
             meta,
@@ -352,7 +357,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
             Step::Skipped(e) => {
                 stats.lost_frames += e.lost_frames();
                 stats.skipped_bytes += e.skipped_bytes();
-                eprintln!("nav-app: warning: {e}");
+                say(&bar, &format!("nav-app: warning: {e}"));
                 continue;
             }
         };
@@ -409,15 +414,24 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         let states = [report.lanes[0].state, report.lanes[1].state];
         if !quiet && (states != last_states || stats.frames % 100 == 1) {
             let fps = stats.frames as f64 / track_time.as_secs_f64().max(1e-9);
-            eprintln!(
-                "frame {index:6}  t={:7.2}s  left: {:22}  right: {:22}  tracker {fps:8.0} frames/s",
-                meta.t_s,
-                lane_text(&report.lanes[0]),
-                lane_text(&report.lanes[1]),
+            say(
+                &bar,
+                &format!(
+                    "frame {index:6}  t={:7.2}s  left: {:22}  right: {:22}  tracker {fps:8.0} frames/s",
+                    meta.t_s,
+                    lane_text(&report.lanes[0]),
+                    lane_text(&report.lanes[1]),
+                ),
             );
         }
         last_states = states;
+        bar.inc(1);
+        if stats.lost_frames != shown_lost {
+            shown_lost = stats.lost_frames;
+            bar.set_message(format!("{shown_lost} lost"));
+        }
     }
+    bar.finish_and_clear();
     out.flush().context("cannot write to stdout")?;
     if let Some(sink) = overlay {
         sink.finish()?;
@@ -445,6 +459,32 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         bail!("no frame could be read");
     }
     Ok(())
+}
+
+/// A progress bar on stderr (frames done, rate, frames lost) when `wanted` (not `--json`, a file
+/// or stream rather than a device) and stderr is a terminal; hidden otherwise, so nothing of it
+/// ever reaches stdout, a pipe or a log file.
+fn progress_bar(wanted: bool) -> ProgressBar {
+    if !(wanted && std::io::stderr().is_terminal()) {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("{spinner} {pos} frames  {per_sec}  {elapsed_precise}  {msg}")
+    {
+        bar.set_style(style);
+    }
+    bar.set_message("0 lost");
+    bar
+}
+
+/// A status line on stderr, above the progress bar when there is one.
+fn say(bar: &ProgressBar, line: &str) {
+    if bar.is_hidden() {
+        eprintln!("{line}");
+    } else {
+        bar.println(line);
+    }
 }
 
 /// The chain of an error as one line, each message once: a cause whose text its parent already
