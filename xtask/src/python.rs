@@ -14,7 +14,17 @@ use anyhow::{Context, Result, bail};
 use crate::paths::workspace_root;
 
 /// Requirements installed into the venv.
-const REQUIREMENTS: &[&str] = &["maturin>=1.9,<2", "pytest>=7", "numpy>=1.21"];
+const REQUIREMENTS: &[&str] = &[
+    "maturin>=1.9,<2",
+    "pytest>=7",
+    "numpy>=1.21",
+    // The independent implementations the interop tests check nav-app against (robot bags,
+    // JSON schemas, JPEG).
+    "mcap>=1.1",
+    "mcap-ros2-support>=0.5",
+    "jsonschema>=4",
+    "pillow>=9",
+];
 
 /// Arguments of `cargo xtask python`.
 #[derive(clap::Args, Debug)]
@@ -54,7 +64,7 @@ fn ensure_venv(root: &Path) -> Result<PathBuf> {
         root,
         "py-venv",
         REQUIREMENTS,
-        "import numpy, pytest",
+        "import numpy, pytest, mcap, mcap_ros2, jsonschema, PIL",
         Some("bin/maturin"),
     )
 }

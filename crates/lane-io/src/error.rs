@@ -39,6 +39,22 @@ pub enum LaneIoError {
         /// ffmpeg's exit status and last message.
         reason: String,
     },
+    /// A ROS 2 bag (MCAP) could not be read: the file, the container, or the topic (the error
+    /// lists the bag's topics).
+    #[error(transparent)]
+    Bag {
+        /// The bag reader's error.
+        #[from]
+        source: ros_bag::BagError,
+    },
+    /// An image message of a bag cannot be turned into a grey frame.
+    #[error("topic {topic}: {what}")]
+    BagImage {
+        /// The topic.
+        topic: String,
+        /// What is wrong with the message.
+        what: String,
+    },
     /// A still image could not be decoded (truncated, corrupt or of an unknown format).
     #[error("{path}: cannot decode image: {source}")]
     ImageDecode {

@@ -27,6 +27,8 @@ pub mod config;
 mod error;
 mod frame;
 pub mod frame_loop;
+pub mod mcap_sink;
+pub mod mcap_source;
 pub mod overlay;
 pub mod sources;
 pub mod video;

@@ -218,7 +218,8 @@ impl FrameSource for ImageDirectory {
 }
 
 /// Open `--input PATH`: `-` is a YUV4MPEG2 stream on stdin, a directory is an image sequence
-/// (at `dir_fps` frames/s), a video file (by its extension, [`crate::video::VIDEO_EXTENSIONS`])
+/// (at `dir_fps` frames/s), a `.mcap` file is a ROS 2 bag read on its only image topic
+/// ([`crate::mcap_source`]), a video file (by its extension, [`crate::video::VIDEO_EXTENSIONS`])
 /// is decoded by ffmpeg ([`crate::video`]), a `.y4m` file (or any file starting with
 /// `YUV4MPEG2`) is a stream, anything else a still image.
 pub fn open_input(path: &Path, dir_fps: f64) -> Result<Box<dyn FrameSource>, LaneIoError> {
@@ -230,6 +231,11 @@ pub fn open_input(path: &Path, dir_fps: f64) -> Result<Box<dyn FrameSource>, Lan
     let meta = std::fs::metadata(path).map_err(|e| LaneIoError::io(name.clone(), e))?;
     if meta.is_dir() {
         return Ok(Box::new(ImageDirectory::open(path, dir_fps)?));
+    }
+    if crate::mcap_source::is_mcap(path) {
+        return Ok(Box::new(crate::mcap_source::McapImageSource::open(
+            path, None,
+        )?));
     }
     if crate::video::is_video(path) {
         return Ok(Box::new(crate::video::VideoSource::open(path)?));

@@ -107,6 +107,15 @@ struct Args {
     /// Frame rate assumed for a directory of images, frames/s.
     #[arg(long, value_name = "HZ", default_value_t = 25.0)]
     dir_fps: f64,
+    /// With a ROS 2 bag (`--input run.mcap`): the image topic (sensor_msgs/msg/Image or
+    /// CompressedImage); default: the bag's only image topic.
+    #[arg(long, value_name = "TOPIC")]
+    topic: Option<String>,
+    /// Also write the lanes to this MCAP file for Foxglove: the grey frame
+    /// (foxglove.RawImage, /camera/image), the lanes drawn on it (foxglove.ImageAnnotations,
+    /// /camera/lanes) and the lane estimate (JSON, /lanes).
+    #[arg(long, value_name = "FILE")]
+    mcap_out: Option<PathBuf>,
     #[command(flatten)]
     dev: DeviceArgs,
 }
@@ -258,7 +267,15 @@ const EXIT_FRAMES_LOST: u8 = 5;
 
 fn open_source(args: &Args) -> Result<Box<dyn FrameSource>> {
     match &args.input {
-        Some(p) => Ok(open_input(p, args.dir_fps)?),
+        Some(p) if lane_io::mcap_source::is_mcap(p) => Ok(Box::new(
+            lane_io::mcap_source::McapImageSource::open(p, args.topic.as_deref())?,
+        )),
+        Some(p) => {
+            if args.topic.is_some() {
+                bail!("--topic is for a ROS 2 bag (--input FILE.mcap)");
+            }
+            Ok(open_input(p, args.dir_fps)?)
+        }
         None => {
             let spec = SCENES
                 .iter()
@@ -323,6 +340,10 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         Some(p) => Some(OverlaySink::open(p, fps_out)?),
         None => None,
     };
+    let mut mcap_out = match &args.mcap_out {
+        Some(p) => Some(lane_io::mcap_sink::LaneMcapSink::create(p)?),
+        None => None,
+    };
     let mut rgb = Vec::new();
     let mut lanes = FrameLoop::new(cfg, estimator);
     let stdout = std::io::stdout();
@@ -381,26 +402,29 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 eprintln!("nav-app: frame {index}: input signal {what}");
             }
         }
-        if args.json {
-            serde_json::to_writer(
-                &mut out,
-                &FrameJson {
-                    schema: JSON_SCHEMA,
-                    frame: index,
-                    t_s: meta.t_s,
-                    lanes: &report.lanes,
-                    track_us: dt.as_secs_f64() * 1e6,
-                    ego_lane: ego,
-                    lane_cov_px: camera.as_ref().map(|_| {
-                        [Side::Left, Side::Right]
-                            .map(|s| t.lane_covariance_px(s).map(|p| p.transpose().into()))
-                    }),
-                    capture,
-                },
-            )
-            .context("cannot write JSON to stdout")?;
-            out.write_all(b"\n")
-                .context("cannot write JSON to stdout")?;
+        if args.json || mcap_out.is_some() {
+            let frame_json = FrameJson {
+                schema: JSON_SCHEMA,
+                frame: index,
+                t_s: meta.t_s,
+                lanes: &report.lanes,
+                track_us: dt.as_secs_f64() * 1e6,
+                ego_lane: ego,
+                lane_cov_px: camera.as_ref().map(|_| {
+                    [Side::Left, Side::Right]
+                        .map(|s| t.lane_covariance_px(s).map(|p| p.transpose().into()))
+                }),
+                capture,
+            };
+            if args.json {
+                serde_json::to_writer(&mut out, &frame_json)
+                    .context("cannot write JSON to stdout")?;
+                out.write_all(b"\n")
+                    .context("cannot write JSON to stdout")?;
+            }
+            if let Some(sink) = mcap_out.as_mut() {
+                sink.write(meta.t_s, frame, &report, &frame_json)?;
+            }
         }
         if let Some(sink) = overlay.as_mut() {
             render_overlay(frame, t, &mut rgb);
@@ -434,6 +458,9 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
     bar.finish_and_clear();
     out.flush().context("cannot write to stdout")?;
     if let Some(sink) = overlay {
+        sink.finish()?;
+    }
+    if let Some(sink) = mcap_out {
         sink.finish()?;
     }
     let (frames, lost, skipped) = (stats.frames, stats.lost_frames, stats.skipped_bytes);

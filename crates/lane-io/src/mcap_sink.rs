@@ -1,0 +1,160 @@
+//! The lanes as an MCAP file for Foxglove (`nav-app --mcap-out`): per frame, the grey frame as
+//! `foxglove.RawImage` on `/camera/image`, both lanes drawn on it as polylines
+//! (`foxglove.ImageAnnotations` on `/camera/lanes`: left blue, right orange, over the rows of the
+//! points behind each estimate), and the lane estimate itself as JSON on `/lanes` (the object
+//! `nav-app --json` prints for the frame, with its JSON schema [`LANES_SCHEMA`]). Opening the
+//! file in Foxglove's Image panel on `/camera/image` with `/camera/lanes` as annotations shows
+//! the camera with the lanes on it; the Plot panel plots `/lanes.lanes[0].coeffs[2]` and the rest.
+
+use grey_frame::GreyFrame;
+use lane_tracker::TrackReport;
+use ros_bag::out::foxglove::{
+    Color, IMAGE_ANNOTATIONS, ImageAnnotations, LINE_STRIP, Point2, PointsAnnotation, RAW_IMAGE,
+    RawImage, Time, image_annotations_schema, raw_image_schema,
+};
+use ros_bag::out::{JsonChannel, JsonMcapWriter, base64_into};
+use serde::Serialize;
+
+use crate::LaneIoError;
+
+/// Topic of the grey frames.
+pub const IMAGE_TOPIC: &str = "/camera/image";
+/// Topic of the lane polylines.
+pub const ANNOTATIONS_TOPIC: &str = "/camera/lanes";
+/// Topic of the lane estimates.
+pub const LANES_TOPIC: &str = "/lanes";
+/// Schema name of the lane estimates.
+pub const LANES_SCHEMA_NAME: &str = "ita_nav.LaneFrame";
+
+/// JSON schema of the `/lanes` messages (`nav-app --json`'s per-frame object, schema 1).
+pub const LANES_SCHEMA: &str = r#"{"title":"ita_nav.LaneFrame","description":"One frame of nav-app's lane tracker (the --json object of the README, schema 1)","type":"object","properties":{"schema":{"type":"integer","const":1},"frame":{"type":"integer","minimum":0},"t_s":{"type":"number"},"lanes":{"type":"array","minItems":2,"maxItems":2,"items":{"type":"object","properties":{"side":{"enum":["left","right"]},"state":{"enum":["initialising","tracking","coasting","lost"]},"coeffs":{"type":["array","null"],"items":{"type":"number"},"minItems":3,"maxItems":3,"description":"[a1, a2, a3] of x = a1 y^2 + a2 y + a3, pixels of the input image"},"rows":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2},"points":{"type":"integer","minimum":0},"initialised":{"type":"boolean"}},"required":["side","state","coeffs","rows","points","initialised"]}},"track_us":{"type":"number"},"ego_lane":{"type":["object","null"]},"lane_cov_px":{"type":["array","null"]}},"required":["schema","frame","t_s","lanes","track_us"]}"#;
+
+const COLOURS: [Color; 2] = [
+    Color {
+        r: 0.1,
+        g: 0.5,
+        b: 1.0,
+        a: 1.0,
+    },
+    Color {
+        r: 1.0,
+        g: 0.5,
+        b: 0.0,
+        a: 1.0,
+    },
+];
+const NO_FILL: Color = Color {
+    r: 0.0,
+    g: 0.0,
+    b: 0.0,
+    a: 0.0,
+};
+/// Vertices per lane polyline.
+const POLYLINE_POINTS: usize = 24;
+
+/// An open `--mcap-out` file.
+#[derive(Debug)]
+pub struct LaneMcapSink {
+    writer: JsonMcapWriter,
+    image: JsonChannel,
+    annotations: JsonChannel,
+    lanes: JsonChannel,
+    base64: String,
+    ann: ImageAnnotations,
+}
+
+fn bag(source: ros_bag::BagError) -> LaneIoError {
+    LaneIoError::Bag { source }
+}
+
+impl LaneMcapSink {
+    /// Creates the file and its three channels.
+    ///
+    /// # Errors
+    /// [`LaneIoError::Bag`] when the file cannot be created.
+    pub fn create(path: &std::path::Path) -> Result<Self, LaneIoError> {
+        let mut writer = JsonMcapWriter::create(&path.display().to_string()).map_err(bag)?;
+        let image = writer
+            .channel(IMAGE_TOPIC, RAW_IMAGE, &raw_image_schema())
+            .map_err(bag)?;
+        let annotations = writer
+            .channel(
+                ANNOTATIONS_TOPIC,
+                IMAGE_ANNOTATIONS,
+                &image_annotations_schema(),
+            )
+            .map_err(bag)?;
+        let lanes = writer
+            .channel(LANES_TOPIC, LANES_SCHEMA_NAME, LANES_SCHEMA)
+            .map_err(bag)?;
+        Ok(Self {
+            writer,
+            image,
+            annotations,
+            lanes,
+            base64: String::new(),
+            ann: ImageAnnotations::default(),
+        })
+    }
+
+    /// Writes one frame: the image, the lanes drawn on it, and `lanes_message` (the `--json`
+    /// object) at time `t_s` (negative times are written at 0).
+    ///
+    /// # Errors
+    /// [`LaneIoError::Bag`] when writing fails.
+    pub fn write(
+        &mut self,
+        t_s: f64,
+        frame: &GreyFrame,
+        report: &TrackReport,
+        lanes_message: &impl Serialize,
+    ) -> Result<(), LaneIoError> {
+        let t_ns = (t_s.max(0.0) * 1e9).round() as u64;
+        let timestamp = Time::from_ns(t_ns);
+        base64_into(frame.data(), &mut self.base64);
+        let image = RawImage {
+            timestamp,
+            frame_id: "camera",
+            width: frame.width() as u32,
+            height: frame.height() as u32,
+            encoding: "mono8",
+            step: frame.width() as u32,
+            data: &self.base64,
+        };
+        self.writer.write(self.image, t_ns, &image).map_err(bag)?;
+        self.ann.points.clear();
+        for (lane, colour) in report.lanes.iter().zip(COLOURS) {
+            let Some(_) = lane.coeffs else { continue };
+            let [top, bottom] = lane.rows;
+            let points = (0..POLYLINE_POINTS)
+                .filter_map(|k| {
+                    let y = top + (bottom - top) * k as f64 / (POLYLINE_POINTS - 1) as f64;
+                    lane.col_at_row(y).map(|x| Point2 { x, y })
+                })
+                .collect();
+            self.ann.points.push(PointsAnnotation {
+                timestamp,
+                kind: LINE_STRIP,
+                points,
+                outline_color: colour,
+                outline_colors: Vec::new(),
+                fill_color: NO_FILL,
+                thickness: 3.0,
+            });
+        }
+        self.writer
+            .write(self.annotations, t_ns, &self.ann)
+            .map_err(bag)?;
+        self.writer
+            .write(self.lanes, t_ns, lanes_message)
+            .map_err(bag)
+    }
+
+    /// Writes the summary and closes the file.
+    ///
+    /// # Errors
+    /// [`LaneIoError::Bag`].
+    pub fn finish(self) -> Result<(), LaneIoError> {
+        self.writer.finish().map_err(bag)
+    }
+}

@@ -1,0 +1,250 @@
+//! Reading a bag: its topics (from the summary, or by a pass over the file when it has none)
+//! and the messages of one topic in file order, streamed ([`TopicReader`]).
+
+use std::fs::File;
+use std::io::{BufReader, Seek};
+use std::sync::Arc;
+
+use mcap::sans_io::summary_reader::{SummaryReadEvent, SummaryReader};
+
+use crate::BagError;
+
+/// Reading options: every CRC the file carries is checked (chunks and the data section), so a
+/// damaged byte is an error, not a wrong pixel.
+fn checked() -> mcap::sans_io::LinearReaderOptions {
+    mcap::sans_io::LinearReaderOptions::default()
+        .with_validate_chunk_crcs(true)
+        .with_validate_data_section_crc(true)
+}
+
+/// One topic of a bag.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TopicInfo {
+    /// The topic name.
+    pub topic: String,
+    /// The schema name (e.g. `sensor_msgs/msg/Image`; empty without a schema).
+    pub schema: String,
+    /// The message encoding (`cdr` for ROS 2).
+    pub encoding: String,
+}
+
+fn io(path: &str) -> impl Fn(std::io::Error) -> BagError + '_ {
+    move |source| BagError::Io {
+        path: path.to_owned(),
+        source,
+    }
+}
+
+fn mcap_err(path: &str) -> impl Fn(mcap::McapError) -> BagError + '_ {
+    move |source| BagError::Mcap {
+        path: path.to_owned(),
+        source,
+    }
+}
+
+fn info(c: &mcap::Channel<'_>) -> TopicInfo {
+    TopicInfo {
+        topic: c.topic.clone(),
+        schema: c
+            .schema
+            .as_ref()
+            .map(|s| s.name.clone())
+            .unwrap_or_default(),
+        encoding: c.message_encoding.clone(),
+    }
+}
+
+/// The topics of the bag at `path`, sorted by name.
+///
+/// # Errors
+/// [`BagError::Io`], [`BagError::Mcap`] for a damaged file.
+pub fn topics(path: &str) -> Result<Vec<TopicInfo>, BagError> {
+    let mut file = File::open(path).map_err(io(path))?;
+    let mut reader = SummaryReader::new();
+    while let Some(event) = reader.next_event() {
+        match event.map_err(mcap_err(path))? {
+            SummaryReadEvent::ReadRequest(need) => {
+                let n = std::io::Read::read(&mut file, reader.insert(need)).map_err(io(path))?;
+                reader.notify_read(n);
+            }
+            SummaryReadEvent::SeekRequest(to) => {
+                reader.notify_seeked(file.seek(to).map_err(io(path))?);
+            }
+        }
+    }
+    let mut out: Vec<TopicInfo> = match reader.finish() {
+        Some(summary) => summary.channels.values().map(|c| info(c)).collect(),
+        None => {
+            // No summary (a bag cut short while recording): every channel of the file.
+            let file = File::open(path).map_err(io(path))?;
+            let mut seen: Vec<TopicInfo> = Vec::new();
+            for m in mcap::io::MessageReader::new_with_options(BufReader::new(file), checked()) {
+                let m = m.map_err(mcap_err(path))?;
+                if !seen.iter().any(|t| t.topic == m.channel.topic) {
+                    seen.push(info(&m.channel));
+                }
+            }
+            seen
+        }
+    };
+    out.sort_by(|a, b| a.topic.cmp(&b.topic));
+    out.dedup();
+    Ok(out)
+}
+
+/// `topics` as one line for errors: `/a (sensor_msgs/msg/Image), /b (…)`.
+pub fn list(topics: &[TopicInfo]) -> String {
+    if topics.is_empty() {
+        return "(none)".to_owned();
+    }
+    topics
+        .iter()
+        .map(|t| {
+            format!(
+                "{} ({})",
+                t.topic,
+                if t.schema.is_empty() {
+                    "no schema"
+                } else {
+                    &t.schema
+                }
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Chooses the topic to read: `wanted` if given (it must exist with one of `schemas`), else the
+/// only topic with one of `schemas`.
+///
+/// # Errors
+/// [`BagError::Topic`] listing every topic when there is no such topic, or several and none was
+/// chosen, or the chosen one is missing or of another type; [`BagError::Encoding`] when it is not
+/// CDR.
+pub fn choose_topic(
+    path: &str,
+    topics: &[TopicInfo],
+    wanted: Option<&str>,
+    schemas: &[&str],
+    what: &str,
+) -> Result<TopicInfo, BagError> {
+    let fail = |problem: String| BagError::Topic {
+        path: path.to_owned(),
+        problem,
+        topics: list(topics),
+    };
+    let chosen = match wanted {
+        Some(name) => {
+            let Some(t) = topics.iter().find(|t| t.topic == name) else {
+                return Err(fail(format!("no topic {name}")));
+            };
+            if !schemas.contains(&t.schema.as_str()) {
+                return Err(fail(format!(
+                    "topic {name} is {}, not {}",
+                    t.schema,
+                    schemas.join(" or ")
+                )));
+            }
+            t.clone()
+        }
+        None => {
+            let of_kind: Vec<&TopicInfo> = topics
+                .iter()
+                .filter(|t| schemas.contains(&t.schema.as_str()))
+                .collect();
+            match of_kind.as_slice() {
+                [one] => (*one).clone(),
+                [] => return Err(fail(format!("no {what} topic ({})", schemas.join(", ")))),
+                _ => {
+                    return Err(fail(format!(
+                        "{} {what} topics: choose one with --topic",
+                        of_kind.len()
+                    )));
+                }
+            }
+        }
+    };
+    if chosen.encoding != "cdr" {
+        return Err(BagError::Encoding {
+            path: path.to_owned(),
+            topic: chosen.topic,
+            encoding: chosen.encoding,
+        });
+    }
+    Ok(chosen)
+}
+
+/// One message of the topic read: its payload and times.
+#[derive(Debug)]
+pub struct BagMessage {
+    /// The schema name of its channel.
+    pub schema: Arc<str>,
+    /// Log time, ns.
+    pub log_time_ns: u64,
+    /// The CDR payload.
+    pub data: Vec<u8>,
+}
+
+/// The messages of one topic in file order, streamed from the file.
+pub struct TopicReader {
+    path: String,
+    topic: TopicInfo,
+    schema: Arc<str>,
+    messages: mcap::io::MessageReader<BufReader<File>>,
+}
+
+impl std::fmt::Debug for TopicReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TopicReader")
+            .field("path", &self.path)
+            .field("topic", &self.topic)
+            .finish()
+    }
+}
+
+impl TopicReader {
+    /// Opens `path` for the messages of `topic` (from [`choose_topic`]).
+    ///
+    /// # Errors
+    /// [`BagError::Io`].
+    pub fn open(path: &str, topic: TopicInfo) -> Result<Self, BagError> {
+        let file = File::open(path).map_err(io(path))?;
+        Ok(Self {
+            path: path.to_owned(),
+            schema: Arc::from(topic.schema.as_str()),
+            topic,
+            messages: mcap::io::MessageReader::new_with_options(
+                BufReader::with_capacity(1 << 16, file),
+                checked(),
+            ),
+        })
+    }
+
+    /// The file.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// The topic read.
+    pub fn topic(&self) -> &TopicInfo {
+        &self.topic
+    }
+
+    /// The next message of the topic, `None` at the end.
+    ///
+    /// # Errors
+    /// [`BagError::Mcap`] for a damaged file (after the last good message).
+    pub fn next_message(&mut self) -> Result<Option<BagMessage>, BagError> {
+        for m in self.messages.by_ref() {
+            let m = m.map_err(mcap_err(&self.path))?;
+            if m.channel.topic == self.topic.topic {
+                return Ok(Some(BagMessage {
+                    schema: self.schema.clone(),
+                    log_time_ns: m.log_time,
+                    data: m.data.into_owned(),
+                }));
+            }
+        }
+        Ok(None)
+    }
+}
