@@ -54,15 +54,16 @@ fn info(c: &mcap::Channel<'_>) -> TopicInfo {
     }
 }
 
-/// The topics of the bag at `path`, sorted by name.
-///
-/// # Errors
-/// [`BagError::Io`], [`BagError::Mcap`] for a damaged file.
-pub fn topics(path: &str) -> Result<Vec<TopicInfo>, BagError> {
+/// The summary section, `None` when the file has none or it cannot be read (no footer: a
+/// truncated file).
+fn summary(path: &str) -> Result<Option<mcap::Summary>, BagError> {
     let mut file = File::open(path).map_err(io(path))?;
     let mut reader = SummaryReader::new();
     while let Some(event) = reader.next_event() {
-        match event.map_err(mcap_err(path))? {
+        let Ok(event) = event else {
+            return Ok(None);
+        };
+        match event {
             SummaryReadEvent::ReadRequest(need) => {
                 let n = std::io::Read::read(&mut file, reader.insert(need)).map_err(io(path))?;
                 reader.notify_read(n);
@@ -72,14 +73,27 @@ pub fn topics(path: &str) -> Result<Vec<TopicInfo>, BagError> {
             }
         }
     }
-    let mut out: Vec<TopicInfo> = match reader.finish() {
+    Ok(reader.finish())
+}
+
+/// The topics of the bag at `path`, sorted by name.
+///
+/// # Errors
+/// [`BagError::Io`], [`BagError::Mcap`] for a damaged file.
+pub fn topics(path: &str) -> Result<Vec<TopicInfo>, BagError> {
+    let mut out: Vec<TopicInfo> = match summary(path)? {
         Some(summary) => summary.channels.values().map(|c| info(c)).collect(),
         None => {
-            // No summary (a bag cut short while recording): every channel of the file.
+            // No summary (a bag cut short while recording): the channels of its messages, up to
+            // the damage (reading stops with an error there; the topics before it are usable).
             let file = File::open(path).map_err(io(path))?;
             let mut seen: Vec<TopicInfo> = Vec::new();
             for m in mcap::io::MessageReader::new_with_options(BufReader::new(file), checked()) {
-                let m = m.map_err(mcap_err(path))?;
+                let m = match m {
+                    Ok(m) => m,
+                    Err(e) if seen.is_empty() => return Err(mcap_err(path)(e)),
+                    Err(_) => break,
+                };
                 if !seen.iter().any(|t| t.topic == m.channel.topic) {
                     seen.push(info(&m.channel));
                 }
