@@ -177,6 +177,7 @@ def replay(
     align_s: float = 0.0,
     max_gap_s: float = 5.0,
     rate_hz: Optional[float] = None,
+    imu_topic: Optional[str] = None,
 ) -> dict:
     """Replay an IMU log as `nav-app ins` does; returns imu_samples, epochs, sightings_used,
     sightings_rejected, gaps, longest_gap_s, end_t_s and, with truth, metrics (as --metrics-json)."""

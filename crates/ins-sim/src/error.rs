@@ -135,6 +135,13 @@ pub enum SimError {
         #[source]
         error: toml_config::TomlError,
     },
+    /// A ROS 2 bag could not be read (file, container, topic, message).
+    #[error(transparent)]
+    Bag {
+        /// The bag reader's error.
+        #[from]
+        source: ros_bag::BagError,
+    },
     /// A replay needs the reference trajectory at a time it does not cover.
     #[error("reference trajectory at t = {t_s} s: {what}")]
     ReferenceSpan {

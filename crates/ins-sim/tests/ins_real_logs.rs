@@ -30,7 +30,7 @@ fn replay(
     let reference = logs::read_reference(&d.join("truth.csv")).unwrap();
     let start = set.start_s.unwrap_or(reference[0].t_s);
     let initial = logs::initial_from_reference(&reference, start, 1.0).unwrap();
-    let step = logs::imu_nominal_step_s(&d.join("imu.csv")).unwrap();
+    let step = logs::imu_nominal_step_s(&d.join("imu.csv"), None).unwrap();
     let config = FilterFile::preset(preset)
         .unwrap()
         .filter_config(mode, step, initial.t_s)
@@ -38,6 +38,7 @@ fn replay(
     let level = reference.iter().any(|r| r.att_b_to_n.is_none());
     let inputs = ReplayInputs {
         imu: d.join("imu.csv"),
+        imu_topic: None,
         sightings: (mode != Mode::Standalone)
             .then(|| (dir.join("sightings.csv"), dir.join("landmarks.toml"))),
         initial,

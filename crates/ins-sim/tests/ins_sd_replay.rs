@@ -23,6 +23,7 @@ fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
     let sc = Scenario::from_toml_str(&text).unwrap();
     ReplayInputs {
         imu: dir.join(names::IMU),
+        imu_topic: None,
         sightings: Some((dir.join(names::SIGHTINGS), dir.join(names::LANDMARKS))),
         initial: logs::read_initial(&dir.join(names::INITIAL)).unwrap(),
         config: sc.online_filter_config(mode),
@@ -150,6 +151,7 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
             &dir,
             &ReplayInputs {
                 imu: path.clone(),
+                imu_topic: None,
                 ..inp.clone()
             },
         ),
@@ -168,6 +170,7 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
             &dir,
             &ReplayInputs {
                 imu: path.clone(),
+                imu_topic: None,
                 ..inp.clone()
             },
         ),
@@ -184,6 +187,7 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
             &dir,
             &ReplayInputs {
                 imu: path.clone(),
+                imu_topic: None,
                 ..inp.clone()
             },
         ),
@@ -304,7 +308,7 @@ fn a_jittery_104_hz_log_with_a_gap_replays_to_the_end() {
     std::fs::write(&imu, out.join("\n") + "\n").unwrap();
     let mut inp = inputs(&dir, Mode::Kf);
     inp.imu = imu.clone();
-    inp.config.imu_step_s = logs::imu_nominal_step_s(&imu).unwrap();
+    inp.config.imu_step_s = logs::imu_nominal_step_s(&imu, None).unwrap();
     assert!(
         (inp.config.imu_step_s - 1.0 / 104.4).abs() < 1e-3,
         "{}",

@@ -203,6 +203,7 @@ fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Res
     };
     let inputs = ReplayInputs {
         imu: files[0].clone(),
+        imu_topic: None,
         sightings: Some((files[1].clone(), files[2].clone())),
         initial,
         config: sc.online_filter_config(Mode::Kf),

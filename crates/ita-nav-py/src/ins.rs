@@ -439,14 +439,14 @@ pub fn monte_carlo<'py>(
     Ok(d)
 }
 
-/// Replay an IMU log (increments or rates) through the filter, as `nav-app ins` does: sightings
+/// Replay an IMU log (CSV increments or rates, or a ROS 2 bag's `imu_topic`) through the filter, as `nav-app ins` does: sightings
 /// (with `landmarks`) or unaided (`filter="none"`), the initial state from `initial` or from the
 /// reference `truth` at `start_s`, the filter settings from `filter_file` or `preset` (default
 /// mems), an optional static alignment `align_s`, solution rows into `out` at `rate_hz` (None:
 /// every sample). Returns the summary, and with `truth` the metrics (`position_m`,
 /// `velocity_mps`, `attitude_rad`, `nees_per_dof`, `nis_per_dof`, … as in `--metrics-json`).
 #[pyfunction]
-#[pyo3(signature = (imu, out, sightings=None, landmarks=None, initial=None, truth=None, start_s=None, filter="kf", filter_file=None, preset=None, gate=None, align_s=0.0, max_gap_s=5.0, rate_hz=None))]
+#[pyo3(signature = (imu, out, sightings=None, landmarks=None, initial=None, truth=None, start_s=None, filter="kf", filter_file=None, preset=None, gate=None, align_s=0.0, max_gap_s=5.0, rate_hz=None, imu_topic=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn replay<'py>(
     py: Python<'py>,
@@ -464,9 +464,11 @@ pub fn replay<'py>(
     align_s: f64,
     max_gap_s: f64,
     rate_hz: Option<f64>,
+    imu_topic: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = logs::ReplayRequest {
         imu: imu.into(),
+        imu_topic: imu_topic.map(Into::into),
         sightings: sightings.map(Into::into).zip(landmarks.map(Into::into)),
         initial: initial.map(Into::into),
         reference: truth.map(Into::into),

@@ -222,3 +222,36 @@ def test_damaged_bags_are_clear_errors(bags, tmp_path):
         assert r.returncode in (1, 5), (name, r.returncode, r.stderr)
         assert str(p) in r.stderr, (name, r.stderr)
         assert "panicked" not in r.stderr, (name, r.stderr)
+
+
+def test_nav_app_ins_reads_the_imu_topic_of_a_bag_as_the_same_csv(bags, tmp_path):
+    # The bag's /imu: ω = (0, 0, 0.01) rad/s and a = (0.1, 0, 9.81) m/s² in ROS's FLU axes,
+    # stamped i / fps. The same samples as an FRD rates CSV (y and z negated) must replay the same.
+    frames, fps = read_y4m(SAMPLE)
+    csv = tmp_path / "imu.csv"
+    rows = ["t_s,gyro_x_radps,gyro_y_radps,gyro_z_radps,accel_x_mps2,accel_y_mps2,accel_z_mps2"]
+    for i in range(len(frames)):
+        s = stamp(i, fps)
+        t = s["sec"] + s["nanosec"] * 1e-9
+        rows.append(f"{t!r},0.0,-0.0,-0.01,0.1,-0.0,-9.81")
+    csv.write_text("\n".join(rows) + "\n")
+    init = tmp_path / "initial.toml"
+    init.write_text("t_s = -0.04\nlat_rad = 0.7\nlon_rad = 0.1\nalt_m = 100.0\n"
+                    "vel_ned_mps = [0.0, 0.0, 0.0]\natt_quat_wxyz = [1.0, 0.0, 0.0, 0.0]\n")
+    outs = {}
+    for name, extra in {"bag": ["--imu", str(bags["image"]), "--imu-topic", "/imu"],
+                        "csv": ["--imu", str(csv)]}.items():
+        out = tmp_path / f"{name}.csv"
+        r = subprocess.run([exe(), "ins", *extra, "--filter", "none", "--init", str(init),
+                            "--max-gap-s", "1", "--out", str(out)],
+                           capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        assert "221 IMU samples" in r.stderr, r.stderr
+        outs[name] = np.loadtxt(out, delimiter=",", skiprows=1, usecols=range(11))
+    assert outs["bag"].shape == outs["csv"].shape
+    assert np.allclose(outs["bag"], outs["csv"], rtol=0, atol=1e-9)
+    # Without --imu-topic the bag's only IMU topic is taken; a lane bag's image topic is refused.
+    r = subprocess.run([exe(), "ins", "--imu", str(bags["image"]), "--imu-topic",
+                        "/camera/image_raw", "--filter", "none", "--init", str(init),
+                        "--out", str(tmp_path / "x.csv")], capture_output=True, text=True)
+    assert r.returncode == 1 and "sensor_msgs/msg/Imu" in r.stderr, r.stderr

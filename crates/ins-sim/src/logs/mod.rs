@@ -89,6 +89,7 @@ pub mod names {
     pub const SOLUTION: &str = "solution_simulated.csv";
 }
 
+mod imu;
 mod read;
 mod reference;
 mod replay;
@@ -96,6 +97,7 @@ mod request;
 mod sightings;
 mod write;
 
+pub use imu::is_bag;
 pub use read::*;
 pub use reference::*;
 pub use replay::*;

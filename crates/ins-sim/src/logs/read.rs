@@ -362,18 +362,20 @@ pub fn read_solution(path: &Path) -> Result<Vec<(f64, NavState)>, SimError> {
     Ok(out)
 }
 
-/// The nominal step of an IMU log (either header): the median interval of its first 200
-/// samples, s.
+/// The nominal step of an IMU log (either header, or a bag's IMU `topic`): the median interval
+/// of its first 200 samples, s.
 ///
 /// # Errors
 /// [`SimError::LogIo`], [`SimError::LogParse`] for a bad header or time field, or fewer than two
 /// samples.
-pub fn imu_nominal_step_s(path: &Path) -> Result<f64, SimError> {
-    let (mut r, _) = CsvReader::open_any(path, &[super::IMU_HEADER, super::IMU_RATES_HEADER])?;
+pub fn imu_nominal_step_s(path: &Path, topic: Option<&str>) -> Result<f64, SimError> {
+    let mut r = super::imu::ImuStream::open(path, topic)?;
     let mut times = Vec::with_capacity(201);
+    let mut line = 1;
     while times.len() < 201 {
         let Some(rec) = r.next()? else { break };
-        times.push(r.f64(&rec, 0, "t_s")?);
+        times.push(rec.t_s);
+        line = rec.line;
     }
     let mut dts: Vec<f64> = times
         .windows(2)
@@ -382,7 +384,7 @@ pub fn imu_nominal_step_s(path: &Path) -> Result<f64, SimError> {
         .collect();
     if dts.is_empty() {
         return Err(r.parse_err(
-            r.line.max(1),
+            line,
             1,
             "fewer than two increasing IMU time stamps: no sample rate".into(),
         ));

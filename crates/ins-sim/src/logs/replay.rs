@@ -19,12 +19,11 @@ use ins_errors::strapdown::NavState;
 use ins_sd_filter::{InsSdFilter, InsSdFilterConfig, PointedSighting, Sighting, UpdateReport};
 use nalgebra::{SMatrix, Vector3};
 
+use super::imu::ImuStream;
 use super::read::{CsvReader, InitialState, Record, io_err, read_landmarks, read_truth};
 use super::reference::{ReferenceRow, interpolate};
 use super::write::write_solution;
-use super::{
-    IMU_HEADER, IMU_RATES_HEADER, POINTED_SIGHTINGS_HEADER, SIGHTINGS_HEADER, SOLUTION_HEADER,
-};
+use super::{POINTED_SIGHTINGS_HEADER, SIGHTINGS_HEADER, SOLUTION_HEADER};
 use crate::SimError;
 
 /// A sample later than this many nominal IMU steps after the previous one is a gap.
@@ -44,8 +43,10 @@ pub enum SolutionRate {
 /// The inputs and settings of a replay.
 #[derive(Clone, Debug)]
 pub struct ReplayInputs {
-    /// IMU log (increments or rates, declared by its header).
+    /// IMU log (CSV increments or rates, declared by its header; or a ROS 2 bag, `.mcap`).
     pub imu: PathBuf,
+    /// With a bag: its `sensor_msgs/msg/Imu` topic (default: the only one).
+    pub imu_topic: Option<String>,
     /// Sightings log (offsets, format 1, or pointed, format 2) and its landmark table; `None`:
     /// unaided.
     pub sightings: Option<(PathBuf, PathBuf)>,
@@ -92,32 +93,31 @@ pub struct Alignment {
 /// [`SimError::LogIo`], [`SimError::LogParse`] for a bad record or no sample in the window.
 pub fn align_at_rest(
     imu_path: &Path,
+    imu_topic: Option<&str>,
     initial: &mut InitialState,
     duration_s: f64,
     level: bool,
 ) -> Result<Alignment, SimError> {
-    let (mut imu, which) = CsvReader::open_any(imu_path, &[IMU_HEADER, IMU_RATES_HEADER])?;
-    let names: Vec<&str> = [IMU_HEADER, IMU_RATES_HEADER][which].split(',').collect();
+    let mut imu = ImuStream::open(imu_path, imu_topic)?;
+    let rates = imu.rates();
     let (t0, t1) = (initial.t_s, initial.t_s + duration_s);
     let (mut sum_f, mut sum_w, mut sum_dt, mut n) = (Vector3::zeros(), Vector3::zeros(), 0.0, 0u64);
     let mut prev = f64::NAN;
+    let mut last_line = 1;
     while let Some(rec) = imu.next()? {
-        let mut v = [0.0; 7];
-        for (i, x) in v.iter_mut().enumerate() {
-            *x = imu.f64(&rec, i, names[i])?;
-        }
-        let t = v[0];
+        let t = rec.t_s;
+        last_line = rec.line;
         if t > t1 {
             break;
         }
         if t > t0 && prev.is_finite() && t > prev {
             let dt = t - prev;
-            if which == 1 {
-                sum_f += Vector3::new(v[4], v[5], v[6]) * dt;
-                sum_w += Vector3::new(v[1], v[2], v[3]) * dt;
+            if rates {
+                sum_f += rec.a * dt;
+                sum_w += rec.b * dt;
             } else {
-                sum_f += Vector3::new(v[1], v[2], v[3]);
-                sum_w += Vector3::new(v[4], v[5], v[6]);
+                sum_f += rec.a;
+                sum_w += rec.b;
             }
             sum_dt += dt;
             n += 1;
@@ -126,7 +126,7 @@ pub fn align_at_rest(
     }
     if n == 0 || sum_dt <= 0.0 {
         return Err(imu.parse_err(
-            imu.line.max(1),
+            last_line,
             1,
             format!("no IMU sample between t = {t0} s and {t1} s to align on"),
         ));
@@ -620,6 +620,7 @@ pub fn replay(
     let alignment = if inputs.align_s > 0.0 {
         Some(align_at_rest(
             &inputs.imu,
+            inputs.imu_topic.as_deref(),
             &mut initial,
             inputs.align_s,
             inputs.level,
@@ -641,9 +642,9 @@ pub fn replay(
             .map_err(filter_err0)?;
     }
     writeln!(out, "{SOLUTION_HEADER}").map_err(io_err(out_path))?;
-    let (mut imu, which) = CsvReader::open_any(&inputs.imu, &[IMU_HEADER, IMU_RATES_HEADER])?;
-    let rates = which == 1;
-    let names: Vec<&str> = [IMU_HEADER, IMU_RATES_HEADER][which].split(',').collect();
+    let mut imu = ImuStream::open(&inputs.imu, inputs.imu_topic.as_deref())?;
+    let rates = imu.rates();
+    let imu_path = imu.path();
     let step = inputs.config.imu_step_s;
     let mut run = Run {
         inputs,
@@ -661,27 +662,13 @@ pub fn replay(
     };
     run.after(&mut filter)?;
     while let Some(rec) = imu.next()? {
-        let mut v = [0.0; 7];
-        for (i, x) in v.iter_mut().enumerate() {
-            *x = imu.f64(&rec, i, names[i])?;
-        }
-        let t = v[0];
+        let t = rec.t_s;
         if t <= init.t_s {
             run.summary.imu_skipped += 1;
             continue;
         }
         // (specific force or Δv, angular rate or Δθ)
-        let (a, b) = if rates {
-            (
-                Vector3::new(v[4], v[5], v[6]),
-                Vector3::new(v[1], v[2], v[3]),
-            )
-        } else {
-            (
-                Vector3::new(v[1], v[2], v[3]),
-                Vector3::new(v[4], v[5], v[6]),
-            )
-        };
+        let (a, b) = (rec.a, rec.b);
         let now = filter.time_s();
         let dt = t - now;
         if dt > inputs.max_gap_s {
@@ -700,7 +687,7 @@ pub fn replay(
             run.summary.longest_gap_s = run.summary.longest_gap_s.max(dt);
         }
         let filter_err = |source| SimError::LogFilter {
-            path: inputs.imu.clone(),
+            path: imu_path.clone(),
             line: rec.line,
             source,
         };

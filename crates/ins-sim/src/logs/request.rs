@@ -23,8 +23,10 @@ pub enum FilterSettings {
 /// A replay request ([`ReplayRequest::inputs`]).
 #[derive(Clone, Debug)]
 pub struct ReplayRequest {
-    /// IMU log.
+    /// IMU log (CSV, or a ROS 2 bag).
     pub imu: PathBuf,
+    /// With a bag: its IMU topic (default: the only one).
+    pub imu_topic: Option<String>,
     /// Sightings log and landmark table (ignored for `Mode::Standalone`).
     pub sightings: Option<(PathBuf, PathBuf)>,
     /// Initial state file; without it, the reference at `start_s`.
@@ -100,9 +102,11 @@ impl ReplayRequest {
             }
         };
         let mut config = match &self.settings {
-            FilterSettings::File(f) => {
-                f.filter_config(self.mode, imu_nominal_step_s(&self.imu)?, initial.t_s)?
-            }
+            FilterSettings::File(f) => f.filter_config(
+                self.mode,
+                imu_nominal_step_s(&self.imu, self.imu_topic.as_deref())?,
+                initial.t_s,
+            )?,
             FilterSettings::Scenario(s) => s.online_filter_config(self.mode),
         };
         if let Some(gate) = self.gate {
@@ -121,6 +125,7 @@ impl ReplayRequest {
         };
         Ok(ReplayInputs {
             imu: self.imu.clone(),
+            imu_topic: self.imu_topic.clone(),
             sightings,
             initial,
             config,

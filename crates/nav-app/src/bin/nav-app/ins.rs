@@ -30,9 +30,13 @@ use ins_sim::{Mode, Scenario};
 )]
 struct InsArgs {
     /// IMU log (CSV; header `t_s,dv_x_mps,…,dtheta_z_rad` for increments or
-    /// `t_s,gyro_x_radps,…,accel_z_mps2` for rates; body FRD).
+    /// `t_s,gyro_x_radps,…,accel_z_mps2` for rates; body FRD), or a ROS 2 bag (`.mcap`) with a
+    /// sensor_msgs/msg/Imu topic (ROS's FLU body axes are turned into FRD: y and z negated).
     #[arg(long, value_name = "FILE")]
     imu: PathBuf,
+    /// With a bag: the IMU topic (default: the bag's only sensor_msgs/msg/Imu topic).
+    #[arg(long, value_name = "TOPIC")]
+    imu_topic: Option<String>,
     /// Sightings log (CSV: `t_s,landmark_id,frame,los_x,los_y,los_z`, or the older
     /// `t_s,landmark_id,w_m,h_m`). Without it the INS runs unaided.
     #[arg(long, value_name = "FILE", requires = "landmarks")]
@@ -170,6 +174,7 @@ fn run_ins(args: &InsArgs) -> Result<()> {
     }
     let request = logs::ReplayRequest {
         imu: args.imu.clone(),
+        imu_topic: args.imu_topic.clone(),
         sightings: args.sightings.clone().zip(args.landmarks.clone()),
         initial: args.init.clone(),
         reference: args.truth.clone(),
