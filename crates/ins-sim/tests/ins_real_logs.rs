@@ -48,6 +48,7 @@ fn replay(
         reference: Some(reference),
         align_s: set.align_s,
         level,
+        mcap_out: None,
     };
     let out = dir.join(format!("solution_{preset}_{}.csv", mode.name()));
     let mut w = std::io::BufWriter::new(std::fs::File::create(&out).unwrap());

@@ -32,6 +32,7 @@ fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
         reference: None,
         align_s: 0.0,
         level: false,
+        mcap_out: None,
     }
 }
 

@@ -212,6 +212,7 @@ fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Res
         reference: None,
         align_s: 0.0,
         level: false,
+        mcap_out: None,
     };
     (read, logs::replay(&inputs, &mut w, &out).map(|_| ()))
 }

@@ -479,6 +479,7 @@ pub fn replay<'py>(
         align_s,
         max_gap_s,
         rate: rate_hz.map_or(logs::SolutionRate::EveryImu, logs::SolutionRate::Hz),
+        mcap_out: None,
     };
     let inputs = request.inputs().map_err(err)?;
     let summary = py

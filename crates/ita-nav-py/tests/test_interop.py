@@ -255,3 +255,26 @@ def test_nav_app_ins_reads_the_imu_topic_of_a_bag_as_the_same_csv(bags, tmp_path
                         "/camera/image_raw", "--filter", "none", "--init", str(init),
                         "--out", str(tmp_path / "x.csv")], capture_output=True, text=True)
     assert r.returncode == 1 and "sensor_msgs/msg/Imu" in r.stderr, r.stderr
+
+
+def test_nav_app_ins_mcap_out_reads_back_and_validates(tmp_path):
+    d = tmp_path / "flight"
+    import ita_nav
+    ita_nav.export_run(str(d), filter="kf", seed=3)
+    out = tmp_path / "ins.mcap"
+    r = subprocess.run([exe(), "ins", "--imu", str(d / "imu.csv"), "--sightings", str(d / "sightings.csv"),
+                        "--landmarks", str(d / "landmarks.toml"), "--init", str(d / "initial.toml"),
+                        "--preset", "paper", "--truth", str(d / "truth.csv"), "--rate", "2",
+                        "--out", str(tmp_path / "sol.csv"), "--mcap-out", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    counts = {}
+    with open(out, "rb") as f:
+        for schema, channel, message in make_reader(f).iter_messages():
+            doc = json.loads(message.data)
+            jsonschema.validate(doc, json.loads(schema.data))
+            counts[channel.topic] = counts.get(channel.topic, 0) + 1
+    # 900 s: solution rows at 2 Hz (and at the 900 epochs), errors at the 901 truth rows.
+    assert counts["/ins/epochs"] == 900
+    assert counts["/ins/errors"] == 901
+    assert counts["/ins/solution"] >= 1800

@@ -90,6 +90,7 @@ pub mod names {
 }
 
 mod imu;
+mod mcap_out;
 mod read;
 mod reference;
 mod replay;
@@ -98,6 +99,7 @@ mod sightings;
 mod write;
 
 pub use imu::is_bag;
+pub use mcap_out::InsMcapSink;
 pub use read::*;
 pub use reference::*;
 pub use replay::*;

@@ -67,6 +67,9 @@ pub struct ReplayInputs {
     /// With `align_s`: also take roll and pitch from the mean specific force (keeping the
     /// initial heading): for an initial attitude that did not come from a reference attitude.
     pub level: bool,
+    /// Also write the solution (and the errors, with a reference) to this MCAP file
+    /// ([`super::InsMcapSink`]).
+    pub mcap_out: Option<PathBuf>,
 }
 
 /// What a static alignment found.
@@ -520,6 +523,7 @@ struct Run<'a, W: Write> {
     next_output_s: f64,
     tol: f64,
     t0_s: f64,
+    mcap: Option<super::InsMcapSink>,
 }
 
 impl<W: Write> Run<'_, W> {
@@ -577,9 +581,16 @@ impl<W: Write> Run<'_, W> {
         if write {
             write_solution(self.out, now, filter, report.as_ref())
                 .map_err(io_err(self.out_path))?;
+            if let Some(sink) = self.mcap.as_mut() {
+                sink.solution(filter, report.as_ref())?;
+            }
         }
         if let Some(m) = self.metrics.as_mut() {
+            let before = m.out.series.len();
             m.observe(filter);
+            if let (Some(sink), Some(e)) = (self.mcap.as_mut(), m.out.series.get(before)) {
+                sink.errors(e)?;
+            }
         }
         Ok(())
     }
@@ -658,6 +669,10 @@ pub fn replay(
         metrics: inputs.reference.clone().map(MetricsAcc::new),
         next_output_s: init.t_s,
         t0_s: init.t_s,
+        mcap: match &inputs.mcap_out {
+            Some(p) => Some(super::InsMcapSink::create(p)?),
+            None => None,
+        },
         tol: inputs.config.timestamp_tolerance_s.max(1e-9),
     };
     run.after(&mut filter)?;
@@ -734,6 +749,9 @@ pub fn replay(
     }
     run.summary.end_t_s = filter.time_s();
     run.out.flush().map_err(io_err(out_path))?;
+    if let Some(sink) = run.mcap.take() {
+        sink.finish()?;
+    }
     let mut summary = run.summary;
     summary.metrics = run.metrics.map(MetricsAcc::finish);
     summary.alignment = alignment;

@@ -49,6 +49,8 @@ pub struct ReplayRequest {
     pub max_gap_s: f64,
     /// When solution rows are written.
     pub rate: SolutionRate,
+    /// Also write the results to this MCAP file.
+    pub mcap_out: Option<PathBuf>,
 }
 
 impl ReplayRequest {
@@ -134,6 +136,7 @@ impl ReplayRequest {
             reference,
             align_s: self.align_s,
             level,
+            mcap_out: self.mcap_out.clone(),
         })
     }
 }

@@ -78,6 +78,11 @@ struct InsArgs {
     /// Solution CSV to write.
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
+    /// Also write the solution with its σ, each epoch's NIS and (with --truth) the errors as
+    /// JSON channels of an MCAP file, plottable in Foxglove (/ins/solution, /ins/epochs,
+    /// /ins/errors).
+    #[arg(long, value_name = "FILE")]
+    mcap_out: Option<PathBuf>,
     /// Reference trajectory (CSV, radians or degrees, attitude optional): print and write the
     /// errors against it.
     #[arg(long, value_name = "FILE")]
@@ -185,6 +190,7 @@ fn run_ins(args: &InsArgs) -> Result<()> {
         align_s: args.align_s,
         max_gap_s: args.max_gap_s,
         rate: args.rate.map_or(SolutionRate::EveryImu, SolutionRate::Hz),
+        mcap_out: args.mcap_out.clone(),
     };
     if args.init.is_none() && args.truth.is_none() {
         bail!("the initial state: give --init FILE, or --truth FILE to take it from the reference");
