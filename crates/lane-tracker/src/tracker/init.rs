@@ -3,7 +3,9 @@
 //! (crate docs: the strongest lines of both bands, the ego pair chosen together), with the sanity
 //! checks that accept a fit.
 
-use hough_init::{Chord, HoughLine, LaneInit, choose_ego_pair, fit_around_line, init_lane};
+use hough_init::{
+    Chord, HoughLine, LaneInit, Parabola, choose_ego_pair, fit_around_line, init_lane,
+};
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
 use vision_gradient::{EdgeClass, GreyImage, Region, keep_bright_stripes, split_stripes};
@@ -113,6 +115,8 @@ impl LaneTracker {
         let mut classes = [EdgeClass::LeftLane; 2 * MAX_LINES];
         let mut chords = [Chord::default(); 2 * MAX_LINES + 1];
         let mut found = [none; MAX_LINES];
+        // With `init.candidate_coverage`, each candidate's fit (reused when it is chosen).
+        let mut fits: [Option<LaneInit>; 2 * MAX_LINES] = [None; 2 * MAX_LINES];
         let mut m = 0;
         for k in 0..2 {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
@@ -130,16 +134,32 @@ impl LaneTracker {
                 continue;
             };
             for line in &found[..count] {
-                if let (Some(xt), Some(xb)) = (line.col_at_row(yt), line.col_at_row(yb)) {
-                    lines[m] = *line;
-                    classes[m] = class;
-                    chords[m] = Chord {
+                let chord = if self.cfg.init.candidate_coverage {
+                    let Ok(init) = fit_around_line(&self.candidates, *line, &self.init_params)
+                    else {
+                        continue;
+                    };
+                    fits[m] = Some(init);
+                    let p = init.parabola;
+                    Chord {
+                        col_top_px: p.col_at_row(yt),
+                        col_bottom_px: p.col_at_row(yb),
+                        support: self.row_coverage(&p),
+                    }
+                } else {
+                    let (Some(xt), Some(xb)) = (line.col_at_row(yt), line.col_at_row(yb)) else {
+                        continue;
+                    };
+                    Chord {
                         col_top_px: xt,
                         col_bottom_px: xb,
                         support: f64::from(line.votes),
-                    };
-                    m += 1;
-                }
+                    }
+                };
+                lines[m] = *line;
+                classes[m] = class;
+                chords[m] = chord;
+                m += 1;
             }
         }
         let s_max = chords[..m].iter().map(|c| c.support).fold(0.0, f64::max);
@@ -174,10 +194,40 @@ impl LaneTracker {
                 continue;
             }
             self.fill_candidates(classes[j]);
-            if let Ok(init) = fit_around_line(&self.candidates, lines[j], &self.init_params) {
+            let init = match fits[j] {
+                Some(init) => Ok(init),
+                None => fit_around_line(&self.candidates, lines[j], &self.init_params),
+            };
+            if let Ok(init) = init {
                 self.install(i, &init);
             }
         }
+    }
+
+    /// Row coverage of parabola `p` (`init.candidate_coverage`): over the ROI rows, the
+    /// candidate pixels in `self.candidates` (paired ones repeated) within the LS band of `p`,
+    /// at most `2·max(gradient.stripe_paired_votes, 1)` per row, summed. Counts in
+    /// `self.row_cover` (one per image row); no allocation.
+    fn row_coverage(&mut self, p: &Parabola) -> f64 {
+        let (top, bottom) = self.roi;
+        let band = self.init_params.band_px;
+        let cap = 2 * u32::from(self.cfg.gradient.stripe_paired_votes.max(1));
+        let cover = &mut self.row_cover;
+        cover.fill(0);
+        for &(x, y) in &self.candidates {
+            let (xf, yf) = (f64::from(x), f64::from(y));
+            if (xf - p.col_at_row(yf)).abs() <= band
+                && let Some(c) = cover.get_mut(y as usize)
+            {
+                *c = c.saturating_add(1);
+            }
+        }
+        cover
+            .get(top..bottom)
+            .unwrap_or(&[])
+            .iter()
+            .map(|&c| f64::from(c.min(cap)))
+            .sum()
     }
 
     /// Accept an initialisation of lane `i` (`self.candidates` holds the pixels it was fitted

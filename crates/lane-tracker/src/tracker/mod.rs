@@ -218,6 +218,8 @@ pub struct LaneTracker {
     hough: HoughWorkspace,
     init_params: LaneInitParams,
     candidates: Vec<(f32, f32)>,
+    /// Candidate pixels per image row near one parabola (`init.candidate_coverage`).
+    row_cover: Vec<u32>,
     scratch: Vec<Candidate>,
     row_norm: RowNorm,
     q: ProcessNoise<3>,
@@ -295,6 +297,7 @@ impl LaneTracker {
             candidates: Vec::with_capacity(
                 usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity,
             ),
+            row_cover: vec![0; height],
             scratch: Vec::with_capacity(capacity),
             row_norm,
             q,
