@@ -16,6 +16,10 @@ use crate::TrackerError;
 use crate::error::FilterFailure;
 use crate::wrls_lane::WrlsLane;
 
+/// The background of a candidate's row coverage is read on the parallel curves this many LS band
+/// half-widths to each side (a gap of one band between them and the band of the candidate).
+const BACKGROUND_SHIFT_BANDS: f64 = 3.0;
+
 impl LaneTracker {
     pub(super) fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
         let outward = self.outward_col();
@@ -204,30 +208,41 @@ impl LaneTracker {
         }
     }
 
-    /// Row coverage of parabola `p` (`init.candidate_coverage`): over the ROI rows, the
-    /// candidate pixels in `self.candidates` (paired ones repeated) within the LS band of `p`,
-    /// at most `2·max(gradient.stripe_paired_votes, 1)` per row, summed. Counts in
-    /// `self.row_cover` (one per image row); no allocation.
+    /// Row coverage of parabola `p` (`init.candidate_coverage`), net of the clutter around it:
+    /// over the ROI rows, the candidate pixels in `self.candidates` (paired ones repeated) within
+    /// the LS band (`±band_half_width_px`) of `p`, at most `2·max(gradient.stripe_paired_votes,
+    /// 1)` per row, summed; minus the mean of the same sum for the two parallel curves
+    /// `p ± 3·band_half_width_px` (a mark on a clean floor keeps its coverage, a line through
+    /// texture or clutter, as dense beside it as on it, loses it); at least 0. Counts in
+    /// `self.row_cover` (three per image row); no allocation.
     fn row_coverage(&mut self, p: &Parabola) -> f64 {
         let (top, bottom) = self.roi;
         let band = self.init_params.band_px;
+        let shift = BACKGROUND_SHIFT_BANDS * band;
         let cap = 2 * u32::from(self.cfg.gradient.stripe_paired_votes.max(1));
+        let h = self.height;
         let cover = &mut self.row_cover;
         cover.fill(0);
         for &(x, y) in &self.candidates {
-            let (xf, yf) = (f64::from(x), f64::from(y));
-            if (xf - p.col_at_row(yf)).abs() <= band
-                && let Some(c) = cover.get_mut(y as usize)
-            {
-                *c = c.saturating_add(1);
+            let r = f64::from(x) - p.col_at_row(f64::from(y));
+            let row = y as usize;
+            for (k, offset) in [0.0, shift, -shift].into_iter().enumerate() {
+                if (r - offset).abs() <= band
+                    && let Some(c) = cover.get_mut(k * h + row)
+                {
+                    *c = c.saturating_add(1);
+                }
             }
         }
-        cover
-            .get(top..bottom)
-            .unwrap_or(&[])
-            .iter()
-            .map(|&c| f64::from(c.min(cap)))
-            .sum()
+        let sum = |k: usize| -> f64 {
+            cover
+                .get(k * h + top..k * h + bottom)
+                .unwrap_or(&[])
+                .iter()
+                .map(|&c| f64::from(c.min(cap)))
+                .sum()
+        };
+        (sum(0) - 0.5 * (sum(1) + sum(2))).max(0.0)
     }
 
     /// Accept an initialisation of lane `i` (`self.candidates` holds the pixels it was fitted

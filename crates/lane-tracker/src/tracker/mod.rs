@@ -297,7 +297,7 @@ impl LaneTracker {
             candidates: Vec::with_capacity(
                 usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity,
             ),
-            row_cover: vec![0; height],
+            row_cover: vec![0; 3 * height],
             scratch: Vec::with_capacity(capacity),
             row_norm,
             q,
