@@ -119,14 +119,15 @@ impl LaneTracker {
         let mut classes = [EdgeClass::LeftLane; 2 * MAX_LINES];
         let mut chords = [Chord::default(); 2 * MAX_LINES + 1];
         let mut found = [none; MAX_LINES];
-        // With `init.candidate_coverage`, each candidate's fit (reused when it is chosen).
-        let mut fits: [Option<LaneInit>; 2 * MAX_LINES] = [None; 2 * MAX_LINES];
         let mut m = 0;
         for k in 0..2 {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
             self.fill_candidates(class);
             if self.candidates.len() < self.init_params.min_points {
                 continue;
+            }
+            if self.cfg.init.candidate_coverage {
+                self.sort_candidates_by_row();
             }
             let Ok(count) = self.hough.find_lines(
                 &self.candidates,
@@ -139,12 +140,9 @@ impl LaneTracker {
             };
             for line in &found[..count] {
                 let chord = if self.cfg.init.candidate_coverage {
-                    let Ok(init) = fit_around_line(&self.candidates, *line, &self.init_params)
-                    else {
+                    let Some(p) = self.row_fit(line) else {
                         continue;
                     };
-                    fits[m] = Some(init);
-                    let p = init.parabola;
                     Chord {
                         col_top_px: p.col_at_row(yt),
                         col_bottom_px: p.col_at_row(yb),
@@ -198,51 +196,174 @@ impl LaneTracker {
                 continue;
             }
             self.fill_candidates(classes[j]);
-            let init = match fits[j] {
-                Some(init) => Ok(init),
-                None => fit_around_line(&self.candidates, lines[j], &self.init_params),
-            };
-            if let Ok(init) = init {
+            if let Ok(init) = fit_around_line(&self.candidates, lines[j], &self.init_params) {
                 self.install(i, &init);
             }
         }
     }
 
+    /// `self.by_row` = `self.candidates` sorted by row, then column, with `self.row_start[r]`
+    /// the index of row `r`'s first pixel (`row_start[height]` = their number): counting sort
+    /// by row, then each row's few pixels sorted. No allocation.
+    fn sort_candidates_by_row(&mut self) {
+        let h = self.height;
+        let starts = &mut self.row_start;
+        starts.fill(0);
+        for &(_, y) in &self.candidates {
+            if let Some(c) = starts.get_mut(y as usize + 1) {
+                *c += 1;
+            }
+        }
+        for r in 0..h {
+            starts[r + 1] += starts[r];
+        }
+        let next = &mut self.row_next;
+        next.clear();
+        next.extend_from_slice(&starts[..h]);
+        let by_row = &mut self.by_row;
+        by_row.clear();
+        by_row.resize(starts[h] as usize, (0.0, 0.0));
+        for &(x, y) in &self.candidates {
+            if let Some(k) = next.get_mut(y as usize) {
+                by_row[*k as usize] = (x, y);
+                *k += 1;
+            }
+        }
+        for r in 0..h {
+            by_row[starts[r] as usize..starts[r + 1] as usize]
+                .sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        }
+    }
+
+    /// The pixels of row `r` in `self.by_row` (sorted by column) from the first with `x ≥ lo`
+    /// on (a binary search; callers scan on while `x ≤` their upper bound).
+    fn row_from(&self, r: usize, lo: f64) -> &[(f32, f32)] {
+        let (Some(&a), Some(&b)) = (self.row_start.get(r), self.row_start.get(r + 1)) else {
+            return &[];
+        };
+        let row = self.by_row.get(a as usize..b as usize).unwrap_or(&[]);
+        let from = row.partition_point(|p| f64::from(p.0) < lo);
+        row.get(from..).unwrap_or(&[])
+    }
+
+    /// The least-squares parabola a candidate `line` would be initialised with
+    /// (`hough_init::fit_around_line`'s pixel sets: those within `band_half_width_px` of the
+    /// line, then `refit_iterations` times those within it, horizontally, of the last fit), read
+    /// row by row from `self.by_row` so that each pass costs the pixels in the band, not every
+    /// candidate pixel; rows normalised over the ROI. `None` with fewer than `min_points` pixels
+    /// in a band, or a degenerate fit. For the choice of the ego pair only: the chosen line is
+    /// fitted by `fit_around_line` itself.
+    fn row_fit(&self, line: &HoughLine) -> Option<Parabola> {
+        let (top, bottom) = self.roi;
+        let band = self.init_params.band_px;
+        let (sin_t, cos_t) = line.theta_rad.sin_cos();
+        if cos_t.abs() < 1e-9 {
+            return None;
+        }
+        let yc = 0.5 * (top + bottom - 1) as f64;
+        let sc = (0.5 * (bottom - 1 - top) as f64).max(1.0);
+        // Pass 0 around the line: |x·cos θ + y·sin θ − ρ| ≤ band ⟺ |x − x_line(y)| ≤ band/|cos θ|.
+        let mut half = band / cos_t.abs();
+        let mut fit: Option<Parabola> = None;
+        for _ in 0..=self.init_params.refit_iterations {
+            // Σ u^k (k = 0..4) and Σ x·u^k (k = 0..2) over the pixels in the band.
+            let (mut su, mut sxu) = ([0.0f64; 5], [0.0f64; 3]);
+            let mut count = 0usize;
+            for r in top..bottom {
+                if self.row_start.get(r) == self.row_start.get(r + 1) {
+                    continue; // no pixel on this row
+                }
+                let x0 = match fit {
+                    Some(p) => p.col_at_row(r as f64),
+                    None => (line.rho_px - r as f64 * sin_t) / cos_t,
+                };
+                if !x0.is_finite() {
+                    continue;
+                }
+                let (mut k, mut sx) = (0usize, 0.0f64);
+                for p in self.row_from(r, x0 - half) {
+                    let x = f64::from(p.0);
+                    if x > x0 + half {
+                        break;
+                    }
+                    k += 1;
+                    sx += x;
+                }
+                if k == 0 {
+                    continue;
+                }
+                let u = (r as f64 - yc) / sc;
+                let u2 = u * u;
+                count += k;
+                let k = k as f64;
+                su[0] += k;
+                su[1] += k * u;
+                su[2] += k * u2;
+                su[3] += k * u2 * u;
+                su[4] += k * u2 * u2;
+                sxu[0] += sx;
+                sxu[1] += sx * u;
+                sxu[2] += sx * u2;
+            }
+            if count < self.init_params.min_points {
+                return None;
+            }
+            let n = nalgebra::Matrix3::new(
+                su[0], su[1], su[2], su[1], su[2], su[3], su[2], su[3], su[4],
+            );
+            let c = n.cholesky()?.solve(&nalgebra::Vector3::from(sxu));
+            // x = c0 + c1·u + c2·u², u = (y − yc)/sc, in pixel coefficients.
+            let p = Parabola {
+                a1: c[2] / (sc * sc),
+                a2: c[1] / sc - 2.0 * c[2] * yc / (sc * sc),
+                a3: c[0] - c[1] * yc / sc + c[2] * yc * yc / (sc * sc),
+            };
+            if !(p.a1.is_finite() && p.a2.is_finite() && p.a3.is_finite()) {
+                return None;
+            }
+            fit = Some(p);
+            half = band;
+        }
+        fit
+    }
+
     /// Row coverage of parabola `p` (`init.candidate_coverage`), net of the clutter around it:
-    /// over the ROI rows, the candidate pixels in `self.candidates` (paired ones repeated) within
-    /// the LS band (`±band_half_width_px`) of `p`, at most `2·max(gradient.stripe_paired_votes,
-    /// 1)` per row, summed; minus the mean of the same sum for the two parallel curves
+    /// over the ROI rows, the candidate pixels (paired ones repeated) within the LS band
+    /// (`±band_half_width_px`) of `p`, at most `2·max(gradient.stripe_paired_votes, 1)` per
+    /// row, summed; minus the mean of the same sum for the two parallel curves
     /// `p ± 3·band_half_width_px` (a mark on a clean floor keeps its coverage, a line through
-    /// texture or clutter, as dense beside it as on it, loses it); at least 0. Counts in
-    /// `self.row_cover` (three per image row); no allocation.
-    fn row_coverage(&mut self, p: &Parabola) -> f64 {
+    /// texture or clutter, as dense beside it as on it, loses it); at least 0. Read row by row
+    /// from `self.by_row`; no allocation.
+    fn row_coverage(&self, p: &Parabola) -> f64 {
         let (top, bottom) = self.roi;
         let band = self.init_params.band_px;
         let shift = BACKGROUND_SHIFT_BANDS * band;
-        let cap = 2 * u32::from(self.cfg.gradient.stripe_paired_votes.max(1));
-        let h = self.height;
-        let cover = &mut self.row_cover;
-        cover.fill(0);
-        for &(x, y) in &self.candidates {
-            let r = f64::from(x) - p.col_at_row(f64::from(y));
-            let row = y as usize;
-            for (k, offset) in [0.0, shift, -shift].into_iter().enumerate() {
-                if (r - offset).abs() <= band
-                    && let Some(c) = cover.get_mut(k * h + row)
-                {
-                    *c = c.saturating_add(1);
+        let cap = 2 * usize::from(self.cfg.gradient.stripe_paired_votes.max(1));
+        let (mut on, mut beside) = (0usize, 0usize);
+        for r in top..bottom {
+            let x = p.col_at_row(r as f64);
+            if !x.is_finite() || self.row_start.get(r) == self.row_start.get(r + 1) {
+                continue;
+            }
+            // The three bands do not overlap (shift = 3·band > 2·band): one scan.
+            let [mut left, mut centre, mut right] = [0usize; 3];
+            for q in self.row_from(r, x - shift - band) {
+                let d = f64::from(q.0) - x;
+                if d > shift + band {
+                    break;
+                }
+                if d.abs() <= band {
+                    centre += 1;
+                } else if (d - shift).abs() <= band {
+                    right += 1;
+                } else if (d + shift).abs() <= band {
+                    left += 1;
                 }
             }
+            on += centre.min(cap);
+            beside += left.min(cap) + right.min(cap);
         }
-        let sum = |k: usize| -> f64 {
-            cover
-                .get(k * h + top..k * h + bottom)
-                .unwrap_or(&[])
-                .iter()
-                .map(|&c| f64::from(c.min(cap)))
-                .sum()
-        };
-        (sum(0) - 0.5 * (sum(1) + sum(2))).max(0.0)
+        (on as f64 - 0.5 * beside as f64).max(0.0)
     }
 
     /// Accept an initialisation of lane `i` (`self.candidates` holds the pixels it was fitted

@@ -218,8 +218,11 @@ pub struct LaneTracker {
     hough: HoughWorkspace,
     init_params: LaneInitParams,
     candidates: Vec<(f32, f32)>,
-    /// Candidate pixels per image row near one parabola (`init.candidate_coverage`).
-    row_cover: Vec<u32>,
+    /// The candidate pixels sorted by row then column, `row_start[r]..row_start[r + 1]` the
+    /// pixels of row `r` (`init.candidate_coverage`), and a counting-sort cursor per row.
+    by_row: Vec<(f32, f32)>,
+    row_start: Vec<u32>,
+    row_next: Vec<u32>,
     scratch: Vec<Candidate>,
     row_norm: RowNorm,
     q: ProcessNoise<3>,
@@ -297,7 +300,11 @@ impl LaneTracker {
             candidates: Vec::with_capacity(
                 usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity,
             ),
-            row_cover: vec![0; 3 * height],
+            by_row: Vec::with_capacity(
+                usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity,
+            ),
+            row_start: vec![0; height + 1],
+            row_next: Vec::with_capacity(height),
             scratch: Vec::with_capacity(capacity),
             row_norm,
             q,
