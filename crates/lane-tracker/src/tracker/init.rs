@@ -127,7 +127,7 @@ impl LaneTracker {
                 continue;
             }
             if self.cfg.init.candidate_coverage {
-                self.sort_candidates_by_row();
+                self.sort_candidates_by_row(class);
             }
             let Ok(count) = self.hough.find_lines(
                 &self.candidates,
@@ -202,15 +202,29 @@ impl LaneTracker {
         }
     }
 
-    /// `self.by_row` = `self.candidates` sorted by row, then column, with `self.row_start[r]`
-    /// the index of row `r`'s first pixel (`row_start[height]` = their number): counting sort
-    /// by row, then each row's few pixels sorted. No allocation.
-    fn sort_candidates_by_row(&mut self) {
-        let h = self.height;
+    /// `self.by_row` = the edge pixels of `class` as `(column, weight)` sorted by row then
+    /// column, the weight being how many times `self.candidates` holds the pixel
+    /// (`gradient.stripe_paired_votes` for a paired one, else 1), with `self.row_start[r]` the
+    /// index of row `r`'s first pixel (`row_start[height]` = their number): the paired pixels
+    /// marked in a bit mask, a counting sort by row, and a row sorted by column only if the
+    /// detector did not emit it so. No allocation.
+    fn sort_candidates_by_row(&mut self, class: EdgeClass) {
+        let (w, h) = (self.width, self.height);
+        let paired_votes = self.cfg.gradient.stripe_paired_votes;
+        let bit =
+            |p: &vision_gradient::EdgePixel| usize::from(p.row_px) * w + usize::from(p.col_px);
+        let mask = &mut self.paired_mask;
+        if paired_votes > 0 {
+            for p in self.paired.iter_class(class) {
+                if let Some(word) = mask.get_mut(bit(p) / 64) {
+                    *word |= 1 << (bit(p) % 64);
+                }
+            }
+        }
         let starts = &mut self.row_start;
         starts.fill(0);
-        for &(_, y) in &self.candidates {
-            if let Some(c) = starts.get_mut(y as usize + 1) {
+        for e in self.edges.iter_class(class) {
+            if let Some(c) = starts.get_mut(usize::from(e.row_px) + 1) {
                 *c += 1;
             }
         }
@@ -222,22 +236,34 @@ impl LaneTracker {
         next.extend_from_slice(&starts[..h]);
         let by_row = &mut self.by_row;
         by_row.clear();
-        by_row.resize(starts[h] as usize, (0.0, 0.0));
-        for &(x, y) in &self.candidates {
-            if let Some(k) = next.get_mut(y as usize) {
-                by_row[*k as usize] = (x, y);
+        by_row.resize(starts[h] as usize, (0, 0));
+        for e in self.edges.iter_class(class) {
+            let paired = mask
+                .get(bit(e) / 64)
+                .is_some_and(|word| word & (1 << (bit(e) % 64)) != 0);
+            let weight = if paired { u16::from(paired_votes) } else { 1 };
+            if let Some(k) = next.get_mut(usize::from(e.row_px)) {
+                by_row[*k as usize] = (e.col_px, weight);
                 *k += 1;
             }
         }
+        // Leave the mask clear for the next call.
+        for p in self.paired.iter_class(class) {
+            if let Some(word) = mask.get_mut(bit(p) / 64) {
+                *word = 0;
+            }
+        }
         for r in 0..h {
-            by_row[starts[r] as usize..starts[r + 1] as usize]
-                .sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            let row = &mut by_row[starts[r] as usize..starts[r + 1] as usize];
+            if !row.windows(2).all(|p| p[0].0 <= p[1].0) {
+                row.sort_unstable();
+            }
         }
     }
 
     /// The pixels of row `r` in `self.by_row` (sorted by column) from the first with `x ≥ lo`
     /// on (a binary search; callers scan on while `x ≤` their upper bound).
-    fn row_from(&self, r: usize, lo: f64) -> &[(f32, f32)] {
+    fn row_from(&self, r: usize, lo: f64) -> &[(u16, u16)] {
         let (Some(&a), Some(&b)) = (self.row_start.get(r), self.row_start.get(r + 1)) else {
             return &[];
         };
@@ -281,13 +307,13 @@ impl LaneTracker {
                     continue;
                 }
                 let (mut k, mut sx) = (0usize, 0.0f64);
-                for p in self.row_from(r, x0 - half) {
-                    let x = f64::from(p.0);
+                for &(col, weight) in self.row_from(r, x0 - half) {
+                    let x = f64::from(col);
                     if x > x0 + half {
                         break;
                     }
-                    k += 1;
-                    sx += x;
+                    k += usize::from(weight);
+                    sx += f64::from(weight) * x;
                 }
                 if k == 0 {
                     continue;
@@ -347,17 +373,18 @@ impl LaneTracker {
             }
             // The three bands do not overlap (shift = 3·band > 2·band): one scan.
             let [mut left, mut centre, mut right] = [0usize; 3];
-            for q in self.row_from(r, x - shift - band) {
-                let d = f64::from(q.0) - x;
+            for &(col, weight) in self.row_from(r, x - shift - band) {
+                let d = f64::from(col) - x;
                 if d > shift + band {
                     break;
                 }
+                let w = usize::from(weight);
                 if d.abs() <= band {
-                    centre += 1;
+                    centre += w;
                 } else if (d - shift).abs() <= band {
-                    right += 1;
+                    right += w;
                 } else if (d + shift).abs() <= band {
-                    left += 1;
+                    left += w;
                 }
             }
             on += centre.min(cap);
