@@ -41,6 +41,11 @@ pub struct EgoPairParams {
     /// A candidate with support below this fraction of the largest is not considered, in
     /// `[0, 1]`. Default `0.2`.
     pub min_support_frac: f64,
+    /// Weight of the pair's width at the bottom ROI row against its support, `≥ 0`: the score
+    /// loses `width_weight·w_b/W`. With the centre term it makes the boundaries nearest the
+    /// image centre on each side win over a wider pair of stronger lines (the ego lane's
+    /// boundaries are the nearest marks on each side of the camera). Default `0.0`.
+    pub width_weight: f64,
 }
 
 impl Default for EgoPairParams {
@@ -52,6 +57,7 @@ impl Default for EgoPairParams {
             max_top_width_ratio: 0.9,
             centre_weight: 2.0,
             min_support_frac: 0.2,
+            width_weight: 0.0,
         }
     }
 }
@@ -105,6 +111,9 @@ impl EgoPairParams {
                 "must be finite and >= 0",
             );
         }
+        if !(fin(self.width_weight) && self.width_weight >= 0.0) {
+            return bad("width_weight", self.width_weight, "must be finite and >= 0");
+        }
         if !(0.0..=1.0).contains(&self.min_support_frac) {
             return bad(
                 "min_support_frac",
@@ -133,8 +142,10 @@ pub struct EgoChoice {
 /// * the camera is inside the lane: `L.bottom ≤ W/2 + m` and `R.bottom ≥ W/2 − m`,
 ///   `m = centre_margin_frac·W`;
 ///
-/// and the plausible pair with the highest `(s_L + s_R)/s_max − centre_weight·|mid − W/2|/W`
-/// wins (support, and nearness to the image centre: the ego lane, not a neighbour). With
+/// and the plausible pair with the highest
+/// `(s_L + s_R)/s_max − centre_weight·|mid − W/2|/W − width_weight·w_b/W` wins (support, and
+/// nearness to the image centre: the ego lane, not a neighbour; the width term prefers the
+/// nearest boundary on each side over a wider pair). With
 /// `locked = Some(i)`, only pairs containing chord `i` are considered (a boundary already
 /// tracked). Without a plausible pair, the single candidate with the best
 /// `s/s_max − centre_weight·|bottom − W/2|/W` is returned on the side of the centre its bottom
@@ -186,8 +197,9 @@ pub fn choose_ego_pair(
                 continue;
             }
             let mid = 0.5 * (cl.col_bottom_px + cr.col_bottom_px);
-            let score =
-                (cl.support + cr.support) / s_max - params.centre_weight * (mid - c).abs() / w;
+            let score = (cl.support + cr.support) / s_max
+                - params.centre_weight * (mid - c).abs() / w
+                - params.width_weight * wb / w;
             if best.is_none_or(|(b, _, _)| score > b) {
                 best = Some((score, l, r));
             }

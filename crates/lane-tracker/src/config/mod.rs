@@ -102,6 +102,19 @@ pub struct InitConfig {
     /// Non-maximum suppression between candidate lines: normal distance ρ, px (≥ 0).
     #[serde(default = "default_separation_px")]
     pub candidate_separation_px: f64,
+    /// Joint initialisation: how a candidate line is weighed for the ego pair. `false` (default
+    /// when absent): by its Hough line (its columns at the top and bottom ROI rows) and its Hough
+    /// votes (near-field straight-line evidence). `true`: by the least-squares parabola fitted
+    /// around it (as an initialisation would) — its columns at the top and bottom ROI rows, and
+    /// its row coverage: the sum over the ROI rows of the candidate pixels (stripe-paired ones
+    /// counted `gradient.stripe_paired_votes` times) within `band_half_width_px` of the
+    /// parabola, at most `2·max(stripe_paired_votes, 1)` per row (both edges of a paired mark),
+    /// so a line seen over the whole ROI beats a short strong one; net of the clutter beside
+    /// it (minus the mean coverage of the parallel curves `3·band_half_width_px` to each side,
+    /// at least 0), so a line through texture counts for little. A candidate whose fit fails
+    /// is not considered.
+    #[serde(default)]
+    pub candidate_coverage: bool,
     /// The plausible ego lane (`hough_init::EgoPairParams`; widths are fractions of the image
     /// width, dimensionless), used when `candidate_lines > 0`.
     #[serde(default)]
@@ -430,6 +443,7 @@ impl TrackerConfig {
                     "centre_margin_frac" => "init.ego_pair.centre_margin_frac",
                     "max_top_width_ratio" => "init.ego_pair.max_top_width_ratio",
                     "centre_weight" => "init.ego_pair.centre_weight",
+                    "width_weight" => "init.ego_pair.width_weight",
                     _ => "init.ego_pair.min_support_frac",
                 },
                 value,

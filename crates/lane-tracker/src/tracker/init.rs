@@ -3,7 +3,9 @@
 //! (crate docs: the strongest lines of both bands, the ego pair chosen together), with the sanity
 //! checks that accept a fit.
 
-use hough_init::{Chord, HoughLine, LaneInit, choose_ego_pair, fit_around_line, init_lane};
+use hough_init::{
+    Chord, HoughLine, LaneInit, Parabola, choose_ego_pair, fit_around_line, init_lane,
+};
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
 use vision_gradient::{EdgeClass, GreyImage, Region, keep_bright_stripes, split_stripes};
@@ -13,6 +15,10 @@ use super::{Estimator, LaneFilter, LaneState, LaneTracker};
 use crate::TrackerError;
 use crate::error::FilterFailure;
 use crate::wrls_lane::WrlsLane;
+
+/// The background of a candidate's row coverage is read on the parallel curves this many LS band
+/// half-widths to each side (a gap of one band between them and the band of the candidate).
+const BACKGROUND_SHIFT_BANDS: f64 = 3.0;
 
 impl LaneTracker {
     pub(super) fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
@@ -120,6 +126,9 @@ impl LaneTracker {
             if self.candidates.len() < self.init_params.min_points {
                 continue;
             }
+            if self.cfg.init.candidate_coverage {
+                self.sort_candidates_by_row(class);
+            }
             let Ok(count) = self.hough.find_lines(
                 &self.candidates,
                 &band,
@@ -130,16 +139,29 @@ impl LaneTracker {
                 continue;
             };
             for line in &found[..count] {
-                if let (Some(xt), Some(xb)) = (line.col_at_row(yt), line.col_at_row(yb)) {
-                    lines[m] = *line;
-                    classes[m] = class;
-                    chords[m] = Chord {
+                let chord = if self.cfg.init.candidate_coverage {
+                    let Some(p) = self.row_fit(line) else {
+                        continue;
+                    };
+                    Chord {
+                        col_top_px: p.col_at_row(yt),
+                        col_bottom_px: p.col_at_row(yb),
+                        support: self.row_coverage(&p),
+                    }
+                } else {
+                    let (Some(xt), Some(xb)) = (line.col_at_row(yt), line.col_at_row(yb)) else {
+                        continue;
+                    };
+                    Chord {
                         col_top_px: xt,
                         col_bottom_px: xb,
                         support: f64::from(line.votes),
-                    };
-                    m += 1;
-                }
+                    }
+                };
+                lines[m] = *line;
+                classes[m] = class;
+                chords[m] = chord;
+                m += 1;
             }
         }
         let s_max = chords[..m].iter().map(|c| c.support).fold(0.0, f64::max);
@@ -178,6 +200,197 @@ impl LaneTracker {
                 self.install(i, &init);
             }
         }
+    }
+
+    /// `self.by_row` = the edge pixels of `class` as `(column, weight)` sorted by row then
+    /// column, the weight being how many times `self.candidates` holds the pixel
+    /// (`gradient.stripe_paired_votes` for a paired one, else 1), with `self.row_start[r]` the
+    /// index of row `r`'s first pixel (`row_start[height]` = their number): the paired pixels
+    /// marked in a bit mask, a counting sort by row, and a row sorted by column only if the
+    /// detector did not emit it so. No allocation.
+    fn sort_candidates_by_row(&mut self, class: EdgeClass) {
+        let (w, h) = (self.width, self.height);
+        let paired_votes = self.cfg.gradient.stripe_paired_votes;
+        let bit =
+            |p: &vision_gradient::EdgePixel| usize::from(p.row_px) * w + usize::from(p.col_px);
+        let mask = &mut self.paired_mask;
+        if paired_votes > 0 {
+            for p in self.paired.iter_class(class) {
+                if let Some(word) = mask.get_mut(bit(p) / 64) {
+                    *word |= 1 << (bit(p) % 64);
+                }
+            }
+        }
+        let starts = &mut self.row_start;
+        starts.fill(0);
+        for e in self.edges.iter_class(class) {
+            if let Some(c) = starts.get_mut(usize::from(e.row_px) + 1) {
+                *c += 1;
+            }
+        }
+        for r in 0..h {
+            starts[r + 1] += starts[r];
+        }
+        let next = &mut self.row_next;
+        next.clear();
+        next.extend_from_slice(&starts[..h]);
+        let by_row = &mut self.by_row;
+        by_row.clear();
+        by_row.resize(starts[h] as usize, (0, 0));
+        for e in self.edges.iter_class(class) {
+            let paired = mask
+                .get(bit(e) / 64)
+                .is_some_and(|word| word & (1 << (bit(e) % 64)) != 0);
+            let weight = if paired { u16::from(paired_votes) } else { 1 };
+            if let Some(k) = next.get_mut(usize::from(e.row_px)) {
+                by_row[*k as usize] = (e.col_px, weight);
+                *k += 1;
+            }
+        }
+        // Leave the mask clear for the next call.
+        for p in self.paired.iter_class(class) {
+            if let Some(word) = mask.get_mut(bit(p) / 64) {
+                *word = 0;
+            }
+        }
+        for r in 0..h {
+            let row = &mut by_row[starts[r] as usize..starts[r + 1] as usize];
+            if !row.windows(2).all(|p| p[0].0 <= p[1].0) {
+                row.sort_unstable();
+            }
+        }
+    }
+
+    /// The pixels of row `r` in `self.by_row` (sorted by column) from the first with `x ≥ lo`
+    /// on (a binary search; callers scan on while `x ≤` their upper bound).
+    fn row_from(&self, r: usize, lo: f64) -> &[(u16, u16)] {
+        let (Some(&a), Some(&b)) = (self.row_start.get(r), self.row_start.get(r + 1)) else {
+            return &[];
+        };
+        let row = self.by_row.get(a as usize..b as usize).unwrap_or(&[]);
+        let from = row.partition_point(|p| f64::from(p.0) < lo);
+        row.get(from..).unwrap_or(&[])
+    }
+
+    /// The least-squares parabola a candidate `line` would be initialised with
+    /// (`hough_init::fit_around_line`'s pixel sets: those within `band_half_width_px` of the
+    /// line, then `refit_iterations` times those within it, horizontally, of the last fit), read
+    /// row by row from `self.by_row` so that each pass costs the pixels in the band, not every
+    /// candidate pixel; rows normalised over the ROI. `None` with fewer than `min_points` pixels
+    /// in a band, or a degenerate fit. For the choice of the ego pair only: the chosen line is
+    /// fitted by `fit_around_line` itself.
+    fn row_fit(&self, line: &HoughLine) -> Option<Parabola> {
+        let (top, bottom) = self.roi;
+        let band = self.init_params.band_px;
+        let (sin_t, cos_t) = line.theta_rad.sin_cos();
+        if cos_t.abs() < 1e-9 {
+            return None;
+        }
+        let yc = 0.5 * (top + bottom - 1) as f64;
+        let sc = (0.5 * (bottom - 1 - top) as f64).max(1.0);
+        // Pass 0 around the line: |x·cos θ + y·sin θ − ρ| ≤ band ⟺ |x − x_line(y)| ≤ band/|cos θ|.
+        let mut half = band / cos_t.abs();
+        let mut fit: Option<Parabola> = None;
+        for _ in 0..=self.init_params.refit_iterations {
+            // Σ u^k (k = 0..4) and Σ x·u^k (k = 0..2) over the pixels in the band.
+            let (mut su, mut sxu) = ([0.0f64; 5], [0.0f64; 3]);
+            let mut count = 0usize;
+            for r in top..bottom {
+                if self.row_start.get(r) == self.row_start.get(r + 1) {
+                    continue; // no pixel on this row
+                }
+                let x0 = match fit {
+                    Some(p) => p.col_at_row(r as f64),
+                    None => (line.rho_px - r as f64 * sin_t) / cos_t,
+                };
+                if !x0.is_finite() {
+                    continue;
+                }
+                let (mut k, mut sx) = (0usize, 0.0f64);
+                for &(col, weight) in self.row_from(r, x0 - half) {
+                    let x = f64::from(col);
+                    if x > x0 + half {
+                        break;
+                    }
+                    k += usize::from(weight);
+                    sx += f64::from(weight) * x;
+                }
+                if k == 0 {
+                    continue;
+                }
+                let u = (r as f64 - yc) / sc;
+                let u2 = u * u;
+                count += k;
+                let k = k as f64;
+                su[0] += k;
+                su[1] += k * u;
+                su[2] += k * u2;
+                su[3] += k * u2 * u;
+                su[4] += k * u2 * u2;
+                sxu[0] += sx;
+                sxu[1] += sx * u;
+                sxu[2] += sx * u2;
+            }
+            if count < self.init_params.min_points {
+                return None;
+            }
+            let n = nalgebra::Matrix3::new(
+                su[0], su[1], su[2], su[1], su[2], su[3], su[2], su[3], su[4],
+            );
+            let c = n.cholesky()?.solve(&nalgebra::Vector3::from(sxu));
+            // x = c0 + c1·u + c2·u², u = (y − yc)/sc, in pixel coefficients.
+            let p = Parabola {
+                a1: c[2] / (sc * sc),
+                a2: c[1] / sc - 2.0 * c[2] * yc / (sc * sc),
+                a3: c[0] - c[1] * yc / sc + c[2] * yc * yc / (sc * sc),
+            };
+            if !(p.a1.is_finite() && p.a2.is_finite() && p.a3.is_finite()) {
+                return None;
+            }
+            fit = Some(p);
+            half = band;
+        }
+        fit
+    }
+
+    /// Row coverage of parabola `p` (`init.candidate_coverage`), net of the clutter around it:
+    /// over the ROI rows, the candidate pixels (paired ones repeated) within the LS band
+    /// (`±band_half_width_px`) of `p`, at most `2·max(gradient.stripe_paired_votes, 1)` per
+    /// row, summed; minus the mean of the same sum for the two parallel curves
+    /// `p ± 3·band_half_width_px` (a mark on a clean floor keeps its coverage, a line through
+    /// texture or clutter, as dense beside it as on it, loses it); at least 0. Read row by row
+    /// from `self.by_row`; no allocation.
+    fn row_coverage(&self, p: &Parabola) -> f64 {
+        let (top, bottom) = self.roi;
+        let band = self.init_params.band_px;
+        let shift = BACKGROUND_SHIFT_BANDS * band;
+        let cap = 2 * usize::from(self.cfg.gradient.stripe_paired_votes.max(1));
+        let (mut on, mut beside) = (0usize, 0usize);
+        for r in top..bottom {
+            let x = p.col_at_row(r as f64);
+            if !x.is_finite() || self.row_start.get(r) == self.row_start.get(r + 1) {
+                continue;
+            }
+            // The three bands do not overlap (shift = 3·band > 2·band): one scan.
+            let [mut left, mut centre, mut right] = [0usize; 3];
+            for &(col, weight) in self.row_from(r, x - shift - band) {
+                let d = f64::from(col) - x;
+                if d > shift + band {
+                    break;
+                }
+                let w = usize::from(weight);
+                if d.abs() <= band {
+                    centre += w;
+                } else if (d - shift).abs() <= band {
+                    right += w;
+                } else if (d + shift).abs() <= band {
+                    left += w;
+                }
+            }
+            on += centre.min(cap);
+            beside += left.min(cap) + right.min(cap);
+        }
+        (on as f64 - 0.5 * beside as f64).max(0.0)
     }
 
     /// Accept an initialisation of lane `i` (`self.candidates` holds the pixels it was fitted

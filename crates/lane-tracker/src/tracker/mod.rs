@@ -218,6 +218,14 @@ pub struct LaneTracker {
     hough: HoughWorkspace,
     init_params: LaneInitParams,
     candidates: Vec<(f32, f32)>,
+    /// The candidate pixels as `(column, weight)` sorted by row then column,
+    /// `row_start[r]..row_start[r + 1]` the pixels of row `r` (`init.candidate_coverage`), and
+    /// a counting-sort cursor per row.
+    by_row: Vec<(u16, u16)>,
+    /// One bit per image pixel: the paired pixels of one class while `by_row` is built.
+    paired_mask: Vec<u64>,
+    row_start: Vec<u32>,
+    row_next: Vec<u32>,
     scratch: Vec<Candidate>,
     row_norm: RowNorm,
     q: ProcessNoise<3>,
@@ -295,6 +303,10 @@ impl LaneTracker {
             candidates: Vec::with_capacity(
                 usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity,
             ),
+            by_row: Vec::with_capacity(capacity),
+            row_start: vec![0; height + 1],
+            paired_mask: vec![0; (width * height).div_ceil(64)],
+            row_next: Vec::with_capacity(height),
             scratch: Vec::with_capacity(capacity),
             row_norm,
             q,
