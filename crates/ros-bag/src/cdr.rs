@@ -146,7 +146,7 @@ impl CdrWriter {
     }
 
     fn align(&mut self, n: usize) {
-        while (self.buf.len() - ORIGIN) % n != 0 {
+        while !(self.buf.len() - ORIGIN).is_multiple_of(n) {
             self.buf.push(0);
         }
     }

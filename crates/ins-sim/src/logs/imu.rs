@@ -28,7 +28,7 @@ pub(super) enum ImuStream {
         rates: bool,
     },
     Bag {
-        reader: TopicReader,
+        reader: Box<TopicReader>,
         path: PathBuf,
         count: usize,
     },
@@ -52,7 +52,7 @@ impl ImuStream {
             let all = topics(&name).map_err(bag_err)?;
             let chosen = choose_topic(&name, &all, topic, &[IMU], "IMU").map_err(bag_err)?;
             return Ok(ImuStream::Bag {
-                reader: TopicReader::open(&name, chosen).map_err(bag_err)?,
+                reader: Box::new(TopicReader::open(&name, chosen).map_err(bag_err)?),
                 path: path.to_path_buf(),
                 count: 0,
             });
