@@ -174,8 +174,14 @@ fn test() -> Result<()> {
             program.to_string_lossy(),
             args.join(" ")
         );
-        let status = Command::new(program)
-            .args(args)
+        let mut command = Command::new(program);
+        command.args(args);
+        // A CI run builds everything once: incremental caches would only take disk (gigabytes
+        // over the gate's profiles), never time. A user's own setting wins.
+        if std::env::var_os("CI").is_some() && std::env::var_os("CARGO_INCREMENTAL").is_none() {
+            command.env("CARGO_INCREMENTAL", "0");
+        }
+        let status = command
             .status()
             .with_context(|| format!("could not start step `{}`", step.name))?;
         if !status.success() {
