@@ -9,7 +9,10 @@ import io
 import json
 import os
 import pathlib
+import pty
+import select
 import subprocess
+import tempfile
 
 import jsonschema
 import numpy as np
@@ -193,6 +196,12 @@ def test_mcap_out_reads_back_with_python_and_validates(bags, tmp_path):
                 assert len(doc["points"]) == 2 and all(len(p["points"]) > 2 for p in doc["points"])
             if channel.topic == "/camera/image":
                 assert doc["width"] == 320 and doc["encoding"] == "mono8"
+            if channel.topic == "/lanes":
+                # Each held lane's coefficient covariance, also without --camera.
+                cov = doc["lane_cov_px"]
+                for lane, c in zip(doc["lanes"], cov):
+                    if lane["coeffs"] is not None:
+                        assert c is not None and all(c[i][i] > 0 for i in range(3)), doc
     assert counts == {"/camera/image": 40, "/camera/lanes": 40, "/lanes": 40}
     assert set(schemas) == {"foxglove.RawImage", "foxglove.ImageAnnotations", "ita_nav.LaneFrame"}
 
@@ -278,3 +287,44 @@ def test_nav_app_ins_mcap_out_reads_back_and_validates(tmp_path):
     assert counts["/ins/epochs"] == 900
     assert counts["/ins/errors"] == 901
     assert counts["/ins/solution"] >= 1800
+
+
+def run_with_terminal_stderr(args):
+    """Runs nav-app with stderr on a pseudo-terminal and stdout to a file; returns both."""
+    leader, follower = pty.openpty()
+    try:
+        with tempfile.TemporaryFile() as stdout:
+            p = subprocess.Popen(args, stdout=stdout, stderr=follower, stdin=subprocess.DEVNULL)
+            os.close(follower)
+            err = b""
+            while True:
+                ready, _, _ = select.select([leader], [], [], 120)
+                if not ready:
+                    p.kill()
+                    pytest.fail("nav-app wrote nothing to its terminal for 120 s")
+                try:
+                    chunk = os.read(leader, 65536)
+                except OSError:  # EIO: the child closed the terminal
+                    break
+                if not chunk:
+                    break
+                err += chunk
+            assert p.wait(timeout=120) == 0, err.decode(errors="replace")
+            stdout.seek(0)
+            out = stdout.read()
+        return out.decode(errors="replace"), err.decode(errors="replace")
+    finally:
+        os.close(leader)
+
+
+def test_a_terminal_gets_a_progress_bar_on_stderr_never_on_stdout_nor_under_json():
+    # Long enough (the clip looped to 30 000 frames) for the bar to be drawn.
+    base = [exe(), "--input", str(SAMPLE), "--loop", "--max-frames", "30000"]
+    out, err = run_with_terminal_stderr(base)
+    assert " frames " in err and " lost" in err, err[-2000:]
+    assert "\x1b[" in err or "\r" in err, "the bar redraws in place"
+    assert " lost" not in out and "\x1b" not in out and "\r" not in out
+    # Under --json stdout is the JSON lines only and the terminal gets no bar.
+    out, err = run_with_terminal_stderr(base[:-1] + ["2000", "--json"])
+    assert len(lanes_of(out)) == 2000
+    assert " lost" not in err and "\x1b[" not in err, err[-2000:]

@@ -5,14 +5,33 @@ use std::fs::File;
 use std::io::{BufReader, Seek};
 use std::sync::Arc;
 
-use mcap::sans_io::summary_reader::{SummaryReadEvent, SummaryReader};
+use mcap::sans_io::summary_reader::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 
 use crate::BagError;
 
-/// Reading options: the chunks' CRCs are checked, so a damaged byte in a chunk is an error, not
-/// a wrong pixel. (The data-section CRC, which would hash every byte a second time, is not.)
-fn checked() -> mcap::sans_io::LinearReaderOptions {
-    mcap::sans_io::LinearReaderOptions::default().with_validate_chunk_crcs(true)
+/// Reading options: each chunk's CRC is checked **before** any of its messages is delivered, so
+/// a damaged byte in a chunk is an error, never a wrong pixel. (Checking it after, as the
+/// `validate_chunk_crcs` option does, would hand out the chunk's altered messages first; the
+/// data-section CRC, which would hash every byte a second time, is not checked.)
+///
+/// Records are also bounded ([`record_limit`]): a damaged length field must be an error, not an
+/// attempt to allocate exabytes (which aborts the process).
+fn checked(file_len: u64) -> mcap::sans_io::LinearReaderOptions {
+    mcap::sans_io::LinearReaderOptions::default()
+        .with_prevalidate_chunk_crcs(true)
+        .with_record_length_limit(record_limit(file_len))
+}
+
+/// The largest record, compressed or decompressed chunk the reader accepts in a file of
+/// `file_len` bytes: 256 × the file (chunks of camera frames compress far less than that), never
+/// below 64 MiB (a few 4K RGBA frames) nor above 1 GiB.
+pub fn record_limit(file_len: u64) -> usize {
+    const MIB: u64 = 1 << 20;
+    usize::try_from(file_len.saturating_mul(256).clamp(64 * MIB, 1024 * MIB)).unwrap_or(usize::MAX)
+}
+
+fn file_len(file: &File, path: &str) -> Result<u64, BagError> {
+    Ok(file.metadata().map_err(io(path))?.len())
 }
 
 /// One topic of a bag.
@@ -56,7 +75,12 @@ fn info(c: &mcap::Channel<'_>) -> TopicInfo {
 /// truncated file).
 fn summary(path: &str) -> Result<Option<mcap::Summary>, BagError> {
     let mut file = File::open(path).map_err(io(path))?;
-    let mut reader = SummaryReader::new();
+    let len = file_len(&file, path)?;
+    let mut reader = SummaryReader::new_with_options(
+        SummaryReaderOptions::default()
+            .with_file_size(len)
+            .with_record_length_limit(record_limit(len)),
+    );
     while let Some(event) = reader.next_event() {
         let Ok(event) = event else {
             return Ok(None);
@@ -85,8 +109,9 @@ pub fn topics(path: &str) -> Result<Vec<TopicInfo>, BagError> {
             // No summary (a bag cut short while recording): the channels of its messages, up to
             // the damage (reading stops with an error there; the topics before it are usable).
             let file = File::open(path).map_err(io(path))?;
+            let len = file_len(&file, path)?;
             let mut seen: Vec<TopicInfo> = Vec::new();
-            for m in mcap::io::MessageReader::new_with_options(BufReader::new(file), checked()) {
+            for m in mcap::io::MessageReader::new_with_options(BufReader::new(file), checked(len)) {
                 let m = match m {
                     Ok(m) => m,
                     Err(e) if seen.is_empty() => return Err(mcap_err(path)(e)),
@@ -221,13 +246,14 @@ impl TopicReader {
     /// [`BagError::Io`].
     pub fn open(path: &str, topic: TopicInfo) -> Result<Self, BagError> {
         let file = File::open(path).map_err(io(path))?;
+        let len = file_len(&file, path)?;
         Ok(Self {
             path: path.to_owned(),
             schema: Arc::from(topic.schema.as_str()),
             topic,
             messages: mcap::io::MessageReader::new_with_options(
                 BufReader::with_capacity(1 << 16, file),
-                checked(),
+                checked(len),
             ),
         })
     }

@@ -169,6 +169,11 @@ pub struct ErrorStats {
     pub rms_axis: [f64; 3],
     /// Fraction of (time, axis) pairs with |error| ≤ 2σ.
     pub inside_2sigma: f64,
+    /// Fraction of compared times whose 3-D error lies inside the filter's 2σ ellipsoid: the
+    /// block's NEES `eᵀ P⁻¹ e` at or below χ²₃(0.9545) ≈ 8.02, the region a consistent filter's
+    /// error falls in with the probability of a 1-D ±2σ interval. An epoch counts only if all
+    /// three axes together are inside.
+    pub inside_2sigma_epochs: f64,
 }
 
 /// One compared time: error (solution − reference: δp NED m, δv NED m/s, ψ rad; ψ NaN without
@@ -362,6 +367,9 @@ struct MetricsAcc {
     last: [f64; 3],
     inside: [u64; 3],
     sigma_count: [u64; 3],
+    inside_epochs: [u64; 3],
+    epoch_count: [u64; 3],
+    ellipsoid_2sigma: f64,
     nees_sum: f64,
     nees_n: u64,
     nis_sum: f64,
@@ -383,6 +391,11 @@ impl MetricsAcc {
             last: [0.0; 3],
             inside: [0; 3],
             sigma_count: [0; 3],
+            inside_epochs: [0; 3],
+            epoch_count: [0; 3],
+            // χ²₃ at the probability of ±2σ in one dimension (erf(√2) = 0.9545).
+            ellipsoid_2sigma: akf::chi_square_quantile(0.954_499_736_103_641_6, 3.0)
+                .unwrap_or(8.024_881_760_266_3),
             nees_sum: 0.0,
             nees_n: 0,
             nis_sum: 0.0,
@@ -432,6 +445,16 @@ impl MetricsAcc {
                     self.sigma_count[b] += 1;
                     if v.abs() <= 2.0 * s {
                         self.inside[b] += 1;
+                    }
+                }
+            }
+            if let Some(p) = &p {
+                let block: SMatrix<f64, 3, 3> = p.fixed_view::<3, 3>(3 * b, 3 * b).into_owned();
+                let eb: SMatrix<f64, 3, 1> = e.fixed_rows::<3>(3 * b).into_owned();
+                if let Some(c) = block.cholesky() {
+                    self.epoch_count[b] += 1;
+                    if (eb.transpose() * c.solve(&eb))[(0, 0)] <= self.ellipsoid_2sigma {
+                        self.inside_epochs[b] += 1;
                     }
                 }
             }
@@ -486,6 +509,11 @@ impl MetricsAcc {
             ],
             inside_2sigma: if acc.sigma_count[b] > 0 {
                 acc.inside[b] as f64 / acc.sigma_count[b] as f64
+            } else {
+                f64::NAN
+            },
+            inside_2sigma_epochs: if acc.epoch_count[b] > 0 {
+                acc.inside_epochs[b] as f64 / acc.epoch_count[b] as f64
             } else {
                 f64::NAN
             },

@@ -272,10 +272,11 @@ fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
 fn print_metrics(truth: &Path, m: &ReplayMetrics) {
     let line = |what: &str, unit: &str, e: &logs::ErrorStats, scale: f64| {
         eprintln!(
-            "  {what:<9} RMS {:>9.3} {unit}, max {:>9.3} {unit}, last {:>9.3} {unit}; inside 2σ {:>5.1} %",
+            "  {what:<9} RMS {:>9.3} {unit}, max {:>9.3} {unit}, last {:>9.3} {unit}; inside 2σ: {:>5.1} % of epochs (3-D), {:>5.1} % of axes",
             e.rms * scale,
             e.max * scale,
             e.last * scale,
+            100.0 * e.inside_2sigma_epochs,
             100.0 * e.inside_2sigma
         );
     };

@@ -113,7 +113,7 @@ struct Args {
     topic: Option<String>,
     /// Also write the lanes to this MCAP file for Foxglove: the grey frame
     /// (foxglove.RawImage, /camera/image), the lanes drawn on it (foxglove.ImageAnnotations,
-    /// /camera/lanes) and the lane estimate (JSON, /lanes).
+    /// /camera/lanes) and the lane estimate with its covariance (JSON, /lanes).
     #[arg(long, value_name = "FILE")]
     mcap_out: Option<PathBuf>,
     #[command(flatten)]
@@ -215,8 +215,8 @@ struct FrameJson<'a> {
     /// The ego lane in metres with σ (with `--camera`; `null` unless both lanes are held).
     #[serde(skip_serializing_if = "Option::is_none")]
     ego_lane: Option<Option<EgoLaneReport>>,
-    /// Each lane's coefficient covariance in pixels (with `--camera`; `null` for a lane without
-    /// an estimate).
+    /// Each lane's coefficient covariance in pixels (with `--camera` or `--mcap-out`, whose
+    /// `/lanes` messages always carry it; `null` for a lane without an estimate).
     #[serde(skip_serializing_if = "Option::is_none")]
     lane_cov_px: Option<[Option<[[f64; 3]; 3]>; 2]>,
     /// Device fields (with `--device` only).
@@ -410,7 +410,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 lanes: &report.lanes,
                 track_us: dt.as_secs_f64() * 1e6,
                 ego_lane: ego,
-                lane_cov_px: camera.as_ref().map(|_| {
+                lane_cov_px: (camera.is_some() || mcap_out.is_some()).then(|| {
                     [Side::Left, Side::Right]
                         .map(|s| t.lane_covariance_px(s).map(|p| p.transpose().into()))
                 }),
