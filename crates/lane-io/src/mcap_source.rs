@@ -157,15 +157,15 @@ impl FrameSource for McapImageSource {
         };
         let index = self.index;
         self.index += 1;
-        let decoded = if &*msg.schema == IMAGE {
-            Image::decode(&msg.data)
+        let decoded = if msg.schema == IMAGE {
+            Image::decode(msg.data)
                 .map_err(|e| e.to_string())
                 .and_then(|img| {
                     from_image(&img, frame)?;
                     Ok(img.header.t_s())
                 })
         } else {
-            CompressedImage::decode(&msg.data)
+            CompressedImage::decode(msg.data)
                 .map_err(|e| e.to_string())
                 .and_then(|img| {
                     from_compressed(&img, frame, &mut self.rgb)?;

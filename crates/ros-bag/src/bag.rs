@@ -3,7 +3,6 @@
 
 use std::fs::File;
 use std::io::{BufReader, Seek};
-use std::sync::Arc;
 
 use mcap::sans_io::summary_reader::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 
@@ -211,23 +210,33 @@ pub fn choose_topic(
     Ok(chosen)
 }
 
-/// One message of the topic read: its payload and times.
+/// One message of the topic read: its payload (borrowed from the reader until the next call)
+/// and times.
 #[derive(Debug)]
-pub struct BagMessage {
+pub struct BagMessage<'a> {
     /// The schema name of its channel.
-    pub schema: Arc<str>,
+    pub schema: &'a str,
     /// Log time, ns.
     pub log_time_ns: u64,
     /// The CDR payload.
-    pub data: Vec<u8>,
+    pub data: &'a [u8],
 }
 
 /// The messages of one topic in file order, streamed from the file.
+///
+/// Reads the records with the `mcap` crate's sans-I/O linear reader and keeps only what the
+/// topic needs: the ids of its channels (from the channel records) and one payload buffer that
+/// is reused, so a frame costs no allocation once the buffers have grown to the largest chunk and
+/// message (the crate's own `MessageReader` copies every payload into a new vector).
 pub struct TopicReader {
     path: String,
     topic: TopicInfo,
-    schema: Arc<str>,
-    messages: mcap::io::MessageReader<BufReader<File>>,
+    file: File,
+    reader: mcap::sans_io::LinearReader,
+    /// Every channel id seen, and whether it is the topic's.
+    channels: Vec<(u16, bool)>,
+    payload: Vec<u8>,
+    done: bool,
 }
 
 impl std::fmt::Debug for TopicReader {
@@ -249,12 +258,12 @@ impl TopicReader {
         let len = file_len(&file, path)?;
         Ok(Self {
             path: path.to_owned(),
-            schema: Arc::from(topic.schema.as_str()),
             topic,
-            messages: mcap::io::MessageReader::new_with_options(
-                BufReader::with_capacity(1 << 16, file),
-                checked(len),
-            ),
+            file,
+            reader: mcap::sans_io::LinearReader::new_with_options(checked(len)),
+            channels: Vec::new(),
+            payload: Vec::new(),
+            done: false,
         })
     }
 
@@ -268,21 +277,92 @@ impl TopicReader {
         &self.topic
     }
 
-    /// The next message of the topic, `None` at the end.
+    /// The next message of the topic, `None` at the end of the data section.
     ///
     /// # Errors
-    /// [`BagError::Mcap`] for a damaged file (after the last good message).
-    pub fn next_message(&mut self) -> Result<Option<BagMessage>, BagError> {
-        for m in self.messages.by_ref() {
-            let m = m.map_err(mcap_err(&self.path))?;
-            if m.channel.topic == self.topic.topic {
-                return Ok(Some(BagMessage {
-                    schema: self.schema.clone(),
-                    log_time_ns: m.log_time,
-                    data: m.data.into_owned(),
-                }));
+    /// [`BagError::Io`], [`BagError::Mcap`] for a damaged file (after the last good message; a
+    /// message on a channel no channel record announced is such damage).
+    pub fn next_message(&mut self) -> Result<Option<BagMessage<'_>>, BagError> {
+        if self.done {
+            return Ok(None);
+        }
+        let path = self.path.as_str();
+        while let Some(event) = self.reader.next_event() {
+            let event = match event {
+                Ok(e) => e,
+                Err(e) => {
+                    self.done = true;
+                    return Err(mcap_err(path)(e));
+                }
+            };
+            let (opcode, data) = match event {
+                mcap::sans_io::LinearReadEvent::ReadRequest(need) => {
+                    let n = loop {
+                        match std::io::Read::read(&mut self.file, self.reader.insert(need)) {
+                            Ok(n) => break n,
+                            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                            Err(e) => {
+                                self.done = true;
+                                return Err(io(path)(e));
+                            }
+                        }
+                    };
+                    self.reader.notify_read(n);
+                    continue;
+                }
+                mcap::sans_io::LinearReadEvent::Record { opcode, data } => (opcode, data),
+            };
+            match opcode {
+                mcap::records::op::DATA_END => {
+                    // The summary after it repeats channels and holds no message.
+                    self.done = true;
+                    return Ok(None);
+                }
+                mcap::records::op::CHANNEL | mcap::records::op::MESSAGE => {}
+                _ => continue,
+            }
+            let record = match mcap::parse_record(opcode, data) {
+                Ok(r) => r,
+                Err(e) => {
+                    self.done = true;
+                    return Err(mcap_err(path)(e));
+                }
+            };
+            match record {
+                mcap::records::Record::Channel(c)
+                    if !self.channels.iter().any(|(id, _)| *id == c.id) =>
+                {
+                    self.channels.push((c.id, c.topic == self.topic.topic));
+                }
+                mcap::records::Record::Message { header, data } => {
+                    match self
+                        .channels
+                        .iter()
+                        .find(|(id, _)| *id == header.channel_id)
+                    {
+                        Some((_, true)) => {
+                            self.payload.clear();
+                            self.payload.extend_from_slice(&data);
+                            return Ok(Some(BagMessage {
+                                schema: &self.topic.schema,
+                                log_time_ns: header.log_time,
+                                data: &self.payload,
+                            }));
+                        }
+                        Some((_, false)) => {}
+                        None => {
+                            self.done = true;
+                            return Err(mcap_err(path)(mcap::McapError::UnknownChannel(
+                                header.sequence,
+                                header.channel_id,
+                            )));
+                        }
+                    }
+                }
+                _ => {}
             }
         }
+        self.done = true;
         Ok(None)
     }
 }

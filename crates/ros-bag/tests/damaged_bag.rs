@@ -137,7 +137,7 @@ fn read_images(path: &str) -> (Vec<Vec<u8>>, Option<BagError>) {
     let mut got = Vec::new();
     loop {
         match reader.next_message() {
-            Ok(Some(m)) => got.push(m.data),
+            Ok(Some(m)) => got.push(m.data.to_vec()),
             Ok(None) => return (got, None),
             Err(e) => return (got, Some(e)),
         }

@@ -130,17 +130,18 @@ impl ImuStream {
                     return Ok(None);
                 };
                 *count += 1;
-                let imu = Imu::decode(&msg.data).map_err(|source| SimError::Bag {
+                let log_time_ns = msg.log_time_ns;
+                let decoded = Imu::decode(msg.data).map(|imu| (imu.header.t_s(), imu.frd()));
+                let (t_s, (f, w)) = decoded.map_err(|source| SimError::Bag {
                     source: ros_bag::BagError::Message {
                         path: path.display().to_string(),
                         topic: reader.topic().topic.clone(),
-                        log_time_ns: msg.log_time_ns,
+                        log_time_ns,
                         source: Box::new(source),
                     },
                 })?;
-                let (f, w) = imu.frd();
                 Ok(Some(ImuRecord {
-                    t_s: imu.header.t_s(),
+                    t_s,
                     a: Vector3::from(f),
                     b: Vector3::from(w),
                     line: *count,
