@@ -48,12 +48,13 @@ pub enum LaneIoError {
         source: ros_bag::BagError,
     },
     /// An image message of a bag cannot be turned into a grey frame.
-    #[error("topic {topic}: {what}")]
+    #[error("topic {topic}: {problem}")]
     BagImage {
         /// The topic.
         topic: String,
         /// What is wrong with the message.
-        what: String,
+        #[source]
+        problem: BagImageProblem,
     },
     /// A still image could not be decoded (truncated, corrupt or of an unknown format).
     #[error("{path}: cannot decode image: {source}")]
@@ -336,4 +337,52 @@ fn frame_reason(source: &LaneIoError) -> String {
         LaneIoError::ImageDecode { source, .. } => format!("cannot decode image: {source}"),
         other => other.to_string(),
     }
+}
+
+/// Why one image message of a bag cannot become a grey frame.
+#[derive(Debug, thiserror::Error)]
+pub enum BagImageProblem {
+    /// The CDR payload does not decode as the topic's message type.
+    #[error(transparent)]
+    Message(#[from] ros_bag::BagError),
+    /// An uncompressed image in a pixel encoding the source does not convert.
+    #[error("pixel encoding `{encoding}` is not mono8, mono16, rgb8, bgr8, rgba8 or bgra8")]
+    PixelEncoding {
+        /// The message's `encoding`.
+        encoding: String,
+    },
+    /// An image with no pixels.
+    #[error("zero-size image {width_px}×{height_px}")]
+    ZeroSize {
+        /// Columns.
+        width_px: usize,
+        /// Rows.
+        height_px: usize,
+    },
+    /// Fewer data bytes than the size, encoding and step declare.
+    #[error("{len} bytes of data for {width_px}×{height_px} {encoding} with step {step} bytes")]
+    ShortData {
+        /// Bytes present.
+        len: usize,
+        /// Columns.
+        width_px: usize,
+        /// Rows.
+        height_px: usize,
+        /// Pixel encoding.
+        encoding: String,
+        /// Bytes per row declared.
+        step: usize,
+    },
+    /// A compressed image in a format other than JPEG or PNG.
+    #[error("compressed format `{format}` is not jpeg or png")]
+    CompressedFormat {
+        /// The message's `format`.
+        format: String,
+    },
+    /// The JPEG or PNG does not decode.
+    #[error("cannot decode the compressed image: {0}")]
+    Decode(#[source] image::ImageError),
+    /// The frame buffer cannot take the image's size.
+    #[error("frame buffer: {0}")]
+    FrameBuffer(#[source] grey_frame::FrameError),
 }

@@ -40,5 +40,5 @@ pub mod capture {
     pub use bt848_capture::{CaptureError, InputSelect, PixelFormat, VideoStd, parse_size};
 }
 
-pub use error::LaneIoError;
+pub use error::{BagImageProblem, LaneIoError};
 pub use frame::{FrameError, FrameMeta, FrameSource, GreyFrame};

@@ -11,6 +11,7 @@ use grey_frame::{GreyFrame, luma_bt601};
 use ros_bag::bag::{TopicReader, choose_topic, topics};
 use ros_bag::msgs::{COMPRESSED_IMAGE, CompressedImage, IMAGE, Image};
 
+use crate::BagImageProblem;
 use crate::LaneIoError;
 use crate::frame::{FrameMeta, FrameSource};
 
@@ -50,20 +51,20 @@ impl McapImageSource {
         })
     }
 
-    fn bad(&self, frame: u64, what: String) -> LaneIoError {
+    fn bad(&self, frame: u64, problem: BagImageProblem) -> LaneIoError {
         LaneIoError::BadFrame {
             name: self.reader.path().to_owned(),
             frame,
             source: Box::new(LaneIoError::BagImage {
                 topic: self.reader.topic().topic.clone(),
-                what,
+                problem,
             }),
         }
     }
 }
 
-/// Fills `frame` from an uncompressed image; `Err(reason)` for what cannot be converted.
-fn from_image(img: &Image<'_>, frame: &mut GreyFrame) -> Result<(), String> {
+/// Fills `frame` from an uncompressed image.
+fn from_image(img: &Image<'_>, frame: &mut GreyFrame) -> Result<(), BagImageProblem> {
     let (w, h, step) = (img.width as usize, img.height as usize, img.step as usize);
     let bpp = match img.encoding {
         "mono8" | "8UC1" => 1,
@@ -71,24 +72,27 @@ fn from_image(img: &Image<'_>, frame: &mut GreyFrame) -> Result<(), String> {
         "rgb8" | "bgr8" => 3,
         "rgba8" | "bgra8" => 4,
         other => {
-            return Err(format!(
-                "pixel encoding `{other}` is not mono8, mono16, rgb8, bgr8, rgba8 or bgra8"
-            ));
+            return Err(BagImageProblem::PixelEncoding {
+                encoding: other.to_owned(),
+            });
         }
     };
     if w == 0 || h == 0 {
-        return Err(format!("zero-size image {w}×{h}"));
+        return Err(BagImageProblem::ZeroSize {
+            width_px: w,
+            height_px: h,
+        });
     }
     if step < w * bpp || img.data.len() < step * (h - 1) + w * bpp {
-        return Err(format!(
-            "{} bytes of data for {w}×{h} {} with step {step}",
-            img.data.len(),
-            img.encoding
-        ));
+        return Err(BagImageProblem::ShortData {
+            len: img.data.len(),
+            width_px: w,
+            height_px: h,
+            encoding: img.encoding.to_owned(),
+            step,
+        });
     }
-    frame
-        .reshape(w, h)
-        .map_err(|e| format!("frame buffer: {e}"))?;
+    frame.reshape(w, h).map_err(BagImageProblem::FrameBuffer)?;
     let out = frame.data_mut();
     for (r, row_out) in out.chunks_exact_mut(w).enumerate() {
         let row = &img.data[r * step..r * step + w * bpp];
@@ -119,24 +123,21 @@ fn from_compressed(
     img: &CompressedImage<'_>,
     frame: &mut GreyFrame,
     rgb: &mut Vec<u8>,
-) -> Result<(), String> {
+) -> Result<(), BagImageProblem> {
     let f = img.format.to_ascii_lowercase();
     let format = if f.contains("png") {
         image::ImageFormat::Png
     } else if f.contains("jpeg") || f.contains("jpg") {
         image::ImageFormat::Jpeg
     } else {
-        return Err(format!(
-            "compressed format `{}` is not jpeg or png",
-            img.format
-        ));
+        return Err(BagImageProblem::CompressedFormat {
+            format: img.format.to_owned(),
+        });
     };
-    let decoded = image::load_from_memory_with_format(img.data, format)
-        .map_err(|e| format!("cannot decode the {format:?} image: {e}"))?;
+    let decoded =
+        image::load_from_memory_with_format(img.data, format).map_err(BagImageProblem::Decode)?;
     let (w, h) = (decoded.width() as usize, decoded.height() as usize);
-    frame
-        .reshape(w, h)
-        .map_err(|e| format!("frame buffer: {e}"))?;
+    frame.reshape(w, h).map_err(BagImageProblem::FrameBuffer)?;
     match decoded {
         image::DynamicImage::ImageLuma8(g) => frame.data_mut().copy_from_slice(g.as_raw()),
         other => {
@@ -159,14 +160,14 @@ impl FrameSource for McapImageSource {
         self.index += 1;
         let decoded = if msg.schema == IMAGE {
             Image::decode(msg.data)
-                .map_err(|e| e.to_string())
+                .map_err(BagImageProblem::from)
                 .and_then(|img| {
                     from_image(&img, frame)?;
                     Ok(img.header.t_s())
                 })
         } else {
             CompressedImage::decode(msg.data)
-                .map_err(|e| e.to_string())
+                .map_err(BagImageProblem::from)
                 .and_then(|img| {
                     from_compressed(&img, frame, &mut self.rgb)?;
                     Ok(img.header.t_s())
