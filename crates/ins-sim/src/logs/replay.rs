@@ -451,9 +451,9 @@ impl MetricsAcc {
             if let Some(p) = &p {
                 let block: SMatrix<f64, 3, 3> = p.fixed_view::<3, 3>(3 * b, 3 * b).into_owned();
                 let eb: SMatrix<f64, 3, 1> = e.fixed_rows::<3>(3 * b).into_owned();
-                if let Some(c) = block.cholesky() {
+                if let Some(inside) = inside_ellipsoid(&block, &eb, self.ellipsoid_2sigma) {
                     self.epoch_count[b] += 1;
-                    if (eb.transpose() * c.solve(&eb))[(0, 0)] <= self.ellipsoid_2sigma {
+                    if inside {
                         self.inside_epochs[b] += 1;
                     }
                 }
@@ -538,6 +538,17 @@ impl MetricsAcc {
         }
         self.out
     }
+}
+
+/// Whether the error `e` lies inside the ellipsoid `eᵀ P⁻¹ e ≤ threshold` of the covariance `p`;
+/// `None` when `p` is not positive definite.
+fn inside_ellipsoid(
+    p: &SMatrix<f64, 3, 3>,
+    e: &SMatrix<f64, 3, 1>,
+    threshold: f64,
+) -> Option<bool> {
+    let c = p.cholesky()?;
+    Some((e.transpose() * c.solve(e))[(0, 0)] <= threshold)
 }
 
 /// Mutable state of one replay besides the filter.
@@ -837,4 +848,39 @@ pub fn compare_with_truth(
         c.rms_pos_3d_m = (sum2 / c.matched as f64).sqrt();
     }
     Ok(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    /// Errors drawn from N(0, P) fall inside the 2σ ellipsoid with the probability of ±2σ in one
+    /// dimension (0.9545); errors twice too large far less often; a singular P is not judged.
+    #[test]
+    fn the_two_sigma_ellipsoid_holds_its_probability_for_a_correlated_covariance() {
+        let threshold = akf::chi_square_quantile(0.954_499_736_103_641_6, 3.0).unwrap();
+        assert!((threshold - 8.0249).abs() < 1e-3, "{threshold}");
+        let l = SMatrix::<f64, 3, 3>::new(2.0, 0.0, 0.0, 1.5, 0.5, 0.0, -0.7, 0.3, 0.1);
+        let p = l * l.transpose();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2026);
+        let n = 20_000;
+        let (mut inside, mut inside_doubled) = (0, 0);
+        for _ in 0..n {
+            let z = SMatrix::<f64, 3, 1>::from_fn(|_, _| StandardNormal.sample(&mut rng));
+            let e = l * z;
+            inside += usize::from(inside_ellipsoid(&p, &e, threshold).unwrap());
+            inside_doubled += usize::from(inside_ellipsoid(&p, &(2.0 * e), threshold).unwrap());
+        }
+        let frac = inside as f64 / n as f64;
+        // Binomial σ at n = 20 000: 0.0015.
+        assert!((frac - 0.9545).abs() < 0.006, "{frac}");
+        assert!((inside_doubled as f64 / n as f64) < 0.6, "{inside_doubled}");
+        let singular = SMatrix::<f64, 3, 3>::from_diagonal_element(0.0);
+        assert_eq!(
+            inside_ellipsoid(&singular, &SMatrix::zeros(), threshold),
+            None
+        );
+    }
 }
