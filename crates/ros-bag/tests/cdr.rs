@@ -3,8 +3,9 @@
 //! an IMU sample.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
+mod common;
+
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
 use ros_bag::cdr::CdrReader;
 use ros_bag::msgs::{CompressedImage, Header, Image, Imu};
 
@@ -105,17 +106,8 @@ fn cut_and_damaged_messages_are_errors() {
 
 const SEED: u64 = 0x6364_7200;
 
-fn config(cases: u32) -> Config {
-    Config {
-        cases,
-        rng_seed: RngSeed::Fixed(SEED),
-        failure_persistence: None,
-        ..Config::default()
-    }
-}
-
 proptest! {
-    #![proptest_config(config(256))]
+    #![proptest_config(common::seeded(256, SEED))]
     #[test]
     fn messages_round_trip(
         frame_id in "[a-z_/]{0,12}",

@@ -6,11 +6,12 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::io::Write;
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
 use ros_bag::BagError;
 use ros_bag::bag::{self, TopicReader};
 use ros_bag::msgs::{Header, Image, Imu};
@@ -216,17 +217,8 @@ fn a_topic_of_the_wrong_type_is_refused_with_the_list_of_topics() {
 
 const SEED: u64 = 0x6d63_6170;
 
-fn config(cases: u32) -> Config {
-    Config {
-        cases,
-        rng_seed: RngSeed::Fixed(SEED),
-        failure_persistence: None,
-        ..Config::default()
-    }
-}
-
 proptest! {
-    #![proptest_config(config(256))]
+    #![proptest_config(common::seeded(256, SEED))]
 
     #[test]
     fn a_bag_cut_short_anywhere_delivers_a_faithful_prefix(
