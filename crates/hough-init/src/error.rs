@@ -99,6 +99,14 @@ pub enum HoughError {
         /// Image height, pixels.
         height_px: usize,
     },
+    /// An oriented point's normal angle is not a finite angle in `[−90°, 90°)`.
+    #[error("point {index} has normal angle {normal_deg}°, not a finite angle in [-90°, 90°)")]
+    InvalidNormal {
+        /// Index of the point in the input.
+        index: usize,
+        /// The angle it carried, degrees.
+        normal_deg: f64,
+    },
     /// Not enough points to go on.
     #[error("too few {set} points: {found} < {required}")]
     TooFewPoints {

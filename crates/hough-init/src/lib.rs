@@ -155,4 +155,4 @@ pub use hough::{HoughLine, HoughWorkspace, MAX_ACCUMULATOR_CELLS, MAX_IMAGE_SIDE
 pub use init::{LaneInit, fit_around_line, init_lane};
 pub use parabola::{MIN_RELATIVE_PIVOT, Parabola, ParabolaFit, fit_parabola, fit_parabola_where};
 pub use params::{AngleBand, HoughParams, LaneInitParams};
-pub use point::Point;
+pub use point::{OrientedPoint, Point};

@@ -32,3 +32,33 @@ impl PixelPoint for Point {
         self.row_px
     }
 }
+
+/// An edge pixel with the normal angle of its edge (an addition beyond the paper, for
+/// [`crate::HoughWorkspace::find_lines_oriented`]): image coordinates, pixels, and the angle
+/// `θ` of the pixel's gradient from the column axis towards the (downward) row axis, folded
+/// into `[−90°, 90°)` — the normal angle of the Hough line the edge is locally part of
+/// (`vision_gradient::edge_normal_deg` computes it).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrientedPoint {
+    /// Column coordinate `x` (to the right), pixels.
+    pub col_px: f32,
+    /// Row coordinate `y` (downwards), pixels.
+    pub row_px: f32,
+    /// Normal angle `θ` of the edge, degrees in `[−90, 90)`.
+    pub normal_deg: f32,
+    /// Votes the point casts in each of its θ bins (≥ 1; a pixel that counts more, such as the
+    /// side of a bright stripe, casts several — the same as repeating it).
+    pub votes: u16,
+}
+
+impl PixelPoint for OrientedPoint {
+    #[inline]
+    fn col_px(&self) -> f64 {
+        f64::from(self.col_px)
+    }
+    #[inline]
+    fn row_px(&self) -> f64 {
+        f64::from(self.row_px)
+    }
+}

@@ -5,7 +5,8 @@
 
 use alloc_counter::allocations_in;
 use hough_init::{
-    AngleBand, HoughParams, HoughWorkspace, LaneInitParams, Point, fit_parabola, init_lane,
+    AngleBand, HoughLine, HoughParams, HoughWorkspace, LaneInitParams, OrientedPoint, Point,
+    fit_parabola, init_lane,
 };
 
 #[global_allocator]
@@ -28,9 +29,26 @@ fn repeated_initialisations_do_not_allocate() {
     let (probe, allocations) = allocations_in(|| std::hint::black_box(vec![1u8; 16]));
     assert_eq!(allocations, 1, "counter is not counting");
     drop(probe);
+    let oriented: Vec<OrientedPoint> = left
+        .iter()
+        .map(|p| OrientedPoint {
+            col_px: p.col_px as f32,
+            row_px: p.row_px as f32,
+            normal_deg: 51.3,
+            votes: 1,
+        })
+        .collect();
+    let mut lines = [HoughLine {
+        rho_px: 0.0,
+        theta_rad: 0.0,
+        votes: 0,
+    }; 4];
     let (used, allocations) = allocations_in(|| {
         let mut used = 0;
         for _ in 0..10 {
+            used += ws
+                .find_lines_oriented(&oriented, &AngleBand::LEFT_LANE, 15.0, 3.0, 8.0, &mut lines)
+                .unwrap();
             used += init_lane(&left, &AngleBand::LEFT_LANE, &mut ws, &params)
                 .unwrap()
                 .points_used;

@@ -22,6 +22,30 @@ pub struct EdgePixel {
     pub magnitude: u16,
     /// Orientation class.
     pub class: EdgeClass,
+    /// Horizontal Sobel response `gx` (grey levels, positive when the image brightens to the
+    /// right), `|gx| ≤ 1020`, never 0 for a kept pixel. With `magnitude` and `class` it gives
+    /// the whole gradient: [`EdgePixel::gradient`].
+    pub gx: i16,
+}
+
+impl EdgePixel {
+    /// The Sobel gradient `(gx, gy)` of the pixel, grey levels (`gy` positive when the image
+    /// brightens downwards): `|gy| = magnitude − |gx|`, and `gy` has the sign of `gx` for
+    /// [`EdgeClass::LeftLane`] (`gx·gy > 0`) and the opposite sign for
+    /// [`EdgeClass::RightLane`] — what [`crate::sobel_gradient`] computes from the image, with
+    /// no image access.
+    #[inline]
+    #[must_use]
+    pub fn gradient(&self) -> (i16, i16) {
+        let gy_abs = (self.magnitude as i16).saturating_sub(self.gx.saturating_abs());
+        let same_sign = matches!(self.class, EdgeClass::LeftLane);
+        let gy = if (self.gx >= 0) == same_sign {
+            gy_abs
+        } else {
+            -gy_abs
+        };
+        (self.gx, gy)
+    }
 }
 
 impl grey_frame::PixelPoint for EdgePixel {
@@ -154,6 +178,7 @@ mod tests {
             row_px: 203,
             magnitude: 90,
             class: EdgeClass::RightLane,
+            gx: 40,
         };
         assert_eq!((p.col_px(), p.row_px()), (17.0, 203.0));
         // Taken as is where a point set is expected (a slice of edge pixels).

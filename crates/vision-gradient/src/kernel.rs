@@ -76,7 +76,7 @@ const BLOCK: usize = 16;
 /// `|gx|, |gy| <= 1020`, so `|gx| + |gy| <= 2040` fits `i16`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn sobel(a: u8, b: u8, c: u8, d: u8, f: u8, g: u8, h: u8, k: u8) -> (i16, i16) {
+pub(crate) fn sobel(a: u8, b: u8, c: u8, d: u8, f: u8, g: u8, h: u8, k: u8) -> (i16, i16) {
     let (a, b, c, d) = (i16::from(a), i16::from(b), i16::from(c), i16::from(d));
     let (f, g, h, k) = (i16::from(f), i16::from(g), i16::from(h), i16::from(k));
     let gx = (c - a) + 2 * (f - d) + (k - g);
@@ -102,6 +102,7 @@ fn classify(gx: i16, gy: i16, band: Band, thr: i16) -> u8 {
 /// One fixed block of [`BLOCK`] pixels: fixed-size arrays, no remainder loop, so the block is
 /// straight-line vector code. Blocks where no pixel reaches the threshold skip the band test.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn block(
     up: &[u8; BLOCK + 2],
     mid: &[u8; BLOCK + 2],
@@ -110,8 +111,8 @@ fn block(
     thr: i16,
     mag: &mut [u16; BLOCK],
     cls: &mut [u8; BLOCK],
+    gx: &mut [i16; BLOCK],
 ) {
-    let mut gx = [0i16; BLOCK];
     let mut gy = [0i16; BLOCK];
     let mut any = false;
     for i in 0..BLOCK {
@@ -153,6 +154,7 @@ fn block_at(
     thr: i16,
     mag: &mut [u16],
     cls: &mut [u8],
+    gx: &mut [i16],
     i: usize,
 ) -> Option<()> {
     block(
@@ -163,6 +165,7 @@ fn block_at(
         thr,
         mag.get_mut(i..i + BLOCK)?.try_into().ok()?,
         cls.get_mut(i..i + BLOCK)?.try_into().ok()?,
+        gx.get_mut(i..i + BLOCK)?.try_into().ok()?,
     );
     Some(())
 }
@@ -181,26 +184,40 @@ fn pixel(
     k: u8,
     band: Band,
     thr: i16,
-) -> (u16, u8) {
+) -> (u16, u8, i16) {
     let (gx, gy) = sobel(a, b, c, d, f, g, h, k);
-    ((gx.abs() + gy.abs()) as u16, classify(gx, gy, band, thr))
+    (
+        (gx.abs() + gy.abs()) as u16,
+        classify(gx, gy, band, thr),
+        gx,
+    )
 }
 
 /// Kernel over one row segment. `up`, `mid`, `dn` hold columns `c-1 ..= c+n` of three
-/// consecutive rows, `mag` and `cls` (length `n`) receive columns `c .. c+n`.
+/// consecutive rows, `mag`, `cls` and `gx` (length `n`) receive columns `c .. c+n`.
 /// Full blocks first; the remainder is one more block ending at `n` (overlapping the previous
 /// one, which recomputes identical values) or, for `n < BLOCK`, a per-pixel loop.
 #[inline(always)]
-fn kernel(up: &[u8], mid: &[u8], dn: &[u8], band: Band, thr: i16, mag: &mut [u16], cls: &mut [u8]) {
-    let n = mag.len().min(cls.len());
+#[allow(clippy::too_many_arguments)]
+fn kernel(
+    up: &[u8],
+    mid: &[u8],
+    dn: &[u8],
+    band: Band,
+    thr: i16,
+    mag: &mut [u16],
+    cls: &mut [u8],
+    gx: &mut [i16],
+) {
+    let n = mag.len().min(cls.len()).min(gx.len());
     if n >= BLOCK {
         let mut i = 0;
         while i + BLOCK <= n {
-            block_at(up, mid, dn, band, thr, mag, cls, i);
+            block_at(up, mid, dn, band, thr, mag, cls, gx, i);
             i += BLOCK;
         }
         if i < n {
-            block_at(up, mid, dn, band, thr, mag, cls, n - BLOCK);
+            block_at(up, mid, dn, band, thr, mag, cls, gx, n - BLOCK);
         }
         return;
     }
@@ -209,7 +226,7 @@ fn kernel(up: &[u8], mid: &[u8], dn: &[u8], band: Band, thr: i16, mag: &mut [u16
         return;
     }
     for i in 0..n {
-        let (m, k) = pixel(
+        let (m, k, x) = pixel(
             up[i],
             up[i + 1],
             up[i + 2],
@@ -223,6 +240,7 @@ fn kernel(up: &[u8], mid: &[u8], dn: &[u8], band: Band, thr: i16, mag: &mut [u16
         );
         mag[i] = m;
         cls[i] = k;
+        gx[i] = x;
     }
 }
 
@@ -242,6 +260,7 @@ fn pass_impl(
     }
     let mut mag = [0u16; CHUNK];
     let mut cls = [0u8; CHUNK];
+    let mut gxs = [0i16; CHUNK];
     for r in (1..h - 1).rev() {
         let (c0, c1) = match region {
             CheckedRegion::Full | CheckedRegion::Mask(_) => (1, w - 1),
@@ -268,8 +287,17 @@ fn pass_impl(
         let mut c = c0;
         while c < c1 {
             let n = CHUNK.min(c1 - c);
-            let (m, k) = (&mut mag[..n], &mut cls[..n]);
-            kernel(&up[c - 1..], &mid[c - 1..], &dn[c - 1..], band, thr, m, k);
+            let (m, k, x) = (&mut mag[..n], &mut cls[..n], &mut gxs[..n]);
+            kernel(
+                &up[c - 1..],
+                &mid[c - 1..],
+                &dn[c - 1..],
+                band,
+                thr,
+                m,
+                k,
+                x,
+            );
             if let CheckedRegion::Mask(mask) = region
                 && let Some(mrow) = mask.get(r * w + c..r * w + c + n)
             {
@@ -277,14 +305,14 @@ fn pass_impl(
                     *kk &= 0u8.wrapping_sub(u8::from(mm != 0));
                 }
             }
-            consume(sink, r, c, m, k, w);
+            consume(sink, r, c, m, k, x, w);
             c += n;
         }
     }
 }
 
 #[inline(always)]
-fn consume(sink: &mut Sink<'_>, r: usize, c: usize, mag: &[u16], cls: &[u8], w: usize) {
+fn consume(sink: &mut Sink<'_>, r: usize, c: usize, mag: &[u16], cls: &[u8], gx: &[i16], w: usize) {
     match sink {
         Sink::Histogram {
             hists,
@@ -346,6 +374,7 @@ fn consume(sink: &mut Sink<'_>, r: usize, c: usize, mag: &[u16], cls: &[u8], w: 
                     row_px: r as u16,
                     magnitude: mag.get(i).copied().unwrap_or(0),
                     class,
+                    gx: gx.get(i).copied().unwrap_or(0),
                 });
             };
             let mut chunks = cls.chunks_exact(16);

@@ -139,12 +139,14 @@ mod edges;
 mod error;
 mod image;
 mod kernel;
+mod normal;
 mod params;
 mod ridge;
 
 pub use edges::{EdgeBuffer, EdgeClass, EdgePixel, EdgeStats};
 pub use error::GradientError;
 pub use image::{GreyImage, MAX_SIDE_PX};
+pub use normal::{edge_normal_deg, gradient_normal_deg, sobel_gradient};
 pub use params::{GradientParams, Threshold};
 pub use ridge::{keep_bright_stripes, split_stripes};
 

@@ -102,6 +102,16 @@ pub struct InitConfig {
     /// Non-maximum suppression between candidate lines: normal distance ρ, px (≥ 0).
     #[serde(default = "default_separation_px")]
     pub candidate_separation_px: f64,
+    /// Joint initialisation: orientation-restricted Hough vote (an addition beyond the paper;
+    /// `hough_init::HoughWorkspace::find_lines_oriented`). Each candidate pixel votes only for
+    /// the lines whose normal lies within this many degrees of its own Sobel gradient direction
+    /// (`vision_gradient::edge_normal_deg`), instead of for every line of its band: the pixels
+    /// of a straight mark share its direction and keep their votes, those of texture, blobs and
+    /// jagged borders point every way and no longer add up to strong false lines. Degrees,
+    /// 0..=90; 0 (default when absent) votes across the whole band (the paper). The per-pixel
+    /// angle spreads by several degrees on real edges: values much below 10° lose marks.
+    #[serde(default)]
+    pub orientation_tolerance_deg: f64,
     /// Joint initialisation: how a candidate line is weighed for the ego pair. `false` (default
     /// when absent): by its Hough line (its columns at the top and bottom ROI rows) and its Hough
     /// votes (near-field straight-line evidence). `true`: by the least-squares parabola fitted
@@ -253,6 +263,16 @@ pub struct TrackConfig {
     /// Left and right lanes must stay at least this far apart at the middle and bottom ROI rows
     /// (and in order at the top row), px (≥ 0).
     pub min_lane_separation_px: f64,
+    /// Orientation gate on the window pixels (an addition beyond the paper): a pixel enters the
+    /// measurement only if its Sobel gradient (`vision_gradient::sobel_gradient`) lies within
+    /// this many degrees of the predicted lane's normal at its row, i.e. its edge runs along the
+    /// predicted lane. The edges of the mark pass; sensor noise, texture and the outlines of
+    /// objects crossing the window at another angle (a car's rear, a crosswalk stripe) do not,
+    /// so a band of rows the mark has left holds too few pixels to pin the lane where it was.
+    /// Degrees, 0..=90; 0 (default when absent) keeps every window pixel of the lane's class
+    /// (the paper).
+    #[serde(default)]
+    pub orientation_tolerance_deg: f64,
     /// `true`: measure one sub-pixel mark centre per row (or the sub-pixel position of a single
     /// step edge) and give the KIF the measured point scatter as `R` (an addition beyond the
     /// paper, crate docs "Mark centres"); `false` (default when absent): the paper's integer
@@ -431,6 +451,12 @@ impl TrackerConfig {
             i.candidate_separation_px,
             "must be finite and ≥ 0 px",
         )?;
+        check(
+            (0.0..=90.0).contains(&i.orientation_tolerance_deg),
+            "init.orientation_tolerance_deg",
+            i.orientation_tolerance_deg,
+            "must be in [0, 90] degrees (0: every pixel votes across its band)",
+        )?;
         i.ego_pair.validate().map_err(|e| match e {
             HoughError::InvalidParam {
                 field,
@@ -494,6 +520,12 @@ impl TrackerConfig {
             "track.refine_passes",
             t.refine_passes,
             "must be in 0..=5",
+        )?;
+        check(
+            (0.0..=90.0).contains(&t.orientation_tolerance_deg),
+            "track.orientation_tolerance_deg",
+            t.orientation_tolerance_deg,
+            "must be in [0, 90] degrees (0: every window pixel)",
         )?;
         check(
             t.inlier_half_width_px > 0.0 && t.inlier_half_width_px.is_finite(),

@@ -86,6 +86,15 @@ fn each_out_of_range_field_is_named() {
         }),
         ("init.min_points", |c| c.init.min_points = 2),
         ("init.refit_iterations", |c| c.init.refit_iterations = 11),
+        ("init.orientation_tolerance_deg", |c| {
+            c.init.orientation_tolerance_deg = -5.0
+        }),
+        ("init.orientation_tolerance_deg", |c| {
+            c.init.orientation_tolerance_deg = f64::NAN
+        }),
+        ("track.orientation_tolerance_deg", |c| {
+            c.track.orientation_tolerance_deg = 91.0
+        }),
         ("track.inlier_half_width_px", |c| {
             c.track.inlier_half_width_px = 0.0
         }),

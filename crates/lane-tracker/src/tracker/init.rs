@@ -4,11 +4,14 @@
 //! checks that accept a fit.
 
 use hough_init::{
-    Chord, HoughLine, LaneInit, Parabola, choose_ego_pair, fit_around_line, init_lane,
+    Chord, HoughLine, LaneInit, OrientedPoint, Parabola, choose_ego_pair, fit_around_line,
+    init_lane,
 };
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
-use vision_gradient::{EdgeClass, GreyImage, Region, keep_bright_stripes, split_stripes};
+use vision_gradient::{
+    EdgeClass, GreyImage, Region, gradient_normal_deg, keep_bright_stripes, split_stripes,
+};
 
 use super::points::fit_profile;
 use super::{Estimator, LaneFilter, LaneState, LaneTracker};
@@ -102,7 +105,8 @@ impl LaneTracker {
     }
 
     /// Joint initialisation (`init.candidate_lines > 0`, crate docs): the strongest
-    /// `candidate_lines` Hough lines of each band, the ego pair chosen among all of them by
+    /// `candidate_lines` Hough lines of each band (each pixel voting near its own edge normal
+    /// with `init.orientation_tolerance_deg > 0`), the ego pair chosen among all of them by
     /// `hough_init::choose_ego_pair` (a lane still tracked is kept in the pair), each chosen
     /// line refined by least squares on the pixels of its own class.
     fn initialise_jointly(&mut self) {
@@ -126,16 +130,28 @@ impl LaneTracker {
             if self.candidates.len() < self.init_params.min_points {
                 continue;
             }
-            if self.cfg.init.candidate_coverage {
+            if self.cfg.init.candidate_coverage || self.cfg.init.orientation_tolerance_deg > 0.0 {
                 self.sort_candidates_by_row(class);
             }
-            let Ok(count) = self.hough.find_lines(
-                &self.candidates,
-                &band,
+            let (sep_deg, sep_px) = (
                 self.cfg.init.candidate_separation_deg,
                 self.cfg.init.candidate_separation_px,
-                &mut found[..n],
-            ) else {
+            );
+            let tolerance_deg = self.cfg.init.orientation_tolerance_deg;
+            let lines_found = if tolerance_deg > 0.0 {
+                self.hough.find_lines_oriented(
+                    &self.oriented,
+                    &band,
+                    tolerance_deg,
+                    sep_deg,
+                    sep_px,
+                    &mut found[..n],
+                )
+            } else {
+                self.hough
+                    .find_lines(&self.candidates, &band, sep_deg, sep_px, &mut found[..n])
+            };
+            let Ok(count) = lines_found else {
                 continue;
             };
             for line in &found[..count] {
@@ -207,7 +223,9 @@ impl LaneTracker {
     /// (`gradient.stripe_paired_votes` for a paired one, else 1), with `self.row_start[r]` the
     /// index of row `r`'s first pixel (`row_start[height]` = their number): the paired pixels
     /// marked in a bit mask, a counting sort by row, and a row sorted by column only if the
-    /// detector did not emit it so. No allocation.
+    /// detector did not emit it so. With `init.orientation_tolerance_deg > 0`, also
+    /// `self.oriented` = the same pixels, once each, with the normal angle of their stored
+    /// gradient and the weight as their votes (the Hough input). No allocation.
     fn sort_candidates_by_row(&mut self, class: EdgeClass) {
         let (w, h) = (self.width, self.height);
         let paired_votes = self.cfg.gradient.stripe_paired_votes;
@@ -237,11 +255,27 @@ impl LaneTracker {
         let by_row = &mut self.by_row;
         by_row.clear();
         by_row.resize(starts[h] as usize, (0, 0));
+        let oriented = &mut self.oriented;
+        oriented.clear();
+        let with_normals = self.cfg.init.orientation_tolerance_deg > 0.0;
         for e in self.edges.iter_class(class) {
             let paired = mask
                 .get(bit(e) / 64)
                 .is_some_and(|word| word & (1 << (bit(e) % 64)) != 0);
             let weight = if paired { u16::from(paired_votes) } else { 1 };
+            if with_normals
+                && let Some(normal_deg) = {
+                    let (gx, gy) = e.gradient();
+                    gradient_normal_deg(gx, gy)
+                }
+            {
+                oriented.push(OrientedPoint {
+                    col_px: f32::from(e.col_px),
+                    row_px: f32::from(e.row_px),
+                    normal_deg,
+                    votes: weight,
+                });
+            }
             if let Some(k) = next.get_mut(usize::from(e.row_px)) {
                 by_row[*k as usize] = (e.col_px, weight);
                 *k += 1;

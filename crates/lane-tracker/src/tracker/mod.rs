@@ -1,7 +1,7 @@
 //! The tracking loop (paper Fig. 1): directional gradient → Hough + LS initialisation → KIF
 //! (or WRLS) recursion, per lane, with a state machine and sanity gates.
 
-use hough_init::{AngleBand, HoughWorkspace, LaneInitParams, Parabola};
+use hough_init::{AngleBand, HoughWorkspace, LaneInitParams, OrientedPoint, Parabola};
 use info_filter::{ParabolaKif, ProcessNoise, RowNorm, ThetaCov};
 use lane_geometry::FitRows;
 use nalgebra::{Matrix3, Vector3};
@@ -218,6 +218,10 @@ pub struct LaneTracker {
     hough: HoughWorkspace,
     init_params: LaneInitParams,
     candidates: Vec<(f32, f32)>,
+    /// The candidate pixels once each, with the normal angle of their edge and their weight as
+    /// votes, for the orientation-restricted Hough vote (`init.orientation_tolerance_deg > 0`;
+    /// empty and unallocated otherwise).
+    oriented: Vec<OrientedPoint>,
     /// The candidate pixels as `(column, weight)` sorted by row then column,
     /// `row_start[r]..row_start[r + 1]` the pixels of row `r` (`init.candidate_coverage`), and
     /// a counting-sort cursor per row.
@@ -303,6 +307,11 @@ impl LaneTracker {
             candidates: Vec::with_capacity(
                 usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity,
             ),
+            oriented: Vec::with_capacity(if cfg.init.orientation_tolerance_deg > 0.0 {
+                capacity
+            } else {
+                0
+            }),
             by_row: Vec::with_capacity(capacity),
             row_start: vec![0; height + 1],
             paired_mask: vec![0; (width * height).div_ceil(64)],

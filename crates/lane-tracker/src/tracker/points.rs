@@ -6,7 +6,7 @@ use hough_init::Parabola;
 use info_filter::{PowerSums, RowNorm};
 use lane_geometry::{FIT_SAMPLES, FitRows};
 use nalgebra::{Matrix3, Vector3};
-use vision_gradient::{EdgeClass, EdgePixel, GreyImage};
+use vision_gradient::{EdgeClass, GreyImage};
 
 use super::LaneTracker;
 
@@ -212,24 +212,41 @@ impl LaneTracker {
         // Joint initialisation (lanes sided by position, not lean): per row, the edge class of
         // the predicted slope (`/`: dx/dy < 0), either class where the mark is near vertical.
         let joint = self.cfg.init.candidate_lines > 0;
-        let class_ok = |p: &&EdgePixel| {
-            if !joint {
-                return p.class == lane.class;
+        // Orientation gate (`track.orientation_tolerance_deg`): along x = x̂(y) the tangent is
+        // (x̂′, 1) and the normal n = (1, −x̂′); the pixel's stored Sobel gradient
+        // g = (gx, gy) (`EdgePixel::gradient`) is within the tolerance τ of ±n iff
+        // |g × n| ≤ tan τ · |g · n|, with g × n = −(gx·x̂′ + gy) and g · n = gx − gy·x̂′ (no
+        // angle computed).
+        let tolerance_deg = self.cfg.track.orientation_tolerance_deg;
+        let gate = tolerance_deg > 0.0;
+        let tan_tolerance = tolerance_deg.to_radians().tan() as f32;
+        let predicted = Parabola::from_coeffs(coeffs);
+        for p in self.edges.pixels() {
+            let y = f64::from(p.row_px);
+            let slope = predicted.slope_at_row(y);
+            let class_ok = if joint {
+                slope.abs() < NEAR_VERTICAL_SLOPE
+                    || p.class
+                        == if slope < 0.0 {
+                            EdgeClass::LeftLane
+                        } else {
+                            EdgeClass::RightLane
+                        }
+            } else {
+                p.class == lane.class
+            };
+            if !class_ok {
+                continue;
             }
-            let slope = Parabola::from_coeffs(coeffs).slope_at_row(f64::from(p.row_px));
-            if slope.abs() < NEAR_VERTICAL_SLOPE {
-                return true;
-            }
-            p.class
-                == if slope < 0.0 {
-                    EdgeClass::LeftLane
-                } else {
-                    EdgeClass::RightLane
+            if gate {
+                let (gx, gy) = p.gradient();
+                let (gx, gy) = (f32::from(gx), f32::from(gy));
+                let slope = slope as f32;
+                if (gx * slope + gy).abs() > tan_tolerance * (gx - gy * slope).abs() {
+                    continue;
                 }
-        };
-        for p in self.edges.pixels().iter().filter(class_ok) {
-            let v =
-                f64::from(p.col_px) - Parabola::from_coeffs(coeffs).col_at_row(f64::from(p.row_px));
+            }
+            let v = f64::from(p.col_px) - predicted.col_at_row(y);
             // Truncation of a non-negative value is floor: this rounds v to the nearest bin.
             let bin = ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w_us);
             let row = usize::from(p.row_px);

@@ -79,3 +79,43 @@ fn a_refused_wrls_set_up_is_counted_and_kept_typed() {
         ))
     ));
 }
+
+/// `two_marks` with a bright bar 5 px wide leaning the left mark's way but much flatter
+/// (`dx/dy = −2.5`, 22° from the horizontal against the mark's 66°), crossing the left mark
+/// around row 190: the same edge class, another direction (a crosswalk stripe, a car's rear).
+fn two_marks_and_a_crossing_bar(w: usize, h: usize) -> GreyFrame {
+    let clean = two_marks(w, h);
+    let bar = |y: f64| 100.0 - 0.45 * (190.0 - 239.0) - 2.5 * (y - 190.0);
+    let mut pixels = clean.data().to_vec();
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if (x - bar(y)).abs() < 6.0 && (170.0..210.0).contains(&y) {
+            *p = 200;
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn the_orientation_gate_keeps_a_crossing_bar_out_of_the_window_points() {
+    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let far_points = |cfg: &TrackerConfig| {
+        let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        tracker.track(&two_marks(320, 240)).expect("a frame");
+        tracker
+            .track(&two_marks_and_a_crossing_bar(320, 240))
+            .expect("a frame");
+        let view = tracker.lane_view(Side::Left);
+        assert!(!view.points.is_empty());
+        view.points
+            .iter()
+            .filter(|(x, y)| (f64::from(*x) - left(f64::from(*y))).abs() > 4.0)
+            .count()
+    };
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(cfg.track.orientation_tolerance_deg > 0.0);
+    assert_eq!(far_points(&cfg), 0, "bar pixels passed the gate");
+    let mut ungated = cfg;
+    ungated.track.orientation_tolerance_deg = 0.0;
+    assert!(far_points(&ungated) > 0, "the bar never reached the window");
+}
