@@ -183,6 +183,40 @@ fn step_edge(pixels: &[u8], step: f64) -> Option<(f64, f64)> {
 /// (joint initialisation): tan 10°, the edge band's default upper limit.
 const NEAR_VERTICAL_SLOPE: f64 = 0.176;
 
+/// Uniform decimation of `total` items in order down to `max` (all of them when
+/// `total ≤ max`): item `j` is kept iff `⌊(j+1)·max/total⌋ > ⌊j·max/total⌋`, i.e. iff a
+/// multiple of `total` lies in `(j·max, (j+1)·max]`, tracked as the running remainder of
+/// `j·max` modulo `total` (a Bresenham step: no division per item).
+struct Decimation {
+    max: usize,
+    total: usize,
+    remainder: usize,
+}
+
+impl Decimation {
+    fn new(max: usize, total: usize) -> Self {
+        Self {
+            max,
+            total,
+            remainder: 0,
+        }
+    }
+
+    /// Whether the next item is kept.
+    fn next(&mut self) -> bool {
+        if self.total <= self.max {
+            return true;
+        }
+        self.remainder += self.max;
+        if self.remainder >= self.total {
+            self.remainder -= self.total;
+            true
+        } else {
+            false
+        }
+    }
+}
+
 /// Largest window half-width accepted by the configuration, px.
 pub(crate) const MAX_WINDOW_HALF_WIDTH: usize = 200;
 
@@ -299,8 +333,9 @@ impl LaneTracker {
             // The paper's measurement: the inlier edge pixels, uniformly decimated (in row
             // order) down to max_points, spread over the rows and over both edges of a mark.
             let total = self.scratch.iter().filter(|c| is_inlier(c)).count();
-            for (j, c) in self.scratch.iter().filter(|c| is_inlier(c)).enumerate() {
-                if total <= max_points || (j + 1) * max_points / total > j * max_points / total {
+            let mut keep = Decimation::new(max_points, total);
+            for c in self.scratch.iter().filter(|c| is_inlier(c)) {
+                if keep.next() {
                     lane.points.push((f32::from(c.col_px), f32::from(c.row_px)));
                 }
             }
@@ -339,8 +374,9 @@ impl LaneTracker {
         let total = lane.points.len();
         if mark_centres && total > max_points {
             let mut k = 0;
+            let mut keep = Decimation::new(max_points, total);
             for j in 0..total {
-                if (j + 1) * max_points / total > j * max_points / total {
+                if keep.next() {
                     lane.points[k] = lane.points[j];
                     lane.weights[k] = lane.weights[j];
                     k += 1;
@@ -389,6 +425,21 @@ mod tests {
         let dark: Vec<u8> = row(15.2, 18.9).iter().map(|&p| 255 - p + 35).collect();
         let (x, _) = mark_centre(&dark, 15, 18, 0.0).unwrap();
         assert!((x - 17.05).abs() < 0.04, "{x}");
+    }
+
+    #[test]
+    fn the_decimation_keeps_the_items_of_the_division_rule() {
+        for total in 0..400usize {
+            for max in [1usize, 3, 7, 150, 399] {
+                let mut keep = Decimation::new(max, total);
+                let kept: Vec<usize> = (0..total).filter(|_| keep.next()).collect();
+                let expected: Vec<usize> = (0..total)
+                    .filter(|&j| total <= max || (j + 1) * max / total > j * max / total)
+                    .collect();
+                assert_eq!(kept, expected, "total {total}, max {max}");
+                assert_eq!(kept.len(), total.min(max));
+            }
+        }
     }
 
     #[test]
