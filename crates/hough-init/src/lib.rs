@@ -106,6 +106,14 @@
 //! curve the two boundaries may lean the same way. [`fit_around_line`] is the least-squares
 //! half of [`init_lane`] for a chosen line.
 //!
+//! [`HoughWorkspace::find_lines_oriented`] restricts the vote by orientation: an
+//! [`OrientedPoint`] carries the normal angle `θ_p` of its edge (its Sobel gradient direction,
+//! folded into `[−90°, 90°)`) and votes only in the bins `|θ_k − θ_p| ≤ τ` (modulo 180°), with a
+//! vote weight instead of repetition. The accumulator of a straight mark is unchanged; a pixel of
+//! texture or of a jagged border votes in `2τ/Δθ + 1` bins instead of the whole band, around its
+//! own (wrong) direction, so clutter no longer builds strong false peaks. With `τ ≥ 90°` the
+//! accumulator equals the plain vote's (tested), which is the check of the restricted form.
+//!
 //! # Parameters and units
 //!
 //! | struct | field | unit | default | disables |

@@ -73,7 +73,12 @@
 //! enter the adaptive histogram; the 3×3 neighbours are always read from the real image.
 //!
 //! ## Output
-//! Kept pixels go into a caller-owned [`EdgeBuffer`] (fixed capacity, refilled every call, bottom
+//! Each kept pixel carries its column, row, magnitude, class and `gx`; with the magnitude and
+//! the class that gives the whole gradient ([`EdgePixel::gradient`]: `|gy| = magnitude − |gx|`,
+//! `gy` of `gx`'s sign for the left class and of the opposite sign for the right one), so the
+//! edge direction is known without reading the image again ([`gradient_normal_deg`] folds it to
+//! the Hough normal angle; [`sobel_gradient`] and [`edge_normal_deg`] compute the same from the
+//! image for any pixel). Kept pixels go into a caller-owned [`EdgeBuffer`] (fixed capacity, refilled every call, bottom
 //! row first so truncation loses the far rows; truncation is reported) and, optionally, into a
 //! caller `&mut [u8]` class image of `width·height` bytes (`0` none, `1` left, `2` right).
 //!
