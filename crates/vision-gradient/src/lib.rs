@@ -91,9 +91,9 @@
 //! the row. The dark seam beside a mark, tar joints, and the single edges of dark objects
 //! (cars, kerbs, walls, shadows) then no longer vote. [`split_stripes`] is the weighting form:
 //! it copies the bright-stripe pixels aside (to be counted more) and drops only the sides of
-//! *dark* stripes, so a single step such as a kerb still counts. Both run after [`GradientDetector::detect`]
-//! on its output (any region), costs one 3×3 `gx` per kept pixel and a scan of its row
-//! neighbours, and allocates nothing.
+//! *dark* stripes, so a single step such as a kerb still counts. Both run after
+//! [`GradientDetector::detect`] on its output (any region), read the Sobel `gx` the detector stored
+//! with each pixel, scan its row neighbours, and allocate nothing.
 //!
 //! ## Defaults
 //! [`GradientParams::default`]: band 15°..80°, fixed threshold 120 (a 45° step of 20 grey

@@ -14,18 +14,6 @@ const DARK_BIT: u16 = 1 << 13;
 /// Bits of a real magnitude (at most 2040 < 2¹¹).
 const MAG_MASK: u16 = (1 << 11) - 1;
 
-/// Horizontal Sobel response `gx` at an interior pixel (the crate's operator), `None` on the
-/// image border or outside it.
-fn sobel_gx(image: &GreyImage<'_>, col: usize, row: usize) -> Option<i32> {
-    if col == 0 || row == 0 || col + 1 >= image.width() {
-        return None;
-    }
-    let (up, mid, dn) = (image.row(row - 1)?, image.row(row)?, image.row(row + 1)?);
-    let l = i32::from(up[col - 1]) + 2 * i32::from(mid[col - 1]) + i32::from(dn[col - 1]);
-    let r = i32::from(up[col + 1]) + 2 * i32::from(mid[col + 1]) + i32::from(dn[col + 1]);
-    Some(r - l)
-}
-
 /// Keeps, in every row, only the edge pixels that pair with an edge pixel of the **same class**
 /// and the **opposite horizontal polarity** within `max_width_px` columns, the rising one
 /// (`gx > 0`, dark → bright to the right) on the left and the falling one (`gx < 0`) on the
@@ -47,7 +35,7 @@ pub fn keep_bright_stripes(
     if max_width_px == 0 {
         return 0;
     }
-    mark(image, edges, max_width_px, outward_steps_from_col_px);
+    mark(edges, max_width_px, outward_steps_from_col_px);
     let px = edges.pixels_mut();
     // Clear the class image of dropped pixels, compact, restore the magnitudes.
     if let Some(ci) = class_image {
@@ -67,9 +55,10 @@ pub fn keep_bright_stripes(
 /// only a **dark** stripe at most `max_width_px` wide (falling then rising along the row: the
 /// seam beside a mark, a tar joint, a crack) are removed from `edges`; single steps (a kerb, a
 /// road edge) stay. Returns the number of paired pixels. `max_width_px = 0` copies and drops
-/// nothing. No allocation.
+/// nothing. Polarities come from the Sobel `gx` stored with each pixel
+/// ([`crate::EdgePixel::gx`]), so `edges` must come from [`crate::GradientDetector::detect`].
+/// No allocation.
 pub fn split_stripes(
-    image: &GreyImage<'_>,
     edges: &mut EdgeBuffer,
     paired: &mut EdgeBuffer,
     max_width_px: u16,
@@ -79,7 +68,7 @@ pub fn split_stripes(
     if max_width_px == 0 {
         return 0;
     }
-    mark(image, edges, max_width_px, None);
+    mark(edges, max_width_px, None);
     let mut n = 0;
     for p in edges.pixels_mut() {
         if p.magnitude & KEEP_BIT != 0 {
@@ -99,20 +88,13 @@ pub fn split_stripes(
 
 /// Sets [`KEEP_BIT`] on the pixels that pair (or are outward steps), [`RISE_BIT`] on the rising
 /// ones; magnitudes are restored by the callers.
-fn mark(
-    image: &GreyImage<'_>,
-    edges: &mut EdgeBuffer,
-    max_width_px: u16,
-    outward_steps_from_col_px: Option<u16>,
-) {
+fn mark(edges: &mut EdgeBuffer, max_width_px: u16, outward_steps_from_col_px: Option<u16>) {
     let w = usize::from(max_width_px);
     let px = edges.pixels_mut();
-    // Pass 1: polarity flags.
+    // Pass 1: polarity flags, from the Sobel gx the detector stored with each pixel.
     for p in px.iter_mut() {
         p.magnitude &= MAG_MASK;
-        if let Some(gx) = sobel_gx(image, usize::from(p.col_px), usize::from(p.row_px))
-            && gx > 0
-        {
+        if p.gx > 0 {
             p.magnitude |= RISE_BIT;
         }
     }
@@ -239,7 +221,7 @@ mod tests {
         det.detect(&image, Region::Full, &mut edges, None).unwrap();
         let before = edges.pixels().to_vec();
         let mut paired = EdgeBuffer::with_capacity(4096);
-        let n = split_stripes(&image, &mut edges, &mut paired, 8, true);
+        let n = split_stripes(&mut edges, &mut paired, 8, true);
         assert_eq!(edges.pixels(), &before[..]);
         assert_eq!((n, paired.pixels()), (before.len(), &before[..]));
         // A dark stripe: nothing paired; its sides are dropped only when asked.
@@ -247,17 +229,17 @@ mod tests {
         let image = GreyImage::new(&dark, 64, 48, 64).unwrap();
         det.detect(&image, Region::Full, &mut edges, None).unwrap();
         let before = edges.pixels().to_vec();
-        assert_eq!(split_stripes(&image, &mut edges, &mut paired, 8, false), 0);
+        assert_eq!(split_stripes(&mut edges, &mut paired, 8, false), 0);
         assert!(paired.is_empty());
         assert_eq!(edges.pixels(), &before[..]);
-        assert_eq!(split_stripes(&image, &mut edges, &mut paired, 8, true), 0);
+        assert_eq!(split_stripes(&mut edges, &mut paired, 8, true), 0);
         assert!(edges.is_empty());
         // A single step (a kerb) stays either way.
         let step = stripe(40, 200, 50, 200);
         let image = GreyImage::new(&step, 64, 48, 64).unwrap();
         det.detect(&image, Region::Full, &mut edges, None).unwrap();
         let before = edges.len();
-        split_stripes(&image, &mut edges, &mut paired, 8, true);
+        split_stripes(&mut edges, &mut paired, 8, true);
         assert!(paired.is_empty());
         assert_eq!(edges.len(), before);
     }

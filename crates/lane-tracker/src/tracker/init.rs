@@ -38,7 +38,6 @@ impl LaneTracker {
         )?;
         if self.cfg.gradient.stripe_paired_votes > 0 {
             split_stripes(
-                image,
                 &mut self.edges,
                 &mut self.paired,
                 self.cfg.gradient.stripe_max_width_px,
