@@ -117,13 +117,23 @@ pub enum HoughError {
         /// How many are required.
         required: usize,
     },
-    /// More points than the `u32` vote counters can hold.
+    /// More points than the `u32` vote counters can hold (with the 3×3 peak smoothing, a third
+    /// of `u32::MAX`).
     #[error("{found} points exceed the limit of {limit} per Hough call")]
     TooManyPoints {
         /// How many there were.
         found: usize,
         /// The limit.
         limit: usize,
+    },
+    /// More votes in all than the `u32` vote counters can hold (weighted points,
+    /// [`crate::OrientedPoint::votes`]; a third of `u32::MAX`).
+    #[error("{found} votes exceed the limit of {limit} per Hough call")]
+    TooManyVotes {
+        /// How many there were.
+        found: u64,
+        /// The limit.
+        limit: u64,
     },
     /// All fitted points lie on one image row: `x(y)` is undetermined.
     #[error("all {count} fitted points lie on row {row_px} px; x(y) is undetermined")]

@@ -19,6 +19,11 @@ const _: () = assert!(MAX_IMAGE_SIDE_PX * 20 + 5 < 1 << 22);
 /// Largest accepted accumulator, cells (`u32` each).
 pub const MAX_ACCUMULATOR_CELLS: usize = 1 << 25;
 
+/// Most votes one call may cast in all (points, or the sum of the weights of oriented points):
+/// a cell, and a ρ 3-sum of one θ row, hold at most that many, and the 3×3 smoothed peak search
+/// adds three such sums in a `u32`.
+const MAX_VOTES: u32 = u32::MAX / 3;
+
 /// A straight line in normal form `ρ = x·cos θ + y·sin θ` (x = column, y = row, pixels; origin
 /// at the centre of the top-left pixel).
 ///
@@ -272,23 +277,24 @@ impl HoughWorkspace {
     }
 
     /// [`Self::find_lines`] with an **orientation-restricted vote** (an addition beyond the
-    /// paper): each point votes only in the θ bins within `±tolerance_deg` of its own edge
-    /// normal [`OrientedPoint::normal_deg`] (θ taken modulo 180°), instead of in every bin of
-    /// the band. A straight mark's edge pixels share its normal and keep all their votes; the
+    /// paper): each point votes only in the θ bins within `⌊tolerance_deg/Δθ⌋` bins of the bin
+    /// nearest its own edge normal [`OrientedPoint::normal_deg`] (about `±tolerance_deg`, to half
+    /// a bin; θ taken modulo 180°), instead of in every bin of the band. A straight mark's edge pixels share its normal and keep all their votes; the
     /// pixels of texture, of the jagged border of a mat or of a blob point every way and
     /// spread their votes over other lines, so a long mark stands out of clutter that would
     /// outvote it in the plain transform. With `tolerance_deg ≥ 90` every point votes in every
     /// bin of the band and the accumulator, hence the lines, equal [`Self::find_lines`]'s
-    /// (tested). The per-pixel Sobel angle spreads by several degrees about the true one, so
+    /// (tested, also with a θ step that does not divide 180°). The per-pixel Sobel angle spreads by several degrees about the true one, so
     /// the tolerance should not be much below ~10°.
     ///
-    /// Each point casts [`OrientedPoint::votes`] votes per bin (the same as repeating it).
+    /// Each point casts [`OrientedPoint::votes`] votes per bin (in the accumulator, the same as
+    /// repeating it; the minimum of two points counts points).
     ///
     /// # Errors
     /// As [`Self::find_lines`]; [`HoughError::InvalidParam`] for a `tolerance_deg` that is not
     /// finite and ≥ 0; [`HoughError::InvalidNormal`] naming the first point whose angle is not
-    /// finite in `[−90°, 90°)`; [`HoughError::TooManyPoints`] when the votes of all points
-    /// exceed `u32::MAX` (the counters).
+    /// finite in `[−90°, 90°)`; [`HoughError::TooManyVotes`] when the votes of all points exceed
+    /// a third of `u32::MAX` (the counters and the smoothed peak search).
     pub fn find_lines_oriented(
         &mut self,
         points: &[OrientedPoint],
@@ -319,10 +325,10 @@ impl HoughWorkspace {
         let (k0, k1) = self.band_bins(band)?;
         self.check_count(points.iter())?;
         let votes: u64 = points.iter().map(|p| u64::from(p.votes)).sum();
-        if votes > u64::from(u32::MAX) {
-            return Err(HoughError::TooManyPoints {
-                found: usize::try_from(votes).unwrap_or(usize::MAX),
-                limit: u32::MAX as usize,
+        if votes > u64::from(MAX_VOTES) {
+            return Err(HoughError::TooManyVotes {
+                found: votes,
+                limit: u64::from(MAX_VOTES),
             });
         }
         self.vote_oriented(points, k0, k1, tolerance_deg);
@@ -359,17 +365,17 @@ impl HoughWorkspace {
         n
     }
 
-    /// Validate the points and their number (2 ..= `u32::MAX`): the checks of every vote.
+    /// Validate the points and their number (2 ..= `MAX_VOTES`): the checks of every vote.
     fn check_count<I>(&self, points: I) -> Result<(), HoughError>
     where
         I: IntoIterator,
         I::Item: PixelPoint,
     {
         let count = self.check_points(points)?;
-        if count > u32::MAX as usize {
+        if count > MAX_VOTES as usize {
             return Err(HoughError::TooManyPoints {
                 found: count,
-                limit: u32::MAX as usize,
+                limit: MAX_VOTES as usize,
             });
         }
         if count < 2 {
@@ -515,10 +521,10 @@ impl HoughWorkspace {
     }
 
     /// The orientation-restricted vote of [`Self::find_lines_oriented`]: each point's votes in
-    /// the θ bins `k` with `|θ_k − θ_p| ≤ tolerance` modulo 180° that lie in `k0..=k1`, once
-    /// each; the ρ bin rounded exactly as [`Self::vote`] does (so a tolerance covering every
-    /// bin gives the same accumulator). The bins of a point are at most two contiguous runs
-    /// (the window wraps at ±90°), intersected with the band before the loop.
+    /// the θ bins within `half = ⌊tolerance/Δθ⌋` bins of the bin nearest its normal, and of the
+    /// bins nearest the same normal ± 180° (the window wraps at ±90°), those inside `k0..=k1`,
+    /// once each; every bin of the band when the window covers the half circle. The ρ bin is
+    /// rounded exactly as [`Self::vote`] does (so that case gives the same accumulator).
     fn vote_oriented(
         &mut self,
         points: &[OrientedPoint],
@@ -532,23 +538,23 @@ impl HoughWorkspace {
         let offset = self.rho_zero_bin as f32;
         let step = self.params.theta_step_deg;
         self.acc[k0 * nr..(k1 + 1) * nr].fill(0);
-        // Bins within the tolerance on each side; the whole circle once when it covers it.
         let half = (tolerance_deg / step + 1e-9).floor() as i64;
-        let all = 2 * half + 1 >= nt;
+        let all = tolerance_deg >= 90.0 || 2 * half + 1 >= nt;
         let (k0i, k1i) = (k0 as i64, k1 as i64);
+        // Nearest θ bin of an angle (θ_k = −90° + k·Δθ).
+        let bin = |deg: f64| ((deg + 90.0) / step).round() as i64;
         for p in points {
             let x = (f64::from(p.col_px) - cx) as f32;
             let y = (f64::from(p.row_px) - cy) as f32;
             let votes = u32::from(p.votes);
-            // Nearest θ bin of the point's normal (θ_k = −90° + k·Δθ), then its window
-            // [kp − half, kp + half], unwrapped into at most two runs inside [0, nt).
-            let kp = ((f64::from(p.normal_deg) + 90.0) / step).round() as i64;
-            let (lo, hi) = if all {
-                (0, nt - 1)
+            let theta = f64::from(p.normal_deg);
+            // The point's window and its copies one half-turn either way, as bin runs; they
+            // do not overlap (2·half + 1 < nt bins, each copy 180° away).
+            let runs = if all {
+                [(0, nt - 1), (1, 0), (1, 0)]
             } else {
-                (kp - half, kp + half)
+                [theta, theta + 180.0, theta - 180.0].map(|t| (bin(t) - half, bin(t) + half))
             };
-            let runs = [(lo, hi), (lo + nt, hi + nt), (lo - nt, hi - nt)];
             for (a, b) in runs {
                 let (a, b) = (a.max(k0i), b.min(k1i));
                 if a > b {
@@ -565,9 +571,6 @@ impl HoughWorkspace {
                     {
                         *cell += votes;
                     }
-                }
-                if all {
-                    break;
                 }
             }
         }

@@ -112,7 +112,8 @@
 //! vote weight instead of repetition. The accumulator of a straight mark is unchanged; a pixel of
 //! texture or of a jagged border votes in `2τ/Δθ + 1` bins instead of the whole band, around its
 //! own (wrong) direction, so clutter no longer builds strong false peaks. With `τ ≥ 90°` the
-//! accumulator equals the plain vote's (tested), which is the check of the restricted form.
+//! accumulator equals the plain vote's (tested, with θ steps that divide 180° and one that does
+//! not), which is the check of the restricted form.
 //!
 //! # Parameters and units
 //!

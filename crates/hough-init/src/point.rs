@@ -47,8 +47,9 @@ pub struct OrientedPoint {
     pub row_px: f32,
     /// Normal angle `θ` of the edge, degrees in `[−90, 90)`.
     pub normal_deg: f32,
-    /// Votes the point casts in each of its θ bins (≥ 1; a pixel that counts more, such as the
-    /// side of a bright stripe, casts several — the same as repeating it).
+    /// Votes the point casts in each of its θ bins (1 for a plain pixel; a pixel that counts
+    /// more, such as the side of a bright stripe, casts several — in the accumulator the same as
+    /// repeating it; 0 casts none).
     pub votes: u16,
 }
 

@@ -17,11 +17,15 @@ const NONE: HoughLine = HoughLine {
 };
 
 fn workspace() -> HoughWorkspace {
+    workspace_with_step(1.0)
+}
+
+fn workspace_with_step(theta_step_deg: f64) -> HoughWorkspace {
     HoughWorkspace::new(
         W,
         H,
         HoughParams {
-            theta_step_deg: 1.0,
+            theta_step_deg,
             ..HoughParams::default()
         },
     )
@@ -73,16 +77,26 @@ fn a_tolerance_covering_every_bin_gives_the_plain_transforms_lines() {
         let mut points = line(35.0, 120.0, 180.0, 100..240, 35.0);
         points.extend(line(-50.0, 220.0, 200.0, 110..240, -50.0));
         points.extend(texture(400, &mut rng));
-        for band in [AngleBand::LEFT_LANE, AngleBand::RIGHT_LANE] {
+        // 0.7° does not divide 180°: the bins do not close the half circle exactly.
+        for (step, band) in [
+            (1.0, AngleBand::LEFT_LANE),
+            (1.0, AngleBand::RIGHT_LANE),
+            (0.7, AngleBand::new(-85.0, -75.0)),
+            (0.7, AngleBand::LEFT_LANE),
+        ] {
             let (mut plain, mut oriented) = ([NONE; 6], [NONE; 6]);
-            let n_plain = workspace()
+            let n_plain = workspace_with_step(step)
                 .find_lines(&points, &band, 3.0, 8.0, &mut plain)
                 .unwrap();
-            let n_oriented = workspace()
+            let n_oriented = workspace_with_step(step)
                 .find_lines_oriented(&points, &band, 90.0, 3.0, 8.0, &mut oriented)
                 .unwrap();
-            assert_eq!(n_plain, n_oriented, "seed {seed}");
-            assert_eq!(plain[..n_plain], oriented[..n_oriented], "seed {seed}");
+            assert_eq!(n_plain, n_oriented, "seed {seed}, step {step}");
+            assert_eq!(
+                plain[..n_plain],
+                oriented[..n_oriented],
+                "seed {seed}, step {step}"
+            );
         }
     }
 }
@@ -161,14 +175,13 @@ fn a_mark_outvoted_by_texture_and_a_jagged_border_in_the_plain_transform_wins_th
 fn normals_near_the_ends_of_the_range_wrap_modulo_180_degrees() {
     // A near-horizontal line of normal −88° is the line of normal 92° ≡ −88°; points claiming
     // 89.5° (≡ −90.5°) are within 3° of it and vote for it across the wrap.
-    let points = line(-88.0, 160.0, 150.0, 0..1, 89.5)
-        .into_iter()
-        .chain((0..200).map(|i| OrientedPoint {
+    let points = (0..200)
+        .map(|i| OrientedPoint {
             col_px: 20.0 + i as f32,
             row_px: 150.0 + (i as f32) * (2.0f32.to_radians().tan()),
             normal_deg: 89.5,
             votes: 1,
-        }))
+        })
         .collect::<Vec<_>>();
     let mut out = [NONE; 1];
     let n = workspace()
@@ -238,6 +251,20 @@ fn bad_normals_tolerances_and_separations_are_errors_that_say_which() {
             &mut out
         ),
         Err(HoughError::TooFewPoints { found: 1, .. })
+    ));
+    // Weighted votes that the counters (and the 3×3 smoothed peak search) cannot hold.
+    let heavy = vec![
+        OrientedPoint {
+            col_px: 100.0,
+            row_px: 200.0,
+            normal_deg: 30.0,
+            votes: u16::MAX,
+        };
+        (u32::MAX / 3 / u32::from(u16::MAX)) as usize + 1
+    ];
+    assert!(matches!(
+        ws.find_lines_oriented(&heavy, &AngleBand::LEFT_LANE, 15.0, 3.0, 8.0, &mut out),
+        Err(HoughError::TooManyVotes { .. })
     ));
 }
 

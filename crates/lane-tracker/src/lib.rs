@@ -137,8 +137,9 @@
 //!
 //!   (no angle computed per pixel). The edges of the mark pass; noise, texture and the outlines
 //!   of objects crossing the window at another angle do not, so a band of rows the mark has left
-//!   no longer holds enough pixels to pin the lane where it was (the noisy rendered scene: 2.0 →
-//!   0.7 px mean error).
+//!   no longer holds enough pixels to pin the lane where it was (the noisy rendered scene, σ = 8:
+//!   0.7 px mean error with the gate; 1.2–3.6 px without it, depending on the initial lock; the
+//!   previous default 2.0 px).
 //!
 //! Measured on the labelled real sets (`cargo xtask eval-lanes`, `../shared/data/lanes`: 377
 //! stills in four sets, two road, two indoor; tuned on the development part only), TuSimple

@@ -23,13 +23,13 @@ use crate::kernel::sobel;
 /// image border (no 3×3 neighbourhood) or outside the image. Reads 8 pixels; no allocation.
 #[must_use]
 pub fn sobel_gradient(image: &GreyImage<'_>, col_px: usize, row_px: usize) -> Option<(i16, i16)> {
-    if col_px == 0 || row_px == 0 || col_px + 1 >= image.width() {
+    if col_px == 0 || row_px == 0 || col_px >= image.width().saturating_sub(1) {
         return None;
     }
     let (up, mid, dn) = (
         image.row(row_px - 1)?,
         image.row(row_px)?,
-        image.row(row_px + 1)?,
+        image.row(row_px.checked_add(1)?)?,
     );
     let at = |r: &[u8], c: usize| r.get(c).copied();
     Some(sobel(

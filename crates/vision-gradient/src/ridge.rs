@@ -21,9 +21,10 @@ const MAG_MASK: u16 = (1 << 11) - 1;
 /// stripe (the seam beside a mark, a tar joint), the single edge of a dark object (a car, a
 /// kerb's shadow, a wall) and a bright area wider than `max_width_px` no longer pass.
 ///
-/// `edges` must come from [`crate::GradientDetector::detect`] on the same `image` (rows
-/// stored contiguously, columns increasing within a row); pixels outside the image's interior
-/// are dropped. `class_image`, if given (`width·height` bytes), has the dropped pixels cleared.
+/// `edges` must come from [`crate::GradientDetector::detect`] (rows stored contiguously,
+/// columns increasing within a row; the polarity is the sign of the stored Sobel
+/// [`crate::EdgePixel::gx`]); `image` is the frame they came from, whose width indexes
+/// `class_image`, which, if given (`width·height` bytes), has the dropped pixels cleared.
 /// `max_width_px = 0` keeps everything. Returns the number of pixels dropped. No allocation.
 pub fn keep_bright_stripes(
     image: &GreyImage<'_>,

@@ -105,7 +105,8 @@ pub struct InitConfig {
     /// Joint initialisation: orientation-restricted Hough vote (an addition beyond the paper;
     /// `hough_init::HoughWorkspace::find_lines_oriented`). Each candidate pixel votes only for
     /// the lines whose normal lies within this many degrees of its own Sobel gradient direction
-    /// (`vision_gradient::edge_normal_deg`), instead of for every line of its band: the pixels
+    /// (stored with the pixel: `vision_gradient::EdgePixel::gradient`, folded to a normal angle
+    /// by `vision_gradient::gradient_normal_deg`), instead of for every line of its band: the pixels
     /// of a straight mark share its direction and keep their votes, those of texture, blobs and
     /// jagged borders point every way and no longer add up to strong false lines. Degrees,
     /// 0..=90; 0 (default when absent) votes across the whole band (the paper). The per-pixel
@@ -264,7 +265,7 @@ pub struct TrackConfig {
     /// (and in order at the top row), px (≥ 0).
     pub min_lane_separation_px: f64,
     /// Orientation gate on the window pixels (an addition beyond the paper): a pixel enters the
-    /// measurement only if its Sobel gradient (`vision_gradient::sobel_gradient`) lies within
+    /// measurement only if its Sobel gradient (`vision_gradient::EdgePixel::gradient`) lies within
     /// this many degrees of the predicted lane's normal at its row, i.e. its edge runs along the
     /// predicted lane. The edges of the mark pass; sensor noise, texture and the outlines of
     /// objects crossing the window at another angle (a car's rear, a crosswalk stripe) do not,
