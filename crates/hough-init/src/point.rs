@@ -37,7 +37,7 @@ impl PixelPoint for Point {
 /// [`crate::HoughWorkspace::find_lines_oriented`]): image coordinates, pixels, and the angle
 /// `θ` of the pixel's gradient from the column axis towards the (downward) row axis, folded
 /// into `[−90°, 90°)` — the normal angle of the Hough line the edge is locally part of
-/// (`vision_gradient::edge_normal_deg` computes it).
+/// (`vision_gradient::gradient_normal_deg` of `vision_gradient::EdgePixel::gradient` gives it).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OrientedPoint {

@@ -32,7 +32,7 @@ impl EdgePixel {
     /// The Sobel gradient `(gx, gy)` of the pixel, grey levels (`gy` positive when the image
     /// brightens downwards): `|gy| = magnitude − |gx|`, and `gy` has the sign of `gx` for
     /// [`EdgeClass::LeftLane`] (`gx·gy > 0`) and the opposite sign for
-    /// [`EdgeClass::RightLane`] — what [`crate::sobel_gradient`] computes from the image, with
+    /// [`EdgeClass::RightLane`] — the Sobel gradient of the image at the pixel (tested), with
     /// no image access.
     #[inline]
     #[must_use]

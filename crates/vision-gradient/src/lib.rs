@@ -77,8 +77,8 @@
 //! the class that gives the whole gradient ([`EdgePixel::gradient`]: `|gy| = magnitude − |gx|`,
 //! `gy` of `gx`'s sign for the left class and of the opposite sign for the right one), so the
 //! edge direction is known without reading the image again ([`gradient_normal_deg`] folds it to
-//! the Hough normal angle; [`sobel_gradient`] and [`edge_normal_deg`] compute the same from the
-//! image for any pixel). Kept pixels go into a caller-owned [`EdgeBuffer`] (fixed capacity, refilled every call, bottom
+//! the Hough normal angle; tested equal to a Sobel recomputed from the image). Kept pixels go
+//! into a caller-owned [`EdgeBuffer`] (fixed capacity, refilled every call, bottom
 //! row first so truncation loses the far rows; truncation is reported) and, optionally, into a
 //! caller `&mut [u8]` class image of `width·height` bytes (`0` none, `1` left, `2` right).
 //!
@@ -151,7 +151,7 @@ mod ridge;
 pub use edges::{EdgeBuffer, EdgeClass, EdgePixel, EdgeStats};
 pub use error::GradientError;
 pub use image::{GreyImage, MAX_SIDE_PX};
-pub use normal::{edge_normal_deg, gradient_normal_deg, sobel_gradient};
+pub use normal::gradient_normal_deg;
 pub use params::{GradientParams, Threshold};
 pub use ridge::{keep_bright_stripes, split_stripes};
 

@@ -13,46 +13,8 @@
 //! and a `/` mark (top leaning right) gives `θ > 0`, a `\` mark `θ < 0`, as the Hough bands of
 //! `hough_init::AngleBand`. On a sampled edge the per-pixel angle spreads by several degrees
 //! about the true one (the crate docs measure up to ~19° on the rim of an anti-aliased stripe),
-//! so a consumer compares it with a tolerance.
-
-use crate::GreyImage;
-use crate::kernel::sobel;
-
-/// The 3×3 Sobel responses `(gx, gy)` at pixel `(col_px, row_px)` of `image` (crate docs:
-/// `gx` grows to the right, `gy` downwards), grey levels, `|gx|, |gy| ≤ 1020`. `None` on the
-/// image border (no 3×3 neighbourhood) or outside the image. Reads 8 pixels; no allocation.
-#[must_use]
-pub fn sobel_gradient(image: &GreyImage<'_>, col_px: usize, row_px: usize) -> Option<(i16, i16)> {
-    if col_px == 0 || row_px == 0 || col_px >= image.width().saturating_sub(1) {
-        return None;
-    }
-    let (up, mid, dn) = (
-        image.row(row_px - 1)?,
-        image.row(row_px)?,
-        image.row(row_px.checked_add(1)?)?,
-    );
-    let at = |r: &[u8], c: usize| r.get(c).copied();
-    Some(sobel(
-        at(up, col_px - 1)?,
-        at(up, col_px)?,
-        at(up, col_px + 1)?,
-        at(mid, col_px - 1)?,
-        at(mid, col_px + 1)?,
-        at(dn, col_px - 1)?,
-        at(dn, col_px)?,
-        at(dn, col_px + 1)?,
-    ))
-}
-
-/// The normal angle `θ` of the edge through pixel `(col_px, row_px)` of `image`, degrees in
-/// `[−90, 90)` (module docs; [`gradient_normal_deg`] of [`sobel_gradient`]). `None` on the
-/// image border (no 3×3 neighbourhood) or where the gradient is zero (no edge). Reads 8
-/// pixels; no allocation.
-#[must_use]
-pub fn edge_normal_deg(image: &GreyImage<'_>, col_px: usize, row_px: usize) -> Option<f32> {
-    let (gx, gy) = sobel_gradient(image, col_px, row_px)?;
-    gradient_normal_deg(gx, gy)
-}
+//! so a consumer compares it with a tolerance. The detector stores each edge pixel's gradient
+//! ([`crate::EdgePixel::gradient`]), so [`gradient_normal_deg`] needs no image access.
 
 /// The normal angle of gradient `(gx, gy)` folded into `[−90°, 90°)`, degrees: `atan2(gy, gx)`
 /// modulo 180°, which is `sign(gx·gy)·atan(|gy|/|gx|)` (`−90°` for `gx = 0`). The arctangent
@@ -87,6 +49,42 @@ pub fn gradient_normal_deg(gx: i16, gy: i16) -> Option<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::GreyImage;
+    use crate::kernel::sobel;
+
+    /// An independent reference: the 3×3 Sobel responses `(gx, gy)` at pixel `(col_px, row_px)` of `image` (crate docs:
+    /// `gx` grows to the right, `gy` downwards), grey levels, `|gx|, |gy| ≤ 1020`. `None` on the
+    /// image border (no 3×3 neighbourhood) or outside the image. Reads 8 pixels; no allocation.
+    fn sobel_gradient(image: &GreyImage<'_>, col_px: usize, row_px: usize) -> Option<(i16, i16)> {
+        if col_px == 0 || row_px == 0 || col_px >= image.width().saturating_sub(1) {
+            return None;
+        }
+        let (up, mid, dn) = (
+            image.row(row_px - 1)?,
+            image.row(row_px)?,
+            image.row(row_px.checked_add(1)?)?,
+        );
+        let at = |r: &[u8], c: usize| r.get(c).copied();
+        Some(sobel(
+            at(up, col_px - 1)?,
+            at(up, col_px)?,
+            at(up, col_px + 1)?,
+            at(mid, col_px - 1)?,
+            at(mid, col_px + 1)?,
+            at(dn, col_px - 1)?,
+            at(dn, col_px)?,
+            at(dn, col_px + 1)?,
+        ))
+    }
+
+    /// The normal angle `θ` of the edge through pixel `(col_px, row_px)` of `image`, degrees in
+    /// `[−90, 90)` (module docs; [`gradient_normal_deg`] of [`sobel_gradient`]). `None` on the
+    /// image border (no 3×3 neighbourhood) or where the gradient is zero (no edge). Reads 8
+    /// pixels; no allocation.
+    fn edge_normal_deg(image: &GreyImage<'_>, col_px: usize, row_px: usize) -> Option<f32> {
+        let (gx, gy) = sobel_gradient(image, col_px, row_px)?;
+        gradient_normal_deg(gx, gy)
+    }
 
     /// A `w × h` image, dark with a bright 3-px stripe along the line of normal angle `theta_deg`
     /// through the image centre.

@@ -204,7 +204,7 @@ impl Decimation {
     }
 
     /// Whether the next item is kept.
-    fn next(&mut self) -> bool {
+    fn keep(&mut self) -> bool {
         if self.total <= self.max {
             return true;
         }
@@ -334,9 +334,9 @@ impl LaneTracker {
             // The paper's measurement: the inlier edge pixels, uniformly decimated (in row
             // order) down to max_points, spread over the rows and over both edges of a mark.
             let total = self.scratch.iter().filter(|c| is_inlier(c)).count();
-            let mut keep = Decimation::new(max_points, total);
+            let mut decimation = Decimation::new(max_points, total);
             for c in self.scratch.iter().filter(|c| is_inlier(c)) {
-                if keep.next() {
+                if decimation.keep() {
                     lane.points.push((f32::from(c.col_px), f32::from(c.row_px)));
                 }
             }
@@ -375,9 +375,9 @@ impl LaneTracker {
         let total = lane.points.len();
         if mark_centres && total > max_points {
             let mut k = 0;
-            let mut keep = Decimation::new(max_points, total);
+            let mut decimation = Decimation::new(max_points, total);
             for j in 0..total {
-                if keep.next() {
+                if decimation.keep() {
                     lane.points[k] = lane.points[j];
                     lane.weights[k] = lane.weights[j];
                     k += 1;
@@ -432,8 +432,8 @@ mod tests {
     fn the_decimation_keeps_the_items_of_the_division_rule() {
         for total in 0..400usize {
             for max in [1usize, 3, 7, 150, 399] {
-                let mut keep = Decimation::new(max, total);
-                let kept: Vec<usize> = (0..total).filter(|_| keep.next()).collect();
+                let mut decimation = Decimation::new(max, total);
+                let kept: Vec<usize> = (0..total).filter(|_| decimation.keep()).collect();
                 let expected: Vec<usize> = (0..total)
                     .filter(|&j| total <= max || (j + 1) * max / total > j * max / total)
                     .collect();
