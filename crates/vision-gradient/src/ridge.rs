@@ -2,7 +2,6 @@
 //! the paper; see the crate docs, "Stripe pairing").
 
 use crate::edges::EdgeBuffer;
-use crate::image::GreyImage;
 
 /// Bit of [`crate::EdgePixel::magnitude`] used as a temporary "kept" flag (magnitudes are at
 /// most 2040 < 2¹¹).
@@ -23,13 +22,11 @@ const MAG_MASK: u16 = (1 << 11) - 1;
 ///
 /// `edges` must come from [`crate::GradientDetector::detect`] (rows stored contiguously,
 /// columns increasing within a row; the polarity is the sign of the stored Sobel
-/// [`crate::EdgePixel::gx`]); `image` is the frame they came from, whose width indexes
-/// `class_image`, which, if given (`width·height` bytes), has the dropped pixels cleared.
-/// `max_width_px = 0` keeps everything. Returns the number of pixels dropped. No allocation.
+/// [`crate::EdgePixel::gx`]). `max_width_px = 0` keeps everything. Returns the number of
+/// pixels dropped. A class image painted by `detect` is left as it was (it shows every edge
+/// pixel; repaint it from `edges` to show only the stripes). No allocation.
 pub fn keep_bright_stripes(
-    image: &GreyImage<'_>,
     edges: &mut EdgeBuffer,
-    class_image: Option<&mut [u8]>,
     max_width_px: u16,
     outward_steps_from_col_px: Option<u16>,
 ) -> usize {
@@ -37,16 +34,6 @@ pub fn keep_bright_stripes(
         return 0;
     }
     mark(edges, max_width_px, outward_steps_from_col_px);
-    let px = edges.pixels_mut();
-    // Clear the class image of dropped pixels, compact, restore the magnitudes.
-    if let Some(ci) = class_image {
-        let width = image.width();
-        for p in px.iter().filter(|p| p.magnitude & KEEP_BIT == 0) {
-            if let Some(c) = ci.get_mut(usize::from(p.row_px) * width + usize::from(p.col_px)) {
-                *c = 0;
-            }
-        }
-    }
     edges.retain_flagged(KEEP_BIT, MAG_MASK)
 }
 
@@ -155,7 +142,7 @@ fn mark(edges: &mut EdgeBuffer, max_width_px: u16, outward_steps_from_col_px: Op
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{EdgeClass, GradientDetector, GradientParams, Region};
+    use crate::{GradientDetector, GradientParams, GreyImage, Region};
 
     /// 64×48 image of grey `ground` with a 45° stripe `x + y ∈ [c, c + width)` of grey `mark`.
     fn stripe(ground: u8, mark: u8, c: usize, width: usize) -> Vec<u8> {
@@ -177,7 +164,7 @@ mod tests {
         let mut edges = EdgeBuffer::with_capacity(4096);
         det.detect(&image, Region::Full, &mut edges, None).unwrap();
         let before = edges.len();
-        let dropped = keep_bright_stripes(&image, &mut edges, None, max_width_px, None);
+        let dropped = keep_bright_stripes(&mut edges, max_width_px, None);
         assert_eq!(edges.len() + dropped, before);
         assert!(edges.pixels().iter().all(|p| p.magnitude <= 2040));
         (before, edges.len())
@@ -243,19 +230,5 @@ mod tests {
         split_stripes(&mut edges, &mut paired, 8, true);
         assert!(paired.is_empty());
         assert_eq!(edges.len(), before);
-    }
-
-    #[test]
-    fn the_class_image_loses_the_dropped_pixels() {
-        let data = stripe(200, 40, 50, 4);
-        let image = GreyImage::new(&data, 64, 48, 64).unwrap();
-        let det = GradientDetector::new(GradientParams::default()).unwrap();
-        let mut edges = EdgeBuffer::with_capacity(4096);
-        let mut ci = vec![0u8; 64 * 48];
-        det.detect(&image, Region::Full, &mut edges, Some(&mut ci))
-            .unwrap();
-        assert!(ci.contains(&(EdgeClass::LeftLane as u8)));
-        keep_bright_stripes(&image, &mut edges, Some(&mut ci), 8, None);
-        assert!(ci.iter().all(|&c| c == 0));
     }
 }

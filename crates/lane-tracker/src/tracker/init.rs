@@ -45,9 +45,7 @@ impl LaneTracker {
             );
         } else {
             keep_bright_stripes(
-                image,
                 &mut self.edges,
-                None,
                 self.cfg.gradient.stripe_max_width_px,
                 outward,
             );

@@ -35,7 +35,7 @@ impl LaneTracker {
             self.cfg.gradient.stripe_max_width_px
         };
         let outward = self.outward_col();
-        keep_bright_stripes(image, &mut self.edges, None, stripe_px, outward);
+        keep_bright_stripes(&mut self.edges, stripe_px, outward);
         self.select_points(i, image, coeffs, self.window_half_width(predict));
         if self.lanes[i].points.len() < self.cfg.track.reinit_min_points {
             Self::miss(&mut self.lanes[i], &self.cfg);
