@@ -20,7 +20,7 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use lane_eval::labelled::{
     EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, ScoringRules,
-    ceiling_prediction, score_frame, track_label_set,
+    StageCensus, ceiling_prediction, census_set, score_frame, track_label_set,
 };
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
@@ -54,6 +54,11 @@ pub struct EvalLanesArgs {
     /// Do not run the OpenCV peer even if its venv exists.
     #[arg(long)]
     no_peer: bool,
+    /// Also report where the default configuration loses the ego label lanes of the development
+    /// part, stage by stage (`lane_eval::labelled::census_set`: no Hough candidate, candidate not
+    /// chosen, lost after the choice, found by the refinement).
+    #[arg(long)]
+    census: bool,
 }
 
 /// Format version of `summary.json`.
@@ -159,6 +164,37 @@ impl SplitTotals {
             holdout: self.holdout.summary(),
         }
     }
+}
+
+/// The census table (`--census`): per set and overall, development part, default configuration.
+fn render_census(censuses: &[(String, StageCensus)]) -> String {
+    let mut md = String::from(
+        "\n## Where the default loses the development part's ego lanes (`--census`)\n\n\
+         Label lanes on frames with a joint initialisation, by the TuSimple rule \
+         (`lane_eval::labelled::census_set`).\n\n\
+         | set | label lanes | matched | … found by the refinement | no Hough candidate | \
+         candidate not chosen | lost after the choice | not classified |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    let mut total = StageCensus::default();
+    let row = |name: &str, c: &StageCensus| {
+        format!(
+            "| {name} | {} | {} | {} | {} | {} | {} | {} |\n",
+            c.label_lanes,
+            c.matched,
+            c.found_by_refinement,
+            c.no_candidate,
+            c.not_chosen,
+            c.lost_after_choice,
+            c.not_classified
+        )
+    };
+    for (name, c) in censuses {
+        md += &row(name, c);
+        total.add(c);
+    }
+    md += &row("**overall**", &total);
+    md
 }
 
 /// Frames `0..dev_count(n)` of a set of `n` are the development part.
@@ -271,11 +307,17 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
     }
 
     let mut summaries = Vec::new();
+    let mut censuses: Vec<(String, StageCensus)> = Vec::new();
     let mut overall: BTreeMap<String, SplitTotals> = BTreeMap::new();
     let mut ranks = Vec::new();
     let mut drawn: Vec<(Vec<EgoPrediction>, Option<Vec<EgoPrediction>>)> = Vec::new();
     for (si, (dir, set)) in sets.iter().enumerate() {
         let n_dev = dev_count(set.frames.len());
+        if args.census {
+            let c = census_set(dir, set, &configs[0].1, Estimator::Kif, 0..n_dev, &rules)
+                .with_context(|| format!("census of set {}", set.set))?;
+            censuses.push((set.set.clone(), c));
+        }
         let mut results = BTreeMap::new();
         let mut runs: Vec<(String, Vec<EgoPrediction>)> = Vec::new();
         for (name, cfg) in &configs {
@@ -356,7 +398,10 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
             .collect(),
     };
 
-    let md = render_markdown(&summary, args.dev_only);
+    let mut md = render_markdown(&summary, args.dev_only);
+    if args.census {
+        md += &render_census(&censuses);
+    }
     print!("{md}");
     if !args.dev_only {
         std::fs::write(out.join("summary.md"), &md)?;

@@ -209,5 +209,6 @@ pub use error::{FilterFailure, TrackerError};
 /// The workspace's one grey frame (crate `grey-frame`).
 pub use grey_frame::{FrameError, GreyFrame};
 pub use tracker::{
-    Estimator, LaneReport, LaneState, LaneTracker, LaneView, Side, TrackReport, TrackerCounters,
+    Estimator, InitCandidate, LaneReport, LaneState, LaneTracker, LaneView, Side, TrackReport,
+    TrackerCounters,
 };

@@ -43,7 +43,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
+use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackReport, TrackerConfig};
 
 use crate::EvalError;
 
@@ -332,6 +332,33 @@ fn eval_parabola(coeffs: [f64; 3], y: f64) -> f64 {
     hough_init::Parabola::from_coeffs(coeffs).col_at_row(y)
 }
 
+/// The points of `labels`' lanes on `side` at or below row `y_top` (the scored ones).
+fn scored_points(labels: &LabelFrame, side: LabelSide, y_top: f64) -> Vec<[f64; 2]> {
+    labels
+        .lanes
+        .iter()
+        .filter(|l| l.side == side)
+        .flat_map(|l| l.points.iter().copied())
+        .filter(|p| p[1] >= y_top)
+        .collect()
+}
+
+/// TuSimple accuracy of prediction `c` on the scored label points `pts` (at least 2), with the
+/// point tolerance `tus_px` (at this width) slope-corrected from the straight fit `x(y)` of the
+/// points; also the sum of |x_pred − x_label| over them, px.
+fn tusimple_lane_accuracy(pts: &[[f64; 2]], c: [f64; 3], tus_px: f64) -> (f64, f64) {
+    let tol = tus_px / fit_slope(pts).atan().cos();
+    let (mut correct, mut abs_err_sum_px) = (0usize, 0.0);
+    for &[x, y] in pts {
+        let e = (eval_parabola(c, y) - x).abs();
+        abs_err_sum_px += e;
+        if e <= tol {
+            correct += 1;
+        }
+    }
+    (correct as f64 / pts.len() as f64, abs_err_sum_px)
+}
+
 /// Score one frame's ego prediction against its labels under `rules`.
 pub fn score_frame(
     labels: &LabelFrame,
@@ -348,13 +375,7 @@ pub fn score_frame(
     let tus_px = rules.tusimple_px_at_1280 * width as f64 / 1280.0;
     let aly_px = rules.aly_px_at_640 * width as f64 / 640.0;
     for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
-        let pts: Vec<[f64; 2]> = labels
-            .lanes
-            .iter()
-            .filter(|l| l.side == side)
-            .flat_map(|l| l.points.iter().copied())
-            .filter(|p| p[1] >= y_top)
-            .collect();
+        let pts = scored_points(labels, side, y_top);
         let labelled = labels.lanes.iter().any(|l| l.side == side);
         let pred = prediction[k];
         if labelled && pts.len() < 2 {
@@ -369,19 +390,9 @@ pub fn score_frame(
         }
         t.label_lanes += 1;
         let Some(c) = pred else { continue };
-        // TuSimple: slope-corrected tolerance from the straight fit x(y) of the label points.
-        let slope = fit_slope(&pts);
-        let tol = tus_px / slope.atan().cos();
-        let mut correct = 0u64;
-        for &[x, y] in &pts {
-            let e = (eval_parabola(c, y) - x).abs();
-            t.abs_err_sum_px += e;
-            t.abs_err_points += 1;
-            if e <= tol {
-                correct += 1;
-            }
-        }
-        let acc = correct as f64 / pts.len() as f64;
+        let (acc, abs_err_sum_px) = tusimple_lane_accuracy(&pts, c, tus_px);
+        t.abs_err_sum_px += abs_err_sum_px;
+        t.abs_err_points += pts.len() as u64;
         t.tusimple_acc_sum += acc;
         if acc >= rules.tusimple_match_fraction {
             t.tusimple_matched += 1;
@@ -426,9 +437,25 @@ pub fn track_label_set(
     cfg: &TrackerConfig,
     estimator: Estimator,
 ) -> Result<Vec<EgoPrediction>, EvalError> {
+    let mut out = Vec::with_capacity(set.frames.len());
+    run_label_set(dir, set, cfg, estimator, |_, _, _, r| {
+        out.push([r.lanes[0].coeffs, r.lanes[1].coeffs]);
+    })?;
+    Ok(out)
+}
+
+/// Run a tracker over a labelled set, clip by clip (reset at the start of every clip), calling
+/// `on_frame(position in the set, labels, tracker, report)` after every frame, in set order.
+fn run_label_set(
+    dir: &Path,
+    set: &LabelSet,
+    cfg: &TrackerConfig,
+    estimator: Estimator,
+    mut on_frame: impl FnMut(usize, &LabelFrame, &LaneTracker, &TrackReport),
+) -> Result<(), EvalError> {
     let mut tracker = LaneTracker::new(cfg, estimator, set.width, set.height)?;
     let mut frame = GreyFrame::default();
-    let mut out = Vec::with_capacity(set.frames.len());
+    let mut position = 0;
     for clip in set.clips() {
         tracker.reset();
         for f in clip {
@@ -447,10 +474,11 @@ pub fn track_label_set(
                 });
             }
             let r = tracker.track(&frame)?;
-            out.push([r.lanes[0].coeffs, r.lanes[1].coeffs]);
+            on_frame(position, f, &tracker, &r);
+            position += 1;
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 /// The **ceiling** of the lane model: for each ego label lane of `frame`, the least-squares
@@ -516,5 +544,8 @@ fn fit_slope(pts: &[[f64; 2]]) -> f64 {
     if syy > 0.0 { sxy / syy } else { 0.0 }
 }
 
+mod census;
 #[cfg(test)]
 mod tests;
+
+pub use census::{StageCensus, census_set};

@@ -14,7 +14,7 @@ use vision_gradient::{
 };
 
 use super::points::fit_profile;
-use super::{Estimator, LaneFilter, LaneState, LaneTracker};
+use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, MAX_CANDIDATE_LINES};
 use crate::TrackerError;
 use crate::error::FilterFailure;
 use crate::wrls_lane::WrlsLane;
@@ -107,7 +107,7 @@ impl LaneTracker {
     /// `hough_init::choose_ego_pair` (a lane still tracked is kept in the pair), each chosen
     /// line refined by least squares on the pixels of its own class.
     fn initialise_jointly(&mut self) {
-        const MAX_LINES: usize = 8;
+        const MAX_LINES: usize = MAX_CANDIDATE_LINES;
         let none = HoughLine {
             rho_px: 0.0,
             theta_rad: 0.0,
@@ -121,6 +121,7 @@ impl LaneTracker {
         let mut chords = [Chord::default(); 2 * MAX_LINES + 1];
         let mut found = [none; MAX_LINES];
         let mut m = 0;
+        self.init_candidates.clear();
         for k in 0..2 {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
             self.fill_candidates(class);
@@ -152,25 +153,39 @@ impl LaneTracker {
                 continue;
             };
             for line in &found[..count] {
-                let chord = if self.cfg.init.candidate_coverage {
+                let (chord, coeffs) = if self.cfg.init.candidate_coverage {
                     let Some(p) = self.row_fit(line) else {
                         continue;
                     };
-                    Chord {
+                    let chord = Chord {
                         col_top_px: p.col_at_row(yt),
                         col_bottom_px: p.col_at_row(yb),
                         support: self.row_coverage(&p),
-                    }
+                    };
+                    (chord, [p.a1, p.a2, p.a3])
                 } else {
-                    let (Some(xt), Some(xb)) = (line.col_at_row(yt), line.col_at_row(yb)) else {
+                    let (Some(x0), Some(x1), Some(xt), Some(xb)) = (
+                        line.col_at_row(0.0),
+                        line.col_at_row(1.0),
+                        line.col_at_row(yt),
+                        line.col_at_row(yb),
+                    ) else {
                         continue;
                     };
-                    Chord {
+                    let chord = Chord {
                         col_top_px: xt,
                         col_bottom_px: xb,
                         support: f64::from(line.votes),
-                    }
+                    };
+                    (chord, [0.0, x1 - x0, x0])
                 };
+                // Within capacity: at most MAX_LINES per band.
+                self.init_candidates.push(InitCandidate {
+                    band: self.lanes[k].side,
+                    coeffs,
+                    support: chord.support,
+                    chosen: None,
+                });
                 lines[m] = *line;
                 classes[m] = class;
                 chords[m] = chord;
@@ -205,6 +220,11 @@ impl LaneTracker {
         }
         for (i, pick) in [choice.left, choice.right].into_iter().enumerate() {
             let Some(j) = pick else { continue };
+            // `init_candidates` holds the first `m` chords in order (a tracked lane's chord,
+            // appended after them, is not a candidate).
+            if let Some(c) = self.init_candidates.get_mut(j) {
+                c.chosen = Some(self.lanes[i].side);
+            }
             if locked.is_some_and(|(l, _)| l == j) || self.lanes[i].has_estimate() {
                 continue;
             }

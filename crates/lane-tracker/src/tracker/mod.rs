@@ -190,6 +190,31 @@ impl Lane {
     }
 }
 
+/// Most Hough candidate lines per angle band in the joint initialisation
+/// (`init.candidate_lines` is validated to at most this).
+pub(crate) const MAX_CANDIDATE_LINES: usize = 8;
+
+/// One Hough candidate line of the last joint initialisation (`init.candidate_lines > 0`) as the
+/// choice of the ego pair weighed it: for overlays, and for finding at which stage a lane is lost
+/// (`lane_eval::labelled::census_set`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct InitCandidate {
+    /// The angle band whose pixels voted for it: [`Side::Left`] the `/` band, [`Side::Right`]
+    /// the `\` band (on a curve a boundary may lean either way; the choice puts it on a side by
+    /// position).
+    pub band: Side,
+    /// `[a1, a2, a3]` of `x = a1·y² + a2·y + a3`, px: the least-squares parabola the choice
+    /// weighed (`init.candidate_coverage`), else the Hough line itself (`a1 = 0`).
+    pub coeffs: [f64; 3],
+    /// Its support in the choice: the row coverage net of the clutter beside it
+    /// (`init.candidate_coverage`), else its Hough votes.
+    pub support: f64,
+    /// The side the choice gave it, if any. The lane installed there is this candidate's line
+    /// refitted by least squares, then refined in the windows (`track.refine_passes`), and may
+    /// still be refused by the sanity checks.
+    pub chosen: Option<Side>,
+}
+
 /// What an overlay needs of one lane: its windows, its points and its estimate.
 #[derive(Debug, Clone, Copy)]
 pub struct LaneView<'a> {
@@ -235,6 +260,9 @@ pub struct LaneTracker {
     q: ProcessNoise<3>,
     p0: ThetaCov,
     lanes: [Lane; 2],
+    /// The candidates of the last frame's joint initialisation (capacity
+    /// `2 · MAX_CANDIDATE_LINES`, never exceeded); empty on a frame without one.
+    init_candidates: Vec<InitCandidate>,
     counters: TrackerCounters,
     /// The last filter failure per lane (left, right), kept typed without allocating.
     last_failure: [Option<FilterFailure>; 2],
@@ -321,6 +349,7 @@ impl LaneTracker {
             q,
             p0,
             lanes,
+            init_candidates: Vec::with_capacity(2 * MAX_CANDIDATE_LINES),
             counters: TrackerCounters::default(),
             last_failure: [None; 2],
         })
@@ -407,6 +436,14 @@ impl LaneTracker {
         lane.has_estimate().then_some(lane.fit)
     }
 
+    /// The Hough candidate lines of the last frame's joint initialisation, both angle bands
+    /// (at most `init.candidate_lines` each), with their support and the side the choice gave
+    /// them ([`InitCandidate`]). Empty when the last frame ran no joint initialisation (both
+    /// lanes tracked, or `init.candidate_lines = 0`, the paper's one line per band).
+    pub fn init_candidates(&self) -> &[InitCandidate] {
+        &self.init_candidates
+    }
+
     /// Windows, points and report of one lane after the last frame (for overlays).
     pub fn lane_view(&self, side: Side) -> LaneView<'_> {
         let lane = &self.lanes[side as usize];
@@ -444,6 +481,7 @@ impl LaneTracker {
         }
         let image = GreyImage::new(data, self.width, self.height, stride_px)?;
         self.counters.frames += 1;
+        self.init_candidates.clear();
         for i in 0..2 {
             let lane = &mut self.lanes[i];
             lane.initialised_now = false;

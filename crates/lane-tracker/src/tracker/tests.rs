@@ -119,3 +119,73 @@ fn the_orientation_gate_keeps_a_crossing_bar_out_of_the_window_points() {
     ungated.track.orientation_tolerance_deg = 0.0;
     assert!(far_points(&ungated) > 0, "the bar never reached the window");
 }
+
+#[test]
+fn the_joint_initialisation_reports_its_candidates_and_the_chosen_pair() {
+    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
+    let col = |c: [f64; 3], y: f64| c[0] * y * y + c[1] * y + c[2];
+    let frame = two_marks(320, 240);
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut lines_only = cfg;
+    lines_only.init.candidate_coverage = false;
+    for cfg in [cfg, lines_only] {
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let (top, bottom) = tracker.roi;
+        let (yt, yb) = (top as f64, (bottom - 1) as f64);
+        tracker.track(&frame).expect("a frame");
+        let cands = tracker.init_candidates();
+        assert!(!cands.is_empty() && cands.len() <= 2 * cfg.init.candidate_lines);
+        for (side, truth) in [
+            (Side::Left, &left as &dyn Fn(f64) -> f64),
+            (Side::Right, &right),
+        ] {
+            let chosen: Vec<_> = cands.iter().filter(|c| c.chosen == Some(side)).collect();
+            assert_eq!(chosen.len(), 1, "{side:?}: {cands:?}");
+            let c = chosen[0];
+            assert_eq!(c.band, side, "a straight mark votes in its own band");
+            // A Hough line (1° steps) may sit on one side of the 5 px mark; its LS parabola on
+            // the middle.
+            let tol_px = if cfg.init.candidate_coverage {
+                1.5
+            } else {
+                5.0
+            };
+            for y in [yt, yb] {
+                let err = (col(c.coeffs, y) - truth(y)).abs();
+                assert!(err < tol_px, "{side:?} at row {y}: {err} px, {c:?}");
+            }
+            assert!(c.support > 0.0);
+            if !cfg.init.candidate_coverage {
+                assert_eq!(
+                    c.coeffs[0], 0.0,
+                    "without coverage a candidate is its Hough line"
+                );
+            }
+        }
+        // A tracking frame runs no initialisation: no candidates.
+        let (tracked, allocations) = allocations_in(|| tracker.track(&frame));
+        assert!(
+            tracked
+                .expect("a frame")
+                .lanes
+                .iter()
+                .all(|l| !l.initialised)
+        );
+        assert!(tracker.init_candidates().is_empty());
+        assert_eq!(allocations, 0);
+        // Re-initialising reports them again, without allocating.
+        tracker.reset();
+        let (again, allocations) = allocations_in(|| tracker.track(&frame));
+        assert!(again.expect("a frame").lanes.iter().all(|l| l.initialised));
+        assert_eq!(
+            tracker
+                .init_candidates()
+                .iter()
+                .filter(|c| c.chosen.is_some())
+                .count(),
+            2
+        );
+        assert_eq!(allocations, 0, "a joint initialisation allocated");
+    }
+}

@@ -1,0 +1,116 @@
+//! `census_set` puts every scored ego label lane in the stage where it is lost: a label on the
+//! tracked mark is matched, a label where no mark is has no candidate, a label on a mark the
+//! ego-pair choice passed over is "not chosen".
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::PathBuf;
+
+use lane_eval::labelled::{LabelSet, ScoringRules, StageCensus, census_set};
+use lane_tracker::{Estimator, TrackerConfig};
+
+const W: usize = 320;
+const H: usize = 180;
+
+fn left(y: f64) -> f64 {
+    100.0 - 0.6 * (y - 179.0)
+}
+fn right(y: f64) -> f64 {
+    220.0 + 0.6 * (y - 179.0)
+}
+/// A neighbour lane's mark right of the ego lane.
+fn outer(y: f64) -> f64 {
+    300.0 + 1.2 * (y - 179.0)
+}
+
+/// Bright marks 5 px wide on a dark floor along the given curves.
+fn marks(curves: &[fn(f64) -> f64]) -> image::GrayImage {
+    image::GrayImage::from_fn(W as u32, H as u32, |x, y| {
+        let on = curves
+            .iter()
+            .any(|c| (f64::from(x) - c(f64::from(y))).abs() < 2.5);
+        image::Luma([if on { 200 } else { 60 }])
+    })
+}
+
+/// A label lane along `f` from row 100 down, one point per row.
+fn label(side: &str, f: fn(f64) -> f64) -> String {
+    let pts: Vec<String> = (100..H)
+        .map(|y| format!("[{:.2}, {y}]", f(y as f64)))
+        .collect();
+    format!(r#"{{"side": "{side}", "points": [{}]}}"#, pts.join(", "))
+}
+
+#[test]
+fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
+    let dir: PathBuf = std::env::temp_dir().join(format!("ita-nav-census-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("frames")).unwrap();
+    // Frame 0: labels on the two marks. Frame 1: the right label 40 px right of any mark.
+    // Frame 2: a neighbour's mark too, and the right label on it.
+    let shifted: fn(f64) -> f64 = |y| right(y) + 40.0;
+    let frames = [
+        (
+            marks(&[left, right]),
+            [label("left", left), label("right", right)],
+        ),
+        (
+            marks(&[left, right]),
+            [label("left", left), label("right", shifted)],
+        ),
+        (
+            marks(&[left, right, outer]),
+            [label("left", left), label("right", outer)],
+        ),
+    ];
+    let mut entries = Vec::new();
+    for (i, (img, lanes)) in frames.iter().enumerate() {
+        let file = format!("frames/{i:04}.png");
+        img.save(dir.join(&file)).unwrap();
+        entries.push(format!(
+            r#"{{"index": {i}, "file": "{file}", "clip": "c{i}", "lanes": [{}]}}"#,
+            lanes.join(", ")
+        ));
+    }
+    let json = format!(
+        r#"{{"schema": 1, "set": "census", "kind": "road", "source": "rendered by the test",
+            "licence": "none", "width": {W}, "height": {H}, "frames": [{}]}}"#,
+        entries.join(", ")
+    );
+    std::fs::write(dir.join("labels.json"), json).unwrap();
+    let set = LabelSet::load(&dir).unwrap();
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let rules = ScoringRules::default();
+    let census = |frames| census_set(&dir, &set, &cfg, Estimator::Kif, frames, &rules).unwrap();
+
+    let first = census(0..1);
+    assert_eq!((first.label_lanes, first.matched), (2, 2), "{first:?}");
+    let nowhere = census(1..2);
+    assert_eq!(
+        (nowhere.matched, nowhere.no_candidate, nowhere.not_chosen),
+        (1, 1, 0),
+        "{nowhere:?}"
+    );
+    let passed_over = census(2..3);
+    assert_eq!(
+        (
+            passed_over.matched,
+            passed_over.no_candidate,
+            passed_over.not_chosen
+        ),
+        (1, 0, 1),
+        "{passed_over:?}"
+    );
+    // The classes partition the lanes, and the whole set is the sum of its frames.
+    let all = census(0..3);
+    let mut sum = StageCensus::default();
+    for c in [first, nowhere, passed_over] {
+        sum.add(&c);
+    }
+    assert_eq!(all, sum);
+    assert_eq!(
+        all.label_lanes,
+        all.matched + all.no_candidate + all.not_chosen + all.lost_after_choice
+    );
+    assert!(all.found_by_refinement <= all.matched);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
