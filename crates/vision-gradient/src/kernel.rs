@@ -72,51 +72,122 @@ pub(crate) enum Sink<'s> {
 /// Pixels per vector block of the kernel (16 × i16 = one AVX2 register).
 const BLOCK: usize = 16;
 
-/// Sobel responses `(gx, gy)` of one pixel from its 3×3 neighbourhood `a b c / d · f / g h k`.
-/// `|gx|, |gy| <= 1020`, so `|gx| + |gy| <= 2040` fits `i16`.
+/// Sobel responses `(gx, gy)` of one pixel from its 3×3 neighbourhood `[a, b, c, d, f, g, h, k]`
+/// (`a b c / d · f / g h k`, row by row). `|gx|, |gy| <= 1020`, so `|gx| + |gy| <= 2040` fits
+/// `i16`.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn sobel(a: u8, b: u8, c: u8, d: u8, f: u8, g: u8, h: u8, k: u8) -> (i16, i16) {
-    let (a, b, c, d) = (i16::from(a), i16::from(b), i16::from(c), i16::from(d));
-    let (f, g, h, k) = (i16::from(f), i16::from(g), i16::from(h), i16::from(k));
+pub(crate) fn sobel(neighbours: [u8; 8]) -> (i16, i16) {
+    let [a, b, c, d, f, g, h, k] = neighbours.map(i16::from);
     let gx = (c - a) + 2 * (f - d) + (k - g);
     let gy = (g + 2 * h + k) - (a + 2 * b + c);
     (gx, gy)
 }
 
-/// Band + threshold decision for one pixel: class 0 (dropped), 1 (left) or 2 (right).
-#[inline(always)]
-fn classify(gx: i16, gy: i16, band: Band, thr: i16) -> u8 {
-    let ax = gx.abs();
-    let ay = gy.abs();
-    let ax32 = i32::from(ax);
-    let ay32 = i32::from(ay);
-    // Products <= 1020 · 16384 < 2^31.
-    let lo_ok = ax32 * band.cos_min >= ay32 * band.sin_min;
-    let hi_ok = ax32 * band.cos_max <= ay32 * band.sin_max;
-    let keep = lo_ok & hi_ok & (gx != 0) & (gy != 0) & (ax + ay >= thr);
-    let right = u8::from((gx ^ gy) < 0);
-    u8::from(keep) * (1 + right)
+/// The per-pixel decision: orientation band and magnitude threshold.
+#[derive(Clone, Copy)]
+struct Decision {
+    band: Band,
+    thr: i16,
+}
+
+impl Decision {
+    /// Class 0 (dropped), 1 (left) or 2 (right) of a pixel with Sobel responses `gx`, `gy`.
+    #[inline(always)]
+    fn classify(self, gx: i16, gy: i16) -> u8 {
+        let ax = gx.abs();
+        let ay = gy.abs();
+        let ax32 = i32::from(ax);
+        let ay32 = i32::from(ay);
+        // Products <= 1020 · 16384 < 2^31.
+        let lo_ok = ax32 * self.band.cos_min >= ay32 * self.band.sin_min;
+        let hi_ok = ax32 * self.band.cos_max <= ay32 * self.band.sin_max;
+        let keep = lo_ok & hi_ok & (gx != 0) & (gy != 0) & (ax + ay >= self.thr);
+        let right = u8::from((gx ^ gy) < 0);
+        u8::from(keep) * (1 + right)
+    }
+
+    /// Magnitude `|gx| + |gy|`, class and `gx` of the pixel with these neighbours.
+    #[inline(always)]
+    fn pixel(self, neighbours: [u8; 8]) -> (u16, u8, i16) {
+        let (gx, gy) = sobel(neighbours);
+        ((gx.abs() + gy.abs()) as u16, self.classify(gx, gy), gx)
+    }
+}
+
+/// The three image rows around a row segment, each from the column left of the segment on.
+#[derive(Clone, Copy)]
+struct Rows3<'r> {
+    up: &'r [u8],
+    mid: &'r [u8],
+    dn: &'r [u8],
+}
+
+impl<'r> Rows3<'r> {
+    /// Columns `i ..= i + BLOCK + 1` of the three rows: the neighbourhoods of segment pixels
+    /// `i .. i + BLOCK`. `None` past the rows' end.
+    #[inline(always)]
+    fn block(self, i: usize) -> Option<[&'r [u8; BLOCK + 2]; 3]> {
+        let at = |row: &'r [u8]| row.get(i..i + BLOCK + 2)?.try_into().ok();
+        Some([at(self.up)?, at(self.mid)?, at(self.dn)?])
+    }
+
+    /// The 3×3 neighbourhood of segment pixel `i`. `None` past the rows' end.
+    #[inline(always)]
+    fn neighbours(self, i: usize) -> Option<[u8; 8]> {
+        let (up, mid, dn) = (self.up, self.mid, self.dn);
+        Some([
+            *up.get(i)?,
+            *up.get(i + 1)?,
+            *up.get(i + 2)?,
+            *mid.get(i)?,
+            *mid.get(i + 2)?,
+            *dn.get(i)?,
+            *dn.get(i + 1)?,
+            *dn.get(i + 2)?,
+        ])
+    }
+}
+
+/// The kernel's outputs over one row segment, one entry per pixel: magnitude, class (0, 1, 2)
+/// and Sobel `gx`.
+struct Outputs<'o> {
+    mag: &'o mut [u16],
+    cls: &'o mut [u8],
+    gx: &'o mut [i16],
+}
+
+/// The outputs of one block of [`BLOCK`] pixels.
+struct BlockOut<'o> {
+    mag: &'o mut [u16; BLOCK],
+    cls: &'o mut [u8; BLOCK],
+    gx: &'o mut [i16; BLOCK],
+}
+
+impl Outputs<'_> {
+    /// Pixels in the segment (the shortest output).
+    fn len(&self) -> usize {
+        self.mag.len().min(self.cls.len()).min(self.gx.len())
+    }
+
+    /// The outputs of pixels `i .. i + BLOCK`. `None` past the end.
+    #[inline(always)]
+    fn block(&mut self, i: usize) -> Option<BlockOut<'_>> {
+        Some(BlockOut {
+            mag: self.mag.get_mut(i..i + BLOCK)?.try_into().ok()?,
+            cls: self.cls.get_mut(i..i + BLOCK)?.try_into().ok()?,
+            gx: self.gx.get_mut(i..i + BLOCK)?.try_into().ok()?,
+        })
+    }
 }
 
 /// One fixed block of [`BLOCK`] pixels: fixed-size arrays, no remainder loop, so the block is
 /// straight-line vector code. Blocks where no pixel reaches the threshold skip the band test.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn block(
-    up: &[u8; BLOCK + 2],
-    mid: &[u8; BLOCK + 2],
-    dn: &[u8; BLOCK + 2],
-    band: Band,
-    thr: i16,
-    mag: &mut [u16; BLOCK],
-    cls: &mut [u8; BLOCK],
-    gx: &mut [i16; BLOCK],
-) {
+fn block([up, mid, dn]: [&[u8; BLOCK + 2]; 3], decision: Decision, out: BlockOut<'_>) {
     let mut gy = [0i16; BLOCK];
     let mut any = false;
     for i in 0..BLOCK {
-        let (x, y) = sobel(
+        let (x, y) = sobel([
             up[i],
             up[i + 1],
             up[i + 2],
@@ -125,122 +196,53 @@ fn block(
             dn[i],
             dn[i + 1],
             dn[i + 2],
-        );
+        ]);
         let m = x.abs() + y.abs();
-        gx[i] = x;
+        out.gx[i] = x;
         gy[i] = y;
-        mag[i] = m as u16;
-        any |= m >= thr;
+        out.mag[i] = m as u16;
+        any |= m >= decision.thr;
     }
     if any {
-        for i in 0..BLOCK {
-            cls[i] = classify(gx[i], gy[i], band, thr);
+        for ((class, &x), &y) in out.cls.iter_mut().zip(out.gx.iter()).zip(&gy) {
+            *class = decision.classify(x, y);
         }
     } else {
-        *cls = [0; BLOCK];
+        *out.cls = [0; BLOCK];
     }
 }
 
-/// [`block`] at offset `i` of a row segment (no-op if the slices are too short, which the
-/// callers rule out). A plain `fn`, not a closure, so it inherits the caller's target features
-/// when inlined.
+/// [`block`] at segment pixel `i` (no-op past the end, which the callers rule out). A plain
+/// `fn`, not a closure, so it inherits the caller's target features when inlined.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn block_at(
-    up: &[u8],
-    mid: &[u8],
-    dn: &[u8],
-    band: Band,
-    thr: i16,
-    mag: &mut [u16],
-    cls: &mut [u8],
-    gx: &mut [i16],
-    i: usize,
-) -> Option<()> {
-    block(
-        up.get(i..i + BLOCK + 2)?.try_into().ok()?,
-        mid.get(i..i + BLOCK + 2)?.try_into().ok()?,
-        dn.get(i..i + BLOCK + 2)?.try_into().ok()?,
-        band,
-        thr,
-        mag.get_mut(i..i + BLOCK)?.try_into().ok()?,
-        cls.get_mut(i..i + BLOCK)?.try_into().ok()?,
-        gx.get_mut(i..i + BLOCK)?.try_into().ok()?,
-    );
-    Some(())
+fn block_at(rows: Rows3<'_>, decision: Decision, out: &mut Outputs<'_>, i: usize) {
+    if let (Some(rows), Some(out)) = (rows.block(i), out.block(i)) {
+        block(rows, decision, out);
+    }
 }
 
-/// Per-pixel form of [`block`] for segments shorter than a block.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn pixel(
-    a: u8,
-    b: u8,
-    c: u8,
-    d: u8,
-    f: u8,
-    g: u8,
-    h: u8,
-    k: u8,
-    band: Band,
-    thr: i16,
-) -> (u16, u8, i16) {
-    let (gx, gy) = sobel(a, b, c, d, f, g, h, k);
-    (
-        (gx.abs() + gy.abs()) as u16,
-        classify(gx, gy, band, thr),
-        gx,
-    )
-}
-
-/// Kernel over one row segment. `up`, `mid`, `dn` hold columns `c-1 ..= c+n` of three
-/// consecutive rows, `mag`, `cls` and `gx` (length `n`) receive columns `c .. c+n`.
+/// Kernel over one row segment of `out.len()` pixels, `rows` holding its columns `c−1 ..= c+n`.
 /// Full blocks first; the remainder is one more block ending at `n` (overlapping the previous
 /// one, which recomputes identical values) or, for `n < BLOCK`, a per-pixel loop.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn kernel(
-    up: &[u8],
-    mid: &[u8],
-    dn: &[u8],
-    band: Band,
-    thr: i16,
-    mag: &mut [u16],
-    cls: &mut [u8],
-    gx: &mut [i16],
-) {
-    let n = mag.len().min(cls.len()).min(gx.len());
+fn kernel(rows: Rows3<'_>, decision: Decision, mut out: Outputs<'_>) {
+    let n = out.len();
     if n >= BLOCK {
         let mut i = 0;
         while i + BLOCK <= n {
-            block_at(up, mid, dn, band, thr, mag, cls, gx, i);
+            block_at(rows, decision, &mut out, i);
             i += BLOCK;
         }
         if i < n {
-            block_at(up, mid, dn, band, thr, mag, cls, gx, n - BLOCK);
+            block_at(rows, decision, &mut out, n - BLOCK);
         }
         return;
     }
-    let w = n + 2;
-    if up.len() < w || mid.len() < w || dn.len() < w {
-        return;
-    }
     for i in 0..n {
-        let (m, k, x) = pixel(
-            up[i],
-            up[i + 1],
-            up[i + 2],
-            mid[i],
-            mid[i + 2],
-            dn[i],
-            dn[i + 1],
-            dn[i + 2],
-            band,
-            thr,
-        );
-        mag[i] = m;
-        cls[i] = k;
-        gx[i] = x;
+        let Some(neighbours) = rows.neighbours(i) else {
+            return;
+        };
+        (out.mag[i], out.cls[i], out.gx[i]) = decision.pixel(neighbours);
     }
 }
 
@@ -258,6 +260,7 @@ fn pass_impl(
     if w < 3 || h < 3 {
         return;
     }
+    let decision = Decision { band, thr };
     let mut mag = [0u16; CHUNK];
     let mut cls = [0u8; CHUNK];
     let mut gxs = [0i16; CHUNK];
@@ -287,17 +290,21 @@ fn pass_impl(
         let mut c = c0;
         while c < c1 {
             let n = CHUNK.min(c1 - c);
-            let (m, k, x) = (&mut mag[..n], &mut cls[..n], &mut gxs[..n]);
+            let rows = Rows3 {
+                up: &up[c - 1..],
+                mid: &mid[c - 1..],
+                dn: &dn[c - 1..],
+            };
             kernel(
-                &up[c - 1..],
-                &mid[c - 1..],
-                &dn[c - 1..],
-                band,
-                thr,
-                m,
-                k,
-                x,
+                rows,
+                decision,
+                Outputs {
+                    mag: &mut mag[..n],
+                    cls: &mut cls[..n],
+                    gx: &mut gxs[..n],
+                },
             );
+            let (m, k, x) = (&mag[..n], &mut cls[..n], &gxs[..n]);
             if let CheckedRegion::Mask(mask) = region
                 && let Some(mrow) = mask.get(r * w + c..r * w + c + n)
             {

@@ -65,7 +65,7 @@ mod tests {
             image.row(row_px.checked_add(1)?)?,
         );
         let at = |r: &[u8], c: usize| r.get(c).copied();
-        Some(sobel(
+        Some(sobel([
             at(up, col_px - 1)?,
             at(up, col_px)?,
             at(up, col_px + 1)?,
@@ -74,7 +74,7 @@ mod tests {
             at(dn, col_px - 1)?,
             at(dn, col_px)?,
             at(dn, col_px + 1)?,
-        ))
+        ]))
     }
 
     /// The normal angle `θ` of the edge through pixel `(col_px, row_px)` of `image`, degrees in
