@@ -14,10 +14,16 @@ const WINDOW_RGB: [[u8; 3]; 2] = [[120, 120, 0], [0, 110, 130]];
 const POINT_RGB: [[u8; 3]; 2] = [[255, 230, 0], [0, 230, 255]];
 const CURVE_RGB: [[u8; 3]; 2] = [[255, 40, 40], [60, 90, 255]];
 const COAST_RGB: [u8; 3] = [255, 140, 0];
+/// The Hough candidates of an initialisation, by angle band (`/` left, `\` right): dotted.
+const CANDIDATE_RGB: [[u8; 3]; 2] = [[200, 90, 200], [90, 200, 120]];
+/// Rows between two dots of a candidate's curve.
+const CANDIDATE_DOT_ROWS: usize = 3;
 
 /// Draw the tracker's last frame into `rgb` (`width·height·3` bytes, reshaped): the grey frame,
-/// each lane's window borders, its points, and its parabola over the ROI rows (left red, right
-/// blue; orange while coasting).
+/// on a frame that ran the joint initialisation its Hough candidates (their least-squares
+/// parabolas, dotted: magenta the `/` band, green the `\` band; `LaneTracker::init_candidates`),
+/// then each lane's window borders, its points, and its parabola over the ROI rows (left red,
+/// right blue; orange while coasting).
 pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8>) {
     let (w, h) = (frame.width(), frame.height());
     rgb.resize(w * h * 3, 0);
@@ -31,6 +37,16 @@ pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8
         }
     };
     let (top, bottom) = tracker.roi_rows();
+    for c in tracker.init_candidates() {
+        let colour = CANDIDATE_RGB[usize::from(c.band == Side::Right)];
+        for row in (top..bottom).step_by(CANDIDATE_DOT_ROWS) {
+            let y = row as f64;
+            let x = c.coeffs[0] * y * y + c.coeffs[1] * y + c.coeffs[2];
+            if x.is_finite() {
+                put(x.round() as i64, row as i64, colour);
+            }
+        }
+    }
     for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
         let view = tracker.lane_view(side);
         for (row, span) in view.spans.iter().enumerate() {
@@ -174,5 +190,50 @@ impl OverlaySink {
                 .map_err(|source| LaneIoError::Write { path, source })?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lane_tracker::{Estimator, TrackerConfig};
+
+    /// Two bright marks 5 px wide on a dark floor, `/` left and `\` right.
+    fn two_marks(w: usize, h: usize) -> GreyFrame {
+        let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+        let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
+        let mut pixels = vec![60u8; w * h];
+        for (i, p) in pixels.iter_mut().enumerate() {
+            let (x, y) = ((i % w) as f64, (i / w) as f64);
+            if (x - left(y)).abs() < 2.5 || (x - right(y)).abs() < 2.5 {
+                *p = 200;
+            }
+        }
+        GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+    }
+
+    fn count(rgb: &[u8], colour: [u8; 3]) -> usize {
+        rgb.chunks_exact(3).filter(|px| *px == colour).count()
+    }
+
+    #[test]
+    fn an_initialisation_frame_shows_its_candidates_and_a_tracking_frame_does_not() {
+        let frame = two_marks(320, 240);
+        let cfg = TrackerConfig::default_preset().expect("the default preset");
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let mut rgb = Vec::new();
+        tracker.track(&frame).expect("a frame");
+        assert!(!tracker.init_candidates().is_empty());
+        render_overlay(&frame, &tracker, &mut rgb);
+        // Both bands' candidates leave dots beside the lanes' own curves.
+        assert!(count(&rgb, CANDIDATE_RGB[0]) > 0 && count(&rgb, CANDIDATE_RGB[1]) > 0);
+        assert!(count(&rgb, CURVE_RGB[0]) > 0 && count(&rgb, CURVE_RGB[1]) > 0);
+        tracker.track(&frame).expect("a frame");
+        render_overlay(&frame, &tracker, &mut rgb);
+        assert_eq!(
+            count(&rgb, CANDIDATE_RGB[0]) + count(&rgb, CANDIDATE_RGB[1]),
+            0
+        );
+        assert!(count(&rgb, CURVE_RGB[0]) > 0);
     }
 }
