@@ -21,7 +21,8 @@ const CANDIDATE_DOT_ROWS: usize = 3;
 
 /// Draw the tracker's last frame into `rgb` (`width·height·3` bytes, reshaped): the grey frame,
 /// on a frame that ran the joint initialisation its Hough candidates (their least-squares
-/// parabolas, dotted: magenta the `/` band, green the `\` band; `LaneTracker::init_candidates`),
+/// parabolas, or the lines themselves with `init.candidate_coverage` off; dotted: magenta the
+/// `/` band, green the `\` band; `LaneTracker::init_candidates`),
 /// then each lane's window borders, its points, and its parabola over the ROI rows (left red,
 /// right blue; orange while coasting).
 pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8>) {

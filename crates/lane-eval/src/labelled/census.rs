@@ -15,10 +15,10 @@
 //!    least-squares refit, the windowed refinement or a gate moved or dropped it);
 //!
 //! and, among the matched ones, those **found by the refinement**: matched by the output but not
-//! by the chosen candidate (the windows corrected a candidate that was off). A label lane on a
-//! frame without a joint initialisation (both lanes tracked from the previous frame of its clip,
-//! or the paper's one line per band, `init.candidate_lines = 0`) is only counted as **not
-//! classified**.
+//! by the chosen candidate (the windows corrected a candidate that was off). A label lane whose
+//! side kept the estimate tracked from the previous frame of its clip, or on a frame without a
+//! joint initialisation (both lanes tracked, or the paper's one line per band,
+//! `init.candidate_lines = 0`), is only counted as **not classified**.
 
 use std::ops::Range;
 use std::path::Path;
@@ -35,8 +35,8 @@ use crate::EvalError;
 /// Counts of scored ego label lanes by the stage where they are lost (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct StageCensus {
-    /// Scored ego label lanes on frames with a joint initialisation (whether or not it found
-    /// candidates).
+    /// Scored ego label lanes classified: on a side the joint initialisation ran for (whether or
+    /// not it found candidates).
     pub label_lanes: u64,
     /// Matched by the tracker's output.
     pub matched: u64,
@@ -48,8 +48,8 @@ pub struct StageCensus {
     pub not_chosen: u64,
     /// Not matched; the chosen candidate matched.
     pub lost_after_choice: u64,
-    /// Scored ego label lanes on frames without a joint initialisation (tracked from the
-    /// previous frame, or `init.candidate_lines = 0`): not classified.
+    /// Scored ego label lanes on a side that kept its tracked estimate, or on a frame without a
+    /// joint initialisation (`init.candidate_lines = 0`): not classified.
     pub not_classified: u64,
 }
 
@@ -105,13 +105,18 @@ pub fn census_set(
                 if pts.len() < 2 {
                     continue;
                 }
-                if !(report.full_gradient && joint) {
+                // Classified: a side the joint initialisation ran for on this frame (installed
+                // now, or left without an estimate); a side that kept its tracked estimate is not.
+                let lane = &report.lanes[k];
+                let initialised_for = lane.initialised || lane.coeffs.is_none();
+                if !(report.full_gradient && joint && initialised_for) {
                     census.not_classified += 1;
                     continue;
                 }
                 census.label_lanes += 1;
                 let matches = |c: [f64; 3]| {
-                    tusimple_lane_accuracy(&pts, c, tus_px).0 >= rules.tusimple_match_fraction
+                    tusimple_lane_accuracy(&pts, c, tus_px, &mut 0.0)
+                        >= rules.tusimple_match_fraction
                 };
                 let output = report.lanes[k].coeffs.is_some_and(matches);
                 let chosen = candidates

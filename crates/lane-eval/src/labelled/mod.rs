@@ -345,18 +345,23 @@ fn scored_points(labels: &LabelFrame, side: LabelSide, y_top: f64) -> Vec<[f64; 
 
 /// TuSimple accuracy of prediction `c` on the scored label points `pts` (at least 2), with the
 /// point tolerance `tus_px` (at this width) slope-corrected from the straight fit `x(y)` of the
-/// points; also the sum of |x_pred − x_label| over them, px.
-fn tusimple_lane_accuracy(pts: &[[f64; 2]], c: [f64; 3], tus_px: f64) -> (f64, f64) {
+/// points. Adds each point's |x_pred − x_label| (px) to `abs_err_sum_px`.
+fn tusimple_lane_accuracy(
+    pts: &[[f64; 2]],
+    c: [f64; 3],
+    tus_px: f64,
+    abs_err_sum_px: &mut f64,
+) -> f64 {
     let tol = tus_px / fit_slope(pts).atan().cos();
-    let (mut correct, mut abs_err_sum_px) = (0usize, 0.0);
+    let mut correct = 0usize;
     for &[x, y] in pts {
         let e = (eval_parabola(c, y) - x).abs();
-        abs_err_sum_px += e;
+        *abs_err_sum_px += e;
         if e <= tol {
             correct += 1;
         }
     }
-    (correct as f64 / pts.len() as f64, abs_err_sum_px)
+    correct as f64 / pts.len() as f64
 }
 
 /// Score one frame's ego prediction against its labels under `rules`.
@@ -390,8 +395,7 @@ pub fn score_frame(
         }
         t.label_lanes += 1;
         let Some(c) = pred else { continue };
-        let (acc, abs_err_sum_px) = tusimple_lane_accuracy(&pts, c, tus_px);
-        t.abs_err_sum_px += abs_err_sum_px;
+        let acc = tusimple_lane_accuracy(&pts, c, tus_px, &mut t.abs_err_sum_px);
         t.abs_err_points += pts.len() as u64;
         t.tusimple_acc_sum += acc;
         if acc >= rules.tusimple_match_fraction {

@@ -434,8 +434,10 @@ impl TrackerConfig {
         self.init.hough_params().validate().map_err(init_field)?;
         self.init.lane_params().validate().map_err(init_field)?;
         let i = &self.init;
+        // The message names the bound.
+        const _: () = assert!(crate::tracker::MAX_CANDIDATE_LINES == 8);
         check(
-            i.candidate_lines <= 8,
+            i.candidate_lines <= crate::tracker::MAX_CANDIDATE_LINES,
             "init.candidate_lines",
             i.candidate_lines,
             "must be in 0..=8",

@@ -209,9 +209,11 @@ pub struct InitCandidate {
     /// Its support in the choice: the row coverage net of the clutter beside it
     /// (`init.candidate_coverage`), else its Hough votes.
     pub support: f64,
-    /// The side the choice gave it, if any. The lane installed there is this candidate's line
-    /// refitted by least squares, then refined in the windows (`track.refine_passes`), and may
-    /// still be refused by the sanity checks.
+    /// The side the choice gave it, if any. A side without an estimate is then initialised from
+    /// this candidate's line refitted by least squares and refined in the windows
+    /// (`track.refine_passes`), unless the fit or the sanity checks refuse it. `None` on every
+    /// candidate when the choice put a lane still being tracked on the other side (both lanes
+    /// are then left as they were).
     pub chosen: Option<Side>,
 }
 
@@ -392,6 +394,7 @@ impl LaneTracker {
             lane.spans.fill(ColSpan::EMPTY);
             lane.points_now = 0;
         }
+        self.init_candidates.clear();
         self.counters = TrackerCounters::default();
         self.last_failure = [None; 2];
     }
