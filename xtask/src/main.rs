@@ -132,6 +132,11 @@ const STEPS: &[Step] = &[
         run: Run::Cargo(&["test", "--workspace", "--doc", "--all-features"]),
     },
     Step {
+        // The API docs build, every intra-doc link resolving (workspace rustdoc lints: deny).
+        name: "doc",
+        run: Run::Cargo(&["doc", "--workspace", "--no-deps", "--all-features"]),
+    },
+    Step {
         name: "regress",
         run: Run::Xtask(&["regress"]),
     },

@@ -329,7 +329,8 @@ impl<const N: usize, const CAP: usize> AdaptiveQ<N, CAP> {
 /// filter's own process noise over the interval (Q_model = Σ Φ_{k←i} Q_d,i Φ_{k←i}ᵀ, the quantity
 /// Q̂ estimates); at each update it pushes Δx, P_k⁺, P_{k−1}⁺ and Φ_interval to the estimator.
 /// It never changes Q by itself: the caller reads [`AdaptiveKalmanFilter::q_estimate`], converts
-/// it to its per-step Q_d (see [`crate::interval`]) and passes that to the next
+/// it to its per-step Q_d (crate docs; `ins-sd-filter` predicts once per interval and needs no
+/// conversion) and passes that to the next
 /// [`AdaptiveKalmanFilter::predict`] calls.
 #[derive(Debug, Clone)]
 pub struct AdaptiveKalmanFilter<const N: usize, const CAP: usize = DEFAULT_WINDOW_CAPACITY> {

@@ -28,7 +28,7 @@
 //!   the inner one;
 //! - dropping the value `f` returns happens after the count, in the caller.
 //!
-//! The counter is a `const`-initialised thread-local [`Cell`](std::cell::Cell) of a type without a
+//! The counter is a `const`-initialised thread-local [`Cell`] of a type without a
 //! destructor, so touching it from inside the allocator neither allocates nor re-enters the
 //! allocator, and it stays usable while a thread is being torn down. (This relies on the target
 //! having native thread-local storage, as Linux, macOS and Windows do.)

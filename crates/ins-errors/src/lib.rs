@@ -37,7 +37,7 @@
 //!
 //! Paper eq. (7) is the navigation-error equation in vector form (second order in δp), eq. (8)
 //! the ψ equation, eq. (9) the gravity error, eqs. (10)–(14) the state-space form
-//! ẋ = A x + w with A = [[B₉ₓ₉, [0; D; 0], [0; 0; −D]], [0], [0]] (D = D_p^b = C̃_b^n). Written
+//! `ẋ = A x + w` with `A = [[B₉ₓ₉, [0; D; 0], [0; 0; −D]], [0], [0]]` (D = D_p^b = C̃_b^n). Written
 //! as first-order equations in the computed frame c (see [`error_model`] for the derivation):
 //!
 //! ```text

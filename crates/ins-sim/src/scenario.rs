@@ -99,7 +99,7 @@ impl Scenario {
         })
     }
 
-    /// The online filter's configuration for `mode` (what [`run`] and `nav-app ins` use).
+    /// The online filter's configuration for `mode` (what [`crate::run`] and `nav-app ins` use).
     pub fn online_filter_config(&self, mode: Mode) -> ins_sd_filter::InsSdFilterConfig {
         engine::online_config(self, mode)
     }
@@ -263,7 +263,7 @@ impl Scenario {
         self.trajectory.end_time_s
     }
 
-    /// Length of the `out` buffer of [`run`]: duration + 1 records (t = 0, 1, …, duration).
+    /// Length of the `out` buffer of [`crate::run`]: duration + 1 records (t = 0, 1, …, duration).
     pub fn samples_per_run(&self) -> usize {
         self.trajectory.end_time_s.round().max(0.0) as usize + 1
     }

@@ -524,7 +524,7 @@ impl lane_io::FrameSource for SceneSource {
 /// fixtures` writes, so tests render their inputs instead of reading committed copies.
 ///
 /// # Errors
-/// [`EvalError::Io`] when `out` refuses a write (`name` in the message).
+/// [`crate::EvalError::Io`] when `out` refuses a write (`name` in the message).
 pub fn write_scene_y4m<W: std::io::Write>(
     spec: SceneSpec,
     width: usize,

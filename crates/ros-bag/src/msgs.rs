@@ -170,7 +170,7 @@ impl<'a> Imu<'a> {
         })
     }
 
-    /// Encodes as CDR (little endian; orientation unknown: zeros with covariance[0] = −1, as
+    /// Encodes as CDR (little endian; orientation unknown: zeros with `covariance[0] = −1`, as
     /// REP 145 says).
     pub fn encode(&self) -> Vec<u8> {
         let mut w = CdrWriter::new();

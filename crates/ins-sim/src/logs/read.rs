@@ -348,7 +348,7 @@ pub fn read_truth(path: &Path) -> Result<Vec<(f64, NavState)>, SimError> {
     Ok(out)
 }
 
-/// Reads a solution file written by [`replay`] or [`export_run`]: (t, state) per row.
+/// Reads a solution file written by [`super::replay`] or [`super::export_run`]: (t, state) per row.
 ///
 /// # Errors
 /// As [`read_truth`].

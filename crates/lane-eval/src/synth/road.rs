@@ -11,7 +11,7 @@
 //! Above the horizon: a plain wall. Gaussian sensor noise (seeded ChaCha8).
 //!
 //! The truth of each frame is the [`EgoGeometry`] the renderer was given, so the tracker's
-//! metric output ([`crate::camera::CameraModel::ego_lane`]) can be scored against it directly.
+//! metric output ([`lane_tracker::camera::CameraModel::ego_lane`]) can be scored against it directly.
 
 use lane_geometry::{ArcRoad, EgoGeometry, PinholeCamera};
 use rand::SeedableRng;

@@ -155,7 +155,7 @@ struct Lane {
     misses: u32,
     points: Vec<(f32, f32)>,
     /// Relative precision `1/v` of each point of `points` after a tracking update
-    /// ([`mark_centre`]).
+    /// (`points::mark_centre`).
     weights: Vec<f64>,
     spans: Vec<ColSpan>,
     rows: [f64; 2],

@@ -81,6 +81,10 @@
 //! 5 the run finished but frames of the input were lost (`lost_frames > 0`). Of `ins` and
 //! `monte-carlo`: 0 success, 1 error (named file, line, option or run), 2 bad command line.
 
+// The argument structs' doc comments are the `--help` text clap prints verbatim
+// (`[default: OUT_ROOT/<config>-…]`, `[[landmarks]]`), not rustdoc markup.
+#![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
+
 use std::process::ExitCode;
 
 mod ins;
