@@ -89,6 +89,7 @@ pub fn census_set(
         set,
         cfg,
         estimator,
+        frames.end,
         |position, labels, tracker, report| {
             if !frames.contains(&position) {
                 return;

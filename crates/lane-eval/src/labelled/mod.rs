@@ -442,19 +442,21 @@ pub fn track_label_set(
     estimator: Estimator,
 ) -> Result<Vec<EgoPrediction>, EvalError> {
     let mut out = Vec::with_capacity(set.frames.len());
-    run_label_set(dir, set, cfg, estimator, |_, _, _, r| {
+    run_label_set(dir, set, cfg, estimator, set.frames.len(), |_, _, _, r| {
         out.push([r.lanes[0].coeffs, r.lanes[1].coeffs]);
     })?;
     Ok(out)
 }
 
-/// Run a tracker over a labelled set, clip by clip (reset at the start of every clip), calling
-/// `on_frame(position in the set, labels, tracker, report)` after every frame, in set order.
+/// Run a tracker over the frames of a labelled set before position `until`, clip by clip (reset
+/// at the start of every clip), calling `on_frame(position in the set, labels, tracker, report)`
+/// after every frame, in set order.
 fn run_label_set(
     dir: &Path,
     set: &LabelSet,
     cfg: &TrackerConfig,
     estimator: Estimator,
+    until: usize,
     mut on_frame: impl FnMut(usize, &LabelFrame, &LaneTracker, &TrackReport),
 ) -> Result<(), EvalError> {
     let mut tracker = LaneTracker::new(cfg, estimator, set.width, set.height)?;
@@ -463,6 +465,9 @@ fn run_label_set(
     for clip in set.clips() {
         tracker.reset();
         for f in clip {
+            if position >= until {
+                return Ok(());
+            }
             let path = LabelSet::frame_path(dir, f);
             lane_io::sources::decode_image_file(&path, &mut frame)?;
             if (frame.width(), frame.height()) != (set.width, set.height) {
