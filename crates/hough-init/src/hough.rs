@@ -106,6 +106,15 @@ impl core::fmt::Debug for HoughWorkspace {
     }
 }
 
+/// The ρ bin of the centred point `(x, y)` for a θ bin with `c = cos θ/Δρ`, `s = sin θ/Δρ`:
+/// `round(x·c + y·s + offset)`, `offset` the bin of ρ = 0. Rounded to nearest by the float-magic
+/// trick (branch-free, vectorises): for 0 ≤ v < 2²², the low mantissa bits of v + 1.5·2²³ are
+/// round(v). The same rounding for every vote, plain or oriented.
+#[inline(always)]
+fn rho_bin(x: f32, y: f32, c: f32, s: f32, offset: f32) -> u32 {
+    (x * c + y * s + offset + ROUND_MAGIC).to_bits() & 0x003F_FFFF
+}
+
 /// The separations of [`HoughWorkspace::find_lines`]: finite and ≥ 0.
 fn check_separation(sep_theta_deg: f64, sep_rho_px: f64) -> Result<(), HoughError> {
     for (field, value) in [("sep_theta_deg", sep_theta_deg), ("sep_rho_px", sep_rho_px)] {
@@ -279,13 +288,14 @@ impl HoughWorkspace {
     /// [`Self::find_lines`] with an **orientation-restricted vote** (an addition beyond the
     /// paper): each point votes only in the θ bins within `⌊tolerance_deg/Δθ⌋` bins of the bin
     /// nearest its own edge normal [`OrientedPoint::normal_deg`] (about `±tolerance_deg`, to half
-    /// a bin; θ taken modulo 180°), instead of in every bin of the band. A straight mark's edge pixels share its normal and keep all their votes; the
-    /// pixels of texture, of the jagged border of a mat or of a blob point every way and
-    /// spread their votes over other lines, so a long mark stands out of clutter that would
-    /// outvote it in the plain transform. With `tolerance_deg ≥ 90` every point votes in every
-    /// bin of the band and the accumulator, hence the lines, equal [`Self::find_lines`]'s
-    /// (tested, also with a θ step that does not divide 180°). The per-pixel Sobel angle spreads by several degrees about the true one, so
-    /// the tolerance should not be much below ~10°.
+    /// a bin; θ taken modulo 180°), instead of in every bin of the band. A straight mark's edge
+    /// pixels share its normal and keep all their votes; the pixels of texture, of the jagged
+    /// border of a mat or of a blob point every way and spread their votes over other lines, so
+    /// a long mark stands out of clutter that would outvote it in the plain transform. With
+    /// `tolerance_deg ≥ 90` every point votes in every bin of the band and the accumulator, hence
+    /// the lines, equal [`Self::find_lines`]'s (tested, also with a θ step that does not divide
+    /// 180°). The per-pixel Sobel angle spreads by several degrees about the true one, so the
+    /// tolerance should not be much below ~10°.
     ///
     /// Each point casts [`OrientedPoint::votes`] votes per bin (in the accumulator, the same as
     /// repeating it; the minimum of two points counts points).
@@ -500,15 +510,13 @@ impl HoughWorkspace {
                 let c = self.cos_over_step[k];
                 let s = self.sin_over_step[k];
                 for ((j, &x), &y) in idx[..m].iter_mut().zip(&xs[..m]).zip(&ys[..m]) {
-                    // Round to nearest by the float-magic trick (branch-free, vectorises):
-                    // for 0 ≤ v < 2²², the low mantissa bits of v + 1.5·2²³ are round(v).
-                    *j = (x * c + y * s + offset + ROUND_MAGIC).to_bits() & 0x003F_FFFF;
+                    *j = rho_bin(x, y, c, s, offset);
                 }
                 let row = &mut self.acc[k * nr..(k + 1) * nr];
                 for &j in &idx[..m] {
                     // In range by construction; `get_mut` keeps a bad index from panicking.
                     // No overflow: a cell gets at most one vote per point per call and
-                    // `find_line` rejects more than u32::MAX points.
+                    // `check_count` rejects more than `MAX_VOTES` points.
                     if let Some(cell) = row.get_mut(j as usize) {
                         *cell += 1;
                     }
@@ -562,8 +570,7 @@ impl HoughWorkspace {
                 }
                 for k in a as usize..=b as usize {
                     let (c, s) = (self.cos_over_step[k], self.sin_over_step[k]);
-                    let r =
-                        ((x * c + y * s + offset + ROUND_MAGIC).to_bits() & 0x003F_FFFF) as usize;
+                    let r = rho_bin(x, y, c, s, offset) as usize;
                     // In range by construction (as in `vote`); a bad index is skipped, never
                     // spilled into the next θ row.
                     if r < nr
