@@ -76,7 +76,7 @@ const BLOCK: usize = 16;
 /// (`a b c / d · f / g h k`, row by row). `|gx|, |gy| <= 1020`, so `|gx| + |gy| <= 2040` fits
 /// `i16`.
 #[inline(always)]
-pub(crate) fn sobel(neighbours: [u8; 8]) -> (i16, i16) {
+fn sobel(neighbours: [u8; 8]) -> (i16, i16) {
     let [a, b, c, d, f, g, h, k] = neighbours.map(i16::from);
     let gx = (c - a) + 2 * (f - d) + (k - g);
     let gy = (g + 2 * h + k) - (a + 2 * b + c);
