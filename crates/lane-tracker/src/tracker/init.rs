@@ -121,7 +121,6 @@ impl LaneTracker {
         let mut chords = [Chord::default(); 2 * MAX_LINES + 1];
         let mut found = [none; MAX_LINES];
         let mut m = 0;
-        self.init_candidates.clear();
         for k in 0..2 {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
             self.fill_candidates(class);
@@ -153,37 +152,33 @@ impl LaneTracker {
                 continue;
             };
             for line in &found[..count] {
-                let (chord, coeffs) = if self.cfg.init.candidate_coverage {
+                // The candidate as a curve x(y): its LS parabola, or the Hough line itself.
+                let (p, support) = if self.cfg.init.candidate_coverage {
                     let Some(p) = self.row_fit(line) else {
                         continue;
                     };
-                    let chord = Chord {
-                        col_top_px: p.col_at_row(yt),
-                        col_bottom_px: p.col_at_row(yb),
-                        support: self.row_coverage(&p),
-                    };
-                    (chord, [p.a1, p.a2, p.a3])
+                    (p, self.row_coverage(&p))
                 } else {
-                    let (Some(x0), Some(x1), Some(xt), Some(xb)) = (
-                        line.col_at_row(0.0),
-                        line.col_at_row(1.0),
-                        line.col_at_row(yt),
-                        line.col_at_row(yb),
-                    ) else {
+                    let (Some(x0), Some(x1)) = (line.col_at_row(0.0), line.col_at_row(1.0)) else {
                         continue;
                     };
-                    let chord = Chord {
-                        col_top_px: xt,
-                        col_bottom_px: xb,
-                        support: f64::from(line.votes),
+                    let p = Parabola {
+                        a1: 0.0,
+                        a2: x1 - x0,
+                        a3: x0,
                     };
-                    (chord, [0.0, x1 - x0, x0])
+                    (p, f64::from(line.votes))
+                };
+                let chord = Chord {
+                    col_top_px: p.col_at_row(yt),
+                    col_bottom_px: p.col_at_row(yb),
+                    support,
                 };
                 // Within capacity: at most MAX_LINES per band.
                 self.init_candidates.push(InitCandidate {
                     band: self.lanes[k].side,
-                    coeffs,
-                    support: chord.support,
+                    coeffs: [p.a1, p.a2, p.a3],
+                    support,
                     chosen: None,
                 });
                 lines[m] = *line;
