@@ -102,6 +102,33 @@ fn tracking_frame(c: &mut Criterion) {
                 black_box(tracker.track(black_box(frame)).unwrap())
             });
         });
+        // The worst initialisation frame of the default: the right half of the ROI blanked, so
+        // that the right side is searched for again over the taller rows
+        // (`roi.fallback_top_row_fraction`).
+        let (top, bottom) = tracker.roi_rows();
+        let mut one_side = frame.clone();
+        let w = one_side.width();
+        let fill = one_side.data()[top * w];
+        for row in one_side.data_mut()[top * w..bottom * w].chunks_mut(w) {
+            row[w / 2..].fill(fill);
+        }
+        tracker.reset();
+        let r = tracker.track(&one_side).unwrap();
+        println!(
+            "{name}, right half of the ROI blanked: {} candidates, right lane {:?} on rows {:?} (ROI from row {top})",
+            tracker.init_candidates().len(),
+            r.lanes[1].state,
+            r.lanes[1].rows
+        );
+        group.bench_function(
+            BenchmarkId::new("init_frame_default_second_search", name),
+            |b| {
+                b.iter(|| {
+                    tracker.reset();
+                    black_box(tracker.track(black_box(&one_side)).unwrap())
+                });
+            },
+        );
     }
     group.finish();
 }

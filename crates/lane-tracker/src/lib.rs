@@ -139,7 +139,17 @@
 //!   of objects crossing the window at another angle do not, so a band of rows the mark has left
 //!   no longer holds enough pixels to pin the lane where it was (the noisy rendered scene, σ = 8:
 //!   0.71 px mean error with the gate, 3.02 px without it; printed by
-//!   `cargo test -p lane-eval --test tracking every_synthetic -- --nocapture`).
+//!   `cargo test -p lane-eval --test tracking every_synthetic -- --nocapture`);
+//! - **searches again over taller rows** (`roi.fallback_top_row_fraction`): a side still
+//!   without a lane after the initialisation in the ROI is looked for over the rows from that
+//!   fraction of the height down (gradient, candidates, coverage and choice as above, the side
+//!   found in the ROI kept in the pair as a tracked lane is; the lane is refined over the same
+//!   rows). A dashed mark whose near field falls in the gap between two dashes, or a camera
+//!   tilted down so that a mark is visible only far ahead, is then found where it is. A fit
+//!   whose pixels all lie above the ROI starts as its chord over its rows, `x = a2·y + a3`: it
+//!   is extrapolated down over the ROI, and a short far segment fixes a slope, not a curvature.
+//!   The second search costs a second gradient, vote and choice, on the frames that need it
+//!   only.
 //!
 //! Measured on the labelled real sets (`cargo xtask eval-lanes`, `../shared/data/lanes`: 377
 //! stills in four sets, two road, two indoor; tuned on the development part only), TuSimple

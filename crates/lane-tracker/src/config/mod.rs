@@ -69,6 +69,15 @@ pub struct RoiConfig {
     pub top_row_fraction: f64,
     /// One past the last ROI row as a fraction of the height (1 = down to the bottom row), in (top, 1].
     pub bottom_row_fraction: f64,
+    /// Beyond the paper: a side still without a lane after the initialisation in the ROI is
+    /// looked for again from this fraction of the height down to `bottom_row_fraction`
+    /// (gradient, Hough candidates and choice over the taller region, the side found in the ROI
+    /// kept in the pair): a dashed mark whose near field falls in a gap between dashes, or a
+    /// camera looking down with the road's far part above the ROI. Its windowed refinement runs
+    /// over the same rows. Dimensionless in `[0, top_row_fraction)`; absent (the default when
+    /// absent) = no second search.
+    #[serde(default)]
+    pub fallback_top_row_fraction: Option<f64>,
 }
 
 /// Stage II: Hough + least-squares (re-)initialisation (see the `hough-init` crate). The ranges
@@ -505,6 +514,14 @@ impl TrackerConfig {
             r.bottom_row_fraction,
             "must be in (top_row_fraction, 1]",
         )?;
+        if let Some(f) = r.fallback_top_row_fraction {
+            check(
+                (0.0..r.top_row_fraction).contains(&f),
+                "roi.fallback_top_row_fraction",
+                f,
+                "must be in [0, top_row_fraction)",
+            )?;
+        }
         let t = &self.track;
         check(
             (1..=200).contains(&t.window_half_width_px),
@@ -623,6 +640,16 @@ impl TrackerConfig {
         let bottom = ((self.roi.bottom_row_fraction * height_px as f64).ceil() as usize)
             .clamp(top + 3, height_px.max(top + 3));
         (top, bottom.min(height_px))
+    }
+
+    /// The rows `[top, bottom)` of the second search (`roi.fallback_top_row_fraction`) for an
+    /// image `height_px` rows high: from that fraction of the height down to the ROI's bottom,
+    /// never starting below the ROI's top. `None` without a second search.
+    pub fn fallback_roi_rows(&self, height_px: usize) -> Option<(usize, usize)> {
+        let (top, bottom) = self.roi_rows(height_px);
+        self.roi
+            .fallback_top_row_fraction
+            .map(|f| (((f * height_px as f64).floor() as usize).min(top), bottom))
     }
 }
 

@@ -79,6 +79,15 @@ fn each_out_of_range_field_is_named() {
         ("roi.bottom_row_fraction", |c| {
             c.roi.bottom_row_fraction = 0.1
         }),
+        ("roi.fallback_top_row_fraction", |c| {
+            c.roi.fallback_top_row_fraction = Some(c.roi.top_row_fraction)
+        }),
+        ("roi.fallback_top_row_fraction", |c| {
+            c.roi.fallback_top_row_fraction = Some(-0.1)
+        }),
+        ("roi.fallback_top_row_fraction", |c| {
+            c.roi.fallback_top_row_fraction = Some(f64::NAN)
+        }),
         ("init.theta_step_deg", |c| c.init.theta_step_deg = 0.0),
         ("init.rho_step_px", |c| c.init.rho_step_px = 51.0),
         ("init.band_half_width_px", |c| {
@@ -209,4 +218,26 @@ fn roi_rows_follow_the_fractions_and_stay_inside_tiny_images() {
     assert_eq!(cfg.roi_rows(240), (120, 240));
     let (t, b) = cfg.roi_rows(4);
     assert!(t < b && b <= 4 && b - t >= 3, "{t}..{b}");
+}
+
+#[test]
+fn the_second_search_rows_run_from_their_fraction_to_the_roi_bottom_and_are_off_when_absent() {
+    let mut cfg = TrackerConfig::outdoor().unwrap();
+    assert_eq!(
+        cfg.roi.fallback_top_row_fraction, None,
+        "absent in the file: no second search"
+    );
+    assert_eq!(cfg.fallback_roi_rows(240), None);
+    cfg.roi.top_row_fraction = 0.5;
+    cfg.roi.bottom_row_fraction = 0.9;
+    cfg.roi.fallback_top_row_fraction = Some(0.25);
+    cfg.validate().unwrap();
+    assert_eq!(cfg.roi_rows(240), (120, 216));
+    assert_eq!(cfg.fallback_roi_rows(240), Some((60, 216)));
+    let default = TrackerConfig::default_preset().unwrap();
+    let (top, bottom) = default.roi_rows(240);
+    let (tall_top, tall_bottom) = default
+        .fallback_roi_rows(240)
+        .expect("the default searches again");
+    assert!(tall_top < top && tall_bottom == bottom);
 }

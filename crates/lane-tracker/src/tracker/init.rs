@@ -14,7 +14,9 @@ use vision_gradient::{
 };
 
 use super::points::fit_profile;
-use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, MAX_CANDIDATE_LINES};
+use super::{
+    Estimator, InitCandidate, Lane, LaneFilter, LaneState, LaneTracker, MAX_CANDIDATE_LINES,
+};
 use crate::TrackerError;
 use crate::error::FilterFailure;
 use crate::wrls_lane::WrlsLane;
@@ -24,7 +26,29 @@ use crate::wrls_lane::WrlsLane;
 const BACKGROUND_SHIFT_BANDS: f64 = 3.0;
 
 impl LaneTracker {
+    /// Initialise the sides without an estimate in the ROI, then, with
+    /// `roi.fallback_top_row_fraction`, a side still without one over the taller rows (the
+    /// side found first kept in the pair, as a tracked one is).
     pub(super) fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
+        self.initialise_in_roi(image)?;
+        let Some(tall) = self.fallback_roi else {
+            return Ok(());
+        };
+        if self.lanes.iter().all(Lane::has_estimate) {
+            return Ok(());
+        }
+        let without = [!self.lanes[0].has_estimate(), !self.lanes[1].has_estimate()];
+        let roi = std::mem::replace(&mut self.roi, tall);
+        let searched = self.initialise_in_roi(image);
+        self.roi = roi;
+        for (lane, was_without) in self.lanes.iter_mut().zip(without) {
+            lane.found_in_fallback = was_without && lane.initialised_now;
+        }
+        searched
+    }
+
+    /// Stages I–II over the rows `self.roi`.
+    fn initialise_in_roi(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
         let outward = self.outward_col();
         let (top, bottom) = self.roi;
         self.detector.detect(
@@ -121,6 +145,8 @@ impl LaneTracker {
         let mut chords = [Chord::default(); 2 * MAX_LINES + 1];
         let mut found = [none; MAX_LINES];
         let mut m = 0;
+        // This search's candidates follow those of an earlier search on the same frame.
+        let first = self.init_candidates.len();
         for k in 0..2 {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
             self.fill_candidates(class);
@@ -174,7 +200,7 @@ impl LaneTracker {
                     col_bottom_px: p.col_at_row(yb),
                     support,
                 };
-                // Within capacity: at most MAX_LINES per band.
+                // Within capacity: at most MAX_LINES per band, two searches a frame.
                 self.init_candidates.push(InitCandidate {
                     band: self.lanes[k].side,
                     coeffs: [p.a1, p.a2, p.a3],
@@ -215,9 +241,9 @@ impl LaneTracker {
         }
         for (i, pick) in [choice.left, choice.right].into_iter().enumerate() {
             let Some(j) = pick else { continue };
-            // `init_candidates` holds the first `m` chords in order (a tracked lane's chord,
-            // appended after them, is not a candidate).
-            if let Some(c) = self.init_candidates.get_mut(j) {
+            // `init_candidates[first..]` holds the first `m` chords in order (a tracked lane's
+            // chord, appended after them, is not a candidate).
+            if let Some(c) = self.init_candidates.get_mut(first + j) {
                 c.chosen = Some(self.lanes[i].side);
             }
             if locked.is_some_and(|(l, _)| l == j) || self.lanes[i].has_estimate() {
@@ -451,7 +477,22 @@ impl LaneTracker {
         if span_rows < min_span || !x_bottom.is_finite() || x_bottom < -w || x_bottom > 2.0 * w {
             return false;
         }
-        let theta = Vector3::new(init.parabola.a1, init.parabola.a2, init.parabola.a3);
+        // A fit whose pixels all lie above the ROI (only the second search finds one) is
+        // extrapolated down over the ROI's rows: a short far segment sets its slope, not its
+        // curvature. It starts as its chord over its rows (the refinement may bend it again).
+        let (y0, y1) = init.rows_px;
+        let p = if y1 < self.cfg.roi_rows(self.height).0 as f64 && y1 > y0 {
+            let (x0, x1) = (init.parabola.col_at_row(y0), init.parabola.col_at_row(y1));
+            let slope = (x1 - x0) / (y1 - y0);
+            Parabola {
+                a1: 0.0,
+                a2: slope,
+                a3: x0 - slope * y0,
+            }
+        } else {
+            init.parabola
+        };
+        let theta = Vector3::new(p.a1, p.a2, p.a3);
         let filter = match self.estimator {
             Estimator::Kif => ParabolaKif::new(&theta, &self.p0, self.row_norm)
                 .map(LaneFilter::Kif)

@@ -163,6 +163,9 @@ struct Lane {
     fit: FitRows,
     points_now: usize,
     initialised_now: bool,
+    /// Initialised on this frame by the second search (`roi.fallback_top_row_fraction`): its
+    /// refinement runs over the taller rows.
+    found_in_fallback: bool,
     updated_now: bool,
     fresh: bool,
 }
@@ -238,6 +241,8 @@ pub struct LaneTracker {
     width: usize,
     height: usize,
     roi: (usize, usize),
+    /// The rows of the second search (`roi.fallback_top_row_fraction`), if any.
+    fallback_roi: Option<(usize, usize)>,
     detector: GradientDetector,
     edges: EdgeBuffer,
     /// The edge pixels that pair into bright stripes (`gradient.stripe_paired_votes`).
@@ -262,8 +267,8 @@ pub struct LaneTracker {
     q: ProcessNoise<3>,
     p0: ThetaCov,
     lanes: [Lane; 2],
-    /// The candidates of the last frame's joint initialisation (capacity
-    /// `2 · MAX_CANDIDATE_LINES`, never exceeded); empty on a frame without one.
+    /// The candidates of the last frame's joint initialisation, then those of its second search
+    /// (capacity `4 · MAX_CANDIDATE_LINES`, never exceeded); empty on a frame without one.
     init_candidates: Vec<InitCandidate>,
     counters: TrackerCounters,
     /// The last filter failure per lane (left, right), kept typed without allocating.
@@ -284,7 +289,9 @@ impl LaneTracker {
         }
         let detector = GradientDetector::new(cfg.gradient.params())?;
         let roi = cfg.roi_rows(height);
-        let capacity = width * (roi.1 - roi.0);
+        let fallback_roi = cfg.fallback_roi_rows(height);
+        // The buffers hold the pixels of the tallest region searched.
+        let capacity = width * (roi.1 - fallback_roi.map_or(roi.0, |r| r.0));
         let hough = HoughWorkspace::new(width, height, cfg.init.hough_params())?;
         let init_params = cfg.init.lane_params();
         init_params.validate()?;
@@ -313,6 +320,7 @@ impl LaneTracker {
             fit: FitRows::uniform(0.0, 0.0),
             points_now: 0,
             initialised_now: false,
+            found_in_fallback: false,
             updated_now: false,
             fresh: false,
         };
@@ -329,6 +337,7 @@ impl LaneTracker {
             width,
             height,
             roi,
+            fallback_roi,
             detector,
             edges: EdgeBuffer::with_capacity(capacity),
             paired: EdgeBuffer::with_capacity(capacity),
@@ -351,7 +360,7 @@ impl LaneTracker {
             q,
             p0,
             lanes,
-            init_candidates: Vec::with_capacity(2 * MAX_CANDIDATE_LINES),
+            init_candidates: Vec::with_capacity(4 * MAX_CANDIDATE_LINES),
             counters: TrackerCounters::default(),
             last_failure: [None; 2],
         })
@@ -488,6 +497,7 @@ impl LaneTracker {
         for i in 0..2 {
             let lane = &mut self.lanes[i];
             lane.initialised_now = false;
+            lane.found_in_fallback = false;
             lane.updated_now = false;
             lane.points_now = 0;
             if lane.has_estimate() {
@@ -504,9 +514,21 @@ impl LaneTracker {
             // LS parabola, with the window's outlier rejection (the Hough band keeps clutter).
             for i in 0..2 {
                 if self.lanes[i].initialised_now {
-                    for _ in 0..self.cfg.track.refine_passes.max(1) {
-                        self.track_lane(i, &image, false)?;
+                    // A lane the second search found is refined over the rows it was found in.
+                    let roi = self.roi;
+                    if let (true, Some(tall)) = (self.lanes[i].found_in_fallback, self.fallback_roi)
+                    {
+                        self.roi = tall;
                     }
+                    let mut refined = Ok(());
+                    for _ in 0..self.cfg.track.refine_passes.max(1) {
+                        refined = self.track_lane(i, &image, false);
+                        if refined.is_err() {
+                            break;
+                        }
+                    }
+                    self.roi = roi;
+                    refined?;
                     let lane = &mut self.lanes[i];
                     if lane.state != LaneState::Tracking {
                         // The refinement missed: keep the LS initialisation as it was.

@@ -62,7 +62,9 @@ fn a_refused_kif_update_is_counted_kept_typed_and_does_not_allocate() {
 
 #[test]
 fn a_refused_wrls_set_up_is_counted_and_kept_typed() {
-    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut cfg = TrackerConfig::default_preset().expect("the default preset");
+    // One initialisation a side on this frame (no second search).
+    cfg.roi.fallback_top_row_fraction = None;
     let frame = two_marks(320, 240);
     let mut tracker = LaneTracker::new(&cfg, Estimator::Wrls, 320, 240).expect("a tracker");
     // A forgetting factor no validated configuration holds: WRLS refuses to start.
@@ -188,4 +190,68 @@ fn the_joint_initialisation_reports_its_candidates_and_the_chosen_pair() {
         );
         assert_eq!(allocations, 0, "a joint initialisation allocated");
     }
+}
+
+/// Two bright marks 5 px wide on a dark floor, their vanishing point above the image, the right
+/// one painted only on rows 80..140, above the default ROI (from row 148 at 240 rows): a dash
+/// whose near field falls in the gap before the next one.
+fn left(y: f64) -> f64 {
+    60.0 - 0.3 * (y - 239.0)
+}
+fn right(y: f64) -> f64 {
+    260.0 + 0.3 * (y - 239.0)
+}
+fn right_mark_above_the_roi(w: usize, h: usize) -> GreyFrame {
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if (x - left(y)).abs() < 2.5 || ((x - right(y)).abs() < 2.5 && (80.0..140.0).contains(&y)) {
+            *p = 200;
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn a_side_missing_from_the_roi_is_found_by_the_second_search_over_the_taller_rows() {
+    let frame = right_mark_above_the_roi(320, 240);
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut roi_only = cfg;
+    roi_only.roi.fallback_top_row_fraction = None;
+    let mut plain = LaneTracker::new(&roi_only, Estimator::Kif, 320, 240).expect("a tracker");
+    let without = plain.track(&frame).expect("a frame");
+    assert!(without.lanes[0].coeffs.is_some());
+    assert_eq!(without.lanes[1].coeffs, None, "no right mark in the ROI");
+    let first_search = plain.init_candidates().len();
+
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, _) = tracker.roi;
+    assert!(
+        tracker
+            .fallback_roi
+            .is_some_and(|(t, _)| t < 80 && top > 140)
+    );
+    let (report, allocations) = allocations_in(|| tracker.track(&frame));
+    let report = report.expect("a frame");
+    assert_eq!(allocations, 0, "the second search allocated");
+    // The side found in the ROI is the same lane, untouched by the second search.
+    assert_eq!(report.lanes[0].coeffs, without.lanes[0].coeffs);
+    let r = report.lanes[1];
+    assert!(r.initialised && r.state == LaneState::Tracking);
+    for y in [80.0, 110.0, 139.0] {
+        let err = (r.col_at_row(y).expect("a right lane") - right(y)).abs();
+        assert!(err < 1.5, "row {y}: {err} px off the right mark");
+    }
+    // Extrapolated 100 rows below the dash's 60.
+    let err = (r.col_at_row(239.0).expect("a right lane") - right(239.0)).abs();
+    assert!(err < 8.0, "bottom row: {err} px off the right mark's line");
+    assert!(r.rows[1] < 140.0, "its points are the dash's: {:?}", r.rows);
+    // Both searches' candidates are reported; the right one chosen is the second search's.
+    let cands = tracker.init_candidates();
+    assert!(cands.len() > first_search, "{cands:?}");
+    let chosen: Vec<usize> = (0..cands.len())
+        .filter(|&j| cands[j].chosen == Some(Side::Right))
+        .collect();
+    assert_eq!(chosen.len(), 1, "{cands:?}");
+    assert!(chosen[0] >= first_search, "{cands:?}");
 }
