@@ -91,6 +91,11 @@ pub struct HoughWorkspace {
     acc: Vec<u32>,
     /// Three rows of ρ-direction 3-sums (ring buffer) and one zero row, for the 3×3 smoothing.
     ring: Vec<u32>,
+    /// The 3×3-smoothed votes of the band being searched for several peaks, θ-major like
+    /// `acc` (`take_peaks`).
+    smoothed: Vec<u32>,
+    /// Per θ bin of `smoothed`: its first largest value and that value's ρ bin.
+    row_best: Vec<(u32, usize)>,
 }
 
 impl core::fmt::Debug for HoughWorkspace {
@@ -186,6 +191,8 @@ impl HoughWorkspace {
             sin_over_step,
             acc: vec![0; cells],
             ring: vec![0; 4 * rho_bins],
+            smoothed: vec![0; cells],
+            row_best: vec![(0, 0); theta_bins],
         })
     }
 
@@ -358,21 +365,78 @@ impl HoughWorkspace {
         let dk = (sep_theta_deg / self.params.theta_step_deg).round() as usize;
         let dr = (sep_rho_px / self.params.rho_step_px).round() as usize;
         let nr = self.rho_bins;
+        let smoothing = self.params.peak_smoothing;
+        if smoothing {
+            for k in k0..=k1 {
+                self.smooth_row(k, k0, k1);
+            }
+        }
         let mut n = 0;
         for slot in out.iter_mut() {
-            let (k, r) = self.peak(k0, k1);
+            let (k, r) = if smoothing {
+                self.peak_of_rows(k0, k1)
+            } else {
+                self.peak_raw(k0, k1)
+            };
             if self.score(k, r, k0, k1) <= 0.0 {
                 break;
             }
             *slot = self.refined_line(k, r, k0, k1);
             n += 1;
-            for kk in k.saturating_sub(dk).max(k0)..=(k + dk).min(k1) {
+            let (ka, kb) = (k.saturating_sub(dk).max(k0), (k + dk).min(k1));
+            for kk in ka..=kb {
                 let lo = kk * nr + r.saturating_sub(dr);
                 let hi = kk * nr + (r + dr).min(nr - 1);
                 self.acc[lo..=hi].fill(0);
             }
+            // Clearing rows ka..=kb changes the 3×3 sums of one more row on each side only.
+            if smoothing {
+                for kk in ka.saturating_sub(1).max(k0)..=(kb + 1).min(k1) {
+                    self.smooth_row(kk, k0, k1);
+                }
+            }
         }
         n
+    }
+
+    /// Row `k` of `smoothed` (the 3×3 sums of `acc` over the θ bins `k0..=k1`, the bins
+    /// outside the band and beyond the ρ ends counting as zero) and its entry of `row_best`.
+    fn smooth_row(&mut self, k: usize, k0: usize, k1: usize) {
+        let nr = self.rho_bins;
+        let out = &mut self.smoothed[k * nr..(k + 1) * nr];
+        out.fill(0);
+        for kk in k.saturating_sub(1).max(k0)..=(k + 1).min(k1) {
+            let src = &self.acc[kk * nr..(kk + 1) * nr];
+            if nr < 2 {
+                out[0] += src[0];
+                continue;
+            }
+            out[0] += src[0] + src[1];
+            for (d, w) in out[1..nr - 1].iter_mut().zip(src.windows(3)) {
+                *d += w[0] + w[1] + w[2];
+            }
+            out[nr - 1] += src[nr - 2] + src[nr - 1];
+        }
+        let mut best = (0u32, 0usize);
+        for (r, &v) in out.iter().enumerate() {
+            if v > best.0 {
+                best = (v, r);
+            }
+        }
+        self.row_best[k] = best;
+    }
+
+    /// The first largest cell of `smoothed` over the θ bins `k0..=k1` in scan order (θ, then
+    /// ρ), from `row_best`: the cell `peak_smoothed` finds.
+    fn peak_of_rows(&self, k0: usize, k1: usize) -> (usize, usize) {
+        let mut best = (0u32, k0, 0usize);
+        for k in k0..=k1 {
+            let (v, r) = self.row_best[k];
+            if v > best.0 {
+                best = (v, k, r);
+            }
+        }
+        (best.1, best.2)
     }
 
     /// Validate the points and their number (2 ..= `MAX_VOTES`): the checks of every vote.
@@ -758,6 +822,77 @@ mod tests {
                     fast,
                     naive_peak(&ws, k0, k1),
                     "band {k0}..={k1}, smoothing {smoothing}"
+                );
+            }
+        }
+    }
+
+    /// The peaks `take_peaks` takes from its smoothed rows, updated only where a suppression
+    /// changed them, are those of a brute-force argmax of `score` over the whole band after
+    /// every suppression, in the same order, for bands of 1, 2, 3 and many θ bins.
+    #[test]
+    fn incremental_peaks_match_a_brute_force_search_after_every_suppression() {
+        for smoothing in [true, false] {
+            let params = HoughParams {
+                peak_smoothing: smoothing,
+                subbin_refinement: false,
+                ..HoughParams::default()
+            };
+            let mut ws = HoughWorkspace::new(64, 48, params).unwrap();
+            let mut reference = HoughWorkspace::new(64, 48, params).unwrap();
+            let nr = ws.rho_bins;
+            let none = HoughLine {
+                rho_px: 0.0,
+                theta_rad: 0.0,
+                votes: 0,
+            };
+            for (i, (k0, k1)) in [(10, 10), (10, 11), (10, 12), (0, 359), (200, 317)]
+                .into_iter()
+                .enumerate()
+            {
+                fill_votes(&mut ws, k0, k1, 29 + i as u64);
+                // A broad hill: after the suppression of its top the strongest cells lie just
+                // outside the cleared cells, where stale smoothed sums would be wrong.
+                let (kc, rc) = ((k0 + k1) / 2, nr / 2);
+                for k in k0..=k1 {
+                    for r in 0..nr {
+                        let d = k.abs_diff(kc) + r.abs_diff(rc);
+                        ws.acc[k * nr + r] += 400u32.saturating_sub(20 * d as u32);
+                    }
+                }
+                reference.acc.copy_from_slice(&ws.acc);
+                let mut out = [none; 12];
+                let n = ws.take_peaks(k0, k1, 3.0, 4.0, &mut out);
+                let dk = (3.0 / params.theta_step_deg).round() as usize;
+                let dr = (4.0 / params.rho_step_px).round() as usize;
+                let mut expected = Vec::new();
+                while expected.len() < out.len() {
+                    let (k, r) = naive_peak(&reference, k0, k1);
+                    if reference.score(k, r, k0, k1) <= 0.0 {
+                        break;
+                    }
+                    expected.push(reference.refined_line(k, r, k0, k1));
+                    for kk in k.saturating_sub(dk).max(k0)..=(k + dk).min(k1) {
+                        reference.acc
+                            [kk * nr + r.saturating_sub(dr)..=kk * nr + (r + dr).min(nr - 1)]
+                            .fill(0);
+                    }
+                }
+                assert!(n > 1, "band {k0}..={k1}: {n} peaks");
+                assert_eq!(
+                    &out[..n],
+                    &expected[..],
+                    "band {k0}..={k1}, smoothing {smoothing}"
+                );
+                let differing = ws
+                    .acc
+                    .iter()
+                    .zip(&reference.acc)
+                    .filter(|(a, b)| a != b)
+                    .count();
+                assert_eq!(
+                    differing, 0,
+                    "band {k0}..={k1}, smoothing {smoothing}: cells cleared differently"
                 );
             }
         }

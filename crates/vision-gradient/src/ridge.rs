@@ -86,7 +86,11 @@ fn mark(edges: &mut EdgeBuffer, max_width_px: u16, outward_steps_from_col_px: Op
             p.magnitude |= RISE_BIT;
         }
     }
-    // Pass 2: per row run, mark the pixels that have a partner.
+    // Pass 2, per row run, two linear scans (columns increase within a row, so the nearest
+    // pixel of a class and polarity after `j` in the run is the nearest to its right, and the
+    // nearest before it the nearest to its left). Backwards, with the nearest later column per
+    // class and polarity: a rising pixel with a falling partner within `w` to its right bounds
+    // a bright stripe, a falling one with a rising pixel there a dark one.
     let n = px.len();
     let mut start = 0;
     while start < n {
@@ -95,44 +99,51 @@ fn mark(edges: &mut EdgeBuffer, max_width_px: u16, outward_steps_from_col_px: Op
         while end < n && px[end].row_px == row {
             end += 1;
         }
-        for j in start..end {
-            let pj = px[j];
-            let rising = pj.magnitude & RISE_BIT != 0;
-            let partner = if rising {
-                px[j + 1..end]
-                    .iter()
-                    .take_while(|q| usize::from(q.col_px) <= usize::from(pj.col_px) + w)
-                    .any(|q| q.class == pj.class && q.magnitude & RISE_BIT == 0)
+        // Indexed by `EdgeClass as usize` (1, 2).
+        let (mut next_rise, mut next_fall) = ([None::<u16>; 3], [None::<u16>; 3]);
+        for p in px[start..end].iter_mut().rev() {
+            let c = p.class as usize;
+            let rising = p.magnitude & RISE_BIT != 0;
+            let limit = usize::from(p.col_px) + w;
+            let near = |col: Option<u16>| col.is_some_and(|q| usize::from(q) <= limit);
+            if rising {
+                if near(next_fall[c]) {
+                    p.magnitude |= KEEP_BIT;
+                }
+                next_rise[c] = Some(p.col_px);
             } else {
-                px[start..j]
-                    .iter()
-                    .rev()
-                    .take_while(|q| usize::from(q.col_px) + w >= usize::from(pj.col_px))
-                    .any(|q| q.class == pj.class && q.magnitude & RISE_BIT != 0)
-            };
+                if near(next_rise[c]) {
+                    p.magnitude |= DARK_BIT;
+                }
+                next_fall[c] = Some(p.col_px);
+            }
+        }
+        // Forwards, with the nearest earlier column: a falling pixel with a rising partner
+        // within `w` to its left bounds a bright stripe, a rising one with a falling pixel
+        // there a dark one; and the outward steps.
+        let (mut prev_rise, mut prev_fall) = ([None::<u16>; 3], [None::<u16>; 3]);
+        for p in &mut px[start..end] {
+            let c = p.class as usize;
+            let rising = p.magnitude & RISE_BIT != 0;
+            let col = usize::from(p.col_px);
+            let near = |q: Option<u16>| q.is_some_and(|q| usize::from(q) + w >= col);
+            if rising {
+                if near(prev_fall[c]) {
+                    p.magnitude |= DARK_BIT;
+                }
+                prev_rise[c] = Some(p.col_px);
+            } else {
+                if near(prev_rise[c]) {
+                    p.magnitude |= KEEP_BIT;
+                }
+                prev_fall[c] = Some(p.col_px);
+            }
             // An unpaired step whose bright side faces away from the column (a kerb, a road
             // edge: the road is the dark side towards the middle).
-            let outward = outward_steps_from_col_px
-                .is_some_and(|c| (pj.col_px > c && rising) || (pj.col_px < c && !rising));
-            if partner || outward {
-                px[j].magnitude |= KEEP_BIT;
-            }
-            // The sides of a dark stripe: falling with a rising partner on its right, rising
-            // with a falling partner on its left.
-            let dark = if rising {
-                px[start..j]
-                    .iter()
-                    .rev()
-                    .take_while(|q| usize::from(q.col_px) + w >= usize::from(pj.col_px))
-                    .any(|q| q.class == pj.class && q.magnitude & RISE_BIT == 0)
-            } else {
-                px[j + 1..end]
-                    .iter()
-                    .take_while(|q| usize::from(q.col_px) <= usize::from(pj.col_px) + w)
-                    .any(|q| q.class == pj.class && q.magnitude & RISE_BIT != 0)
-            };
-            if dark {
-                px[j].magnitude |= DARK_BIT;
+            if outward_steps_from_col_px
+                .is_some_and(|c| (p.col_px > c && rising) || (p.col_px < c && !rising))
+            {
+                p.magnitude |= KEEP_BIT;
             }
         }
         start = end;
@@ -156,6 +167,119 @@ mod tests {
             }
         }
         data
+    }
+
+    /// The pairing rule read literally, pixel by pixel: for each pixel, scan its row to the
+    /// right (rising) or left (falling) while within `max_width_px` columns for a pixel of its
+    /// class and the opposite polarity (a bright stripe's partner), and the other way for a
+    /// dark stripe's. `mark`'s reference.
+    fn mark_by_scanning(edges: &mut EdgeBuffer, max_width_px: u16, outward: Option<u16>) {
+        let w = usize::from(max_width_px);
+        let px = edges.pixels_mut();
+        for p in px.iter_mut() {
+            p.magnitude &= MAG_MASK;
+            if p.gx > 0 {
+                p.magnitude |= RISE_BIT;
+            }
+        }
+        let n = px.len();
+        for j in 0..n {
+            let pj = px[j];
+            let rising = pj.magnitude & RISE_BIT != 0;
+            let same_row = |q: &crate::EdgePixel| q.row_px == pj.row_px && q.class == pj.class;
+            let right = |want_rising: bool| {
+                px[j + 1..]
+                    .iter()
+                    .take_while(|q| q.row_px == pj.row_px)
+                    .take_while(|q| usize::from(q.col_px) <= usize::from(pj.col_px) + w)
+                    .any(|q| same_row(q) && (q.magnitude & RISE_BIT != 0) == want_rising)
+            };
+            let left = |want_rising: bool| {
+                px[..j]
+                    .iter()
+                    .rev()
+                    .take_while(|q| q.row_px == pj.row_px)
+                    .take_while(|q| usize::from(q.col_px) + w >= usize::from(pj.col_px))
+                    .any(|q| same_row(q) && (q.magnitude & RISE_BIT != 0) == want_rising)
+            };
+            let (bright, dark) = if rising {
+                (right(false), left(false))
+            } else {
+                (left(true), right(true))
+            };
+            let out =
+                outward.is_some_and(|c| (pj.col_px > c && rising) || (pj.col_px < c && !rising));
+            if bright || out {
+                px[j].magnitude |= KEEP_BIT;
+            }
+            if dark {
+                px[j].magnitude |= DARK_BIT;
+            }
+        }
+    }
+
+    /// `mark`'s two linear scans per row flag exactly the pixels the literal scan does, on
+    /// seeded random images (noise, stripes of both polarities and widths, steps), for several
+    /// widths and with and without outward steps.
+    #[test]
+    fn the_linear_pairing_scan_flags_what_the_literal_scan_flags() {
+        let (w, h) = (96usize, 64usize);
+        let det = GradientDetector::new(GradientParams::default()).unwrap();
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut checked = 0;
+        for _ in 0..20 {
+            let mut data = vec![0u8; w * h];
+            for v in &mut data {
+                *v = 60 + (next() % 40) as u8;
+            }
+            for _ in 0..12 {
+                let (x0, width) = ((next() % w as u64) as usize, 1 + (next() % 14) as usize);
+                let (lean, level) = ((next() % 5) as f64 * 0.3 - 0.6, (next() % 200) as u8 + 30);
+                for y in 0..h {
+                    let x = x0 as f64 + lean * y as f64;
+                    for dx in 0..width {
+                        let c = x as i64 + dx as i64;
+                        if (0..w as i64).contains(&c) {
+                            data[y * w + c as usize] = level;
+                        }
+                    }
+                }
+            }
+            let image = GreyImage::new(&data, w, h, w).unwrap();
+            let mut edges = EdgeBuffer::with_capacity(w * h);
+            det.detect(&image, Region::Full, &mut edges, None).unwrap();
+            for (max_width_px, outward) in [(4, None), (12, None), (12, Some(48)), (40, Some(10))] {
+                let mut fast = edges.clone();
+                let mut literal = edges.clone();
+                mark(&mut fast, max_width_px, outward);
+                mark_by_scanning(&mut literal, max_width_px, outward);
+                assert_eq!(
+                    fast.pixels(),
+                    literal.pixels(),
+                    "width {max_width_px}, {outward:?}"
+                );
+                checked += fast
+                    .pixels()
+                    .iter()
+                    .filter(|p| p.magnitude & KEEP_BIT != 0)
+                    .count();
+                checked += fast
+                    .pixels()
+                    .iter()
+                    .filter(|p| p.magnitude & DARK_BIT != 0)
+                    .count();
+            }
+        }
+        assert!(
+            checked > 1000,
+            "too few flagged pixels to compare ({checked})"
+        );
     }
 
     fn run(data: &[u8], max_width_px: u16) -> (usize, usize) {

@@ -30,7 +30,7 @@ impl LaneTracker {
     /// `roi.fallback_top_row_fraction`, a side still without one over the taller rows (the
     /// side found first kept in the pair, as a tracked one is).
     pub(super) fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
-        self.initialise_in_roi(image)?;
+        self.initialise_in_roi(image, [true, true])?;
         let Some(tall) = self.fallback_roi else {
             return Ok(());
         };
@@ -39,7 +39,7 @@ impl LaneTracker {
         }
         let without = [!self.lanes[0].has_estimate(), !self.lanes[1].has_estimate()];
         let roi = std::mem::replace(&mut self.roi, tall);
-        let searched = self.initialise_in_roi(image);
+        let searched = self.initialise_in_roi(image, without);
         self.roi = roi;
         for (lane, was_without) in self.lanes.iter_mut().zip(without) {
             lane.found_in_fallback = was_without && lane.initialised_now;
@@ -47,8 +47,13 @@ impl LaneTracker {
         searched
     }
 
-    /// Stages I–II over the rows `self.roi`.
-    fn initialise_in_roi(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
+    /// Stages I–II over the rows `self.roi`; with the joint initialisation, the Hough candidates
+    /// of the bands `vote[k]` only.
+    fn initialise_in_roi(
+        &mut self,
+        image: &GreyImage<'_>,
+        vote: [bool; 2],
+    ) -> Result<(), TrackerError> {
         let outward = self.outward_col();
         let (top, bottom) = self.roi;
         self.detector.detect(
@@ -75,7 +80,7 @@ impl LaneTracker {
             );
         }
         if self.cfg.init.candidate_lines > 0 {
-            self.initialise_jointly();
+            self.initialise_jointly(vote);
             return Ok(());
         }
         for i in 0..2 {
@@ -130,7 +135,11 @@ impl LaneTracker {
     /// with `init.orientation_tolerance_deg > 0`), the ego pair chosen among all of them by
     /// `hough_init::choose_ego_pair` (a lane still tracked is kept in the pair), each chosen
     /// line refined by least squares on the pixels of its own class.
-    fn initialise_jointly(&mut self) {
+    ///
+    /// `vote[k]`: whether band `k`'s pixels vote (the second search votes only in the bands of
+    /// the sides still without a lane; a side's boundary leans into the other band only on a
+    /// tight bend, where the ROI holds its near part).
+    fn initialise_jointly(&mut self, vote: [bool; 2]) {
         const MAX_LINES: usize = MAX_CANDIDATE_LINES;
         let none = HoughLine {
             rho_px: 0.0,
@@ -148,6 +157,9 @@ impl LaneTracker {
         // This search's candidates follow those of an earlier search on the same frame.
         let first = self.init_candidates.len();
         for k in 0..2 {
+            if !vote[k] {
+                continue;
+            }
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
             self.fill_candidates(class);
             if self.candidates.len() < self.init_params.min_points {
