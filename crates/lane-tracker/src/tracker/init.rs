@@ -156,10 +156,7 @@ impl LaneTracker {
         let mut m = 0;
         // This search's candidates follow those of an earlier search on the same frame.
         let first = self.init_candidates.len();
-        for k in 0..2 {
-            if !vote[k] {
-                continue;
-            }
+        for (k, _) in vote.into_iter().enumerate().filter(|&(_, votes)| votes) {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
             self.fill_candidates(class);
             if self.candidates.len() < self.init_params.min_points {
