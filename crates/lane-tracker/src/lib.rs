@@ -149,7 +149,14 @@
 //!   whose pixels all lie above the ROI starts as its chord over its rows, `x = a2·y + a3`: it
 //!   is extrapolated down over the ROI, and a short far segment fixes a slope, not a curvature.
 //!   The second search costs a second gradient, vote and choice, on the frames that need it
-//!   only.
+//!   only;
+//! - **puts a double line's boundary on its middle** (`init.double_line_middle`; module
+//!   `tracker::double_line`): after a fresh initialisation and its refinement, the image is
+//!   read across the estimate row by row; where the mark under it has a second bright line
+//!   beside it, parallel, a line width or two away and about as bright and as wide, on the
+//!   same side in most rows, the estimate moves to the middle of the two (fitted as a shift
+//!   linear in the row: the gap widens towards the camera), where lane labels put a double
+//!   line.
 //!
 //! Measured on the labelled real sets (`cargo xtask eval-lanes`, `../shared/data/lanes`: 377
 //! stills in four sets, two road, two indoor; tuned on the development part only), TuSimple

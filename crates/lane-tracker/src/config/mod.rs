@@ -139,6 +139,13 @@ pub struct InitConfig {
     /// width, dimensionless), used when `candidate_lines > 0`.
     #[serde(default)]
     pub ego_pair: EgoPairParams,
+    /// An addition beyond the paper: after a fresh initialisation and its refinement, a lane
+    /// whose rows show a second bright line beside its own, parallel, a line width or two
+    /// away (a double line) is moved to the middle of the two, where lane labels put such a
+    /// boundary (the image is read across the estimate row by row; `lane_tracker` crate docs).
+    /// Default `false` when absent.
+    #[serde(default)]
+    pub double_line_middle: bool,
 }
 
 fn default_separation_deg() -> f64 {

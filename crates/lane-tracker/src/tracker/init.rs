@@ -474,6 +474,21 @@ impl LaneTracker {
         (on as f64 - 0.5 * beside as f64).max(0.0)
     }
 
+    /// A fresh estimator at `theta = (a1, a2, a3)` (pixel coefficients) with the initial
+    /// covariance `filter.p0_sigma_px`.
+    pub(super) fn new_filter(&self, theta: &Vector3<f64>) -> Result<LaneFilter, FilterFailure> {
+        match self.estimator {
+            Estimator::Kif => ParabolaKif::new(theta, &self.p0, self.row_norm)
+                .map(LaneFilter::Kif)
+                .map_err(FilterFailure::Kif),
+            Estimator::Wrls => {
+                WrlsLane::new(theta, &self.p0, self.row_norm, self.cfg.filter.wrls_lambda)
+                    .map(LaneFilter::Wrls)
+                    .map_err(FilterFailure::Wrls)
+            }
+        }
+    }
+
     /// Accept an initialisation of lane `i` (`self.candidates` holds the pixels it was fitted
     /// to): sanity checks, a fresh filter, the lane's state. `false` if refused.
     fn install(&mut self, i: usize, init: &LaneInit) -> bool {
@@ -502,17 +517,7 @@ impl LaneTracker {
             init.parabola
         };
         let theta = Vector3::new(p.a1, p.a2, p.a3);
-        let filter = match self.estimator {
-            Estimator::Kif => ParabolaKif::new(&theta, &self.p0, self.row_norm)
-                .map(LaneFilter::Kif)
-                .map_err(FilterFailure::Kif),
-            Estimator::Wrls => {
-                WrlsLane::new(&theta, &self.p0, self.row_norm, self.cfg.filter.wrls_lambda)
-                    .map(LaneFilter::Wrls)
-                    .map_err(FilterFailure::Wrls)
-            }
-        };
-        let filter = match filter {
+        let filter = match self.new_filter(&theta) {
             Ok(filter) => filter,
             Err(e) => {
                 self.counters.filter_failures[i] += 1;

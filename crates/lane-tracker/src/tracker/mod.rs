@@ -12,6 +12,7 @@ use crate::error::FilterFailure;
 use crate::wrls_lane::WrlsLane;
 use crate::{GreyFrame, TrackerConfig, TrackerError};
 
+mod double_line;
 mod init;
 mod points;
 #[cfg(test)]
@@ -526,6 +527,9 @@ impl LaneTracker {
                         if refined.is_err() {
                             break;
                         }
+                    }
+                    if refined.is_ok() && self.cfg.init.double_line_middle {
+                        self.centre_on_double_line(i, &image);
                     }
                     self.roi = roi;
                     refined?;

@@ -3,9 +3,10 @@
 
 use alloc_counter::{CountingAllocator, allocations_in};
 use info_filter::KifError;
+use vision_gradient::GreyImage;
 use wrls::WrlsError;
 
-use super::{Estimator, LaneState, LaneTracker, Side};
+use super::{Estimator, LaneFilter, LaneState, LaneTracker, Side};
 use crate::{FilterFailure, GreyFrame, TrackerConfig};
 
 #[global_allocator]
@@ -254,4 +255,63 @@ fn a_side_missing_from_the_roi_is_found_by_the_second_search_over_the_taller_row
         .collect();
     assert_eq!(chosen.len(), 1, "{cands:?}");
     assert!(chosen[0] >= first_search, "{cands:?}");
+}
+
+/// `left(y) ± s(y)` for the two lines of a double line, `2·h(y)` wide, both growing towards
+/// the camera as on a real road (`s` 3.3 → 7 px, `h` 1.5 → 2.5 px over the ROI), on the left
+/// of `two_marks`' geometry, with its single right mark; `inner_only` paints only the line
+/// `left(y) + s(y)`.
+fn double_line_left(w: usize, h: usize, inner_only: bool) -> GreyFrame {
+    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        let (s, half) = (3.0 + 4.0 * (y - 140.0) / 100.0, 1.5 + (y - 140.0) / 100.0);
+        let d = x - left(y);
+        let outer = !inner_only && (d + s).abs() < half;
+        if (d - s).abs() < half || outer || (x - right(y)).abs() < 2.5 {
+            *p = 200;
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
+    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let rows = [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64];
+    // The lane on the inner line (the only one painted), then read across the double line.
+    let single = double_line_left(320, 240, true);
+    tracker.track(&single).expect("a frame");
+    let before = tracker.lanes[0].filter.as_ref().map(LaneFilter::coeffs);
+    let on_inner = |c: [f64; 3], y: f64| c[0] * y * y + c[1] * y + c[2] - left(y);
+    for y in rows {
+        let d = on_inner(before.expect("a left lane"), y);
+        assert!(
+            d > 2.5,
+            "row {y}: the lane is not on the inner line ({d} px)"
+        );
+    }
+    fn image(f: &GreyFrame) -> GreyImage<'_> {
+        GreyImage::new(f.data(), 320, 240, 320).expect("an image")
+    }
+    // A single line is not a double line: nothing moves.
+    assert!(!tracker.centre_on_double_line(0, &image(&single)));
+    assert_eq!(
+        tracker.lanes[0].filter.as_ref().map(LaneFilter::coeffs),
+        before
+    );
+    let double = double_line_left(320, 240, false);
+    let (moved, allocations) = allocations_in(|| tracker.centre_on_double_line(0, &image(&double)));
+    assert!(moved);
+    assert_eq!(allocations, 0);
+    let after = tracker.lanes[0].filter.as_ref().map(LaneFilter::coeffs);
+    for y in rows {
+        let d = on_inner(after.expect("a left lane"), y);
+        assert!(d.abs() < 1.0, "row {y}: {d} px off the middle");
+    }
 }
