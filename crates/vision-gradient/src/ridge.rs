@@ -74,18 +74,23 @@ pub fn split_stripes(
     n
 }
 
-/// Sets [`KEEP_BIT`] on the pixels that pair (or are outward steps), [`RISE_BIT`] on the rising
-/// ones; magnitudes are restored by the callers.
-fn mark(edges: &mut EdgeBuffer, max_width_px: u16, outward_steps_from_col_px: Option<u16>) {
-    let w = usize::from(max_width_px);
-    let px = edges.pixels_mut();
-    // Pass 1: polarity flags, from the Sobel gx the detector stored with each pixel.
+/// Pass 1 of the pairing: the flags cleared, [`RISE_BIT`] set on the rising pixels (from the
+/// Sobel `gx` the detector stored with each pixel).
+fn flag_polarity(px: &mut [crate::EdgePixel]) {
     for p in px.iter_mut() {
         p.magnitude &= MAG_MASK;
         if p.gx > 0 {
             p.magnitude |= RISE_BIT;
         }
     }
+}
+
+/// Sets [`KEEP_BIT`] on the pixels that pair (or are outward steps), [`RISE_BIT`] on the rising
+/// ones; magnitudes are restored by the callers.
+fn mark(edges: &mut EdgeBuffer, max_width_px: u16, outward_steps_from_col_px: Option<u16>) {
+    let w = usize::from(max_width_px);
+    let px = edges.pixels_mut();
+    flag_polarity(px);
     // Pass 2, per row run, two linear scans (columns increase within a row, so the nearest
     // pixel of a class and polarity after `j` in the run is the nearest to its right, and the
     // nearest before it the nearest to its left). Backwards, with the nearest later column per
@@ -176,12 +181,7 @@ mod tests {
     fn mark_by_scanning(edges: &mut EdgeBuffer, max_width_px: u16, outward: Option<u16>) {
         let w = usize::from(max_width_px);
         let px = edges.pixels_mut();
-        for p in px.iter_mut() {
-            p.magnitude &= MAG_MASK;
-            if p.gx > 0 {
-                p.magnitude |= RISE_BIT;
-            }
-        }
+        flag_polarity(px);
         let n = px.len();
         for j in 0..n {
             let pj = px[j];
