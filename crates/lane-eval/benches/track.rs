@@ -129,6 +129,26 @@ fn tracking_frame(c: &mut Criterion) {
                 });
             },
         );
+        // Both sides missing: the whole ROI blanked, both bands vote over the taller rows.
+        let mut no_side = frame.clone();
+        no_side.data_mut()[top * w..bottom * w].fill(fill);
+        tracker.reset();
+        let r = tracker.track(&no_side).unwrap();
+        println!(
+            "{name}, whole ROI blanked: {} candidates, lanes {:?} / {:?}",
+            tracker.init_candidates().len(),
+            r.lanes[0].state,
+            r.lanes[1].state
+        );
+        group.bench_function(
+            BenchmarkId::new("init_frame_default_second_search_both", name),
+            |b| {
+                b.iter(|| {
+                    tracker.reset();
+                    black_box(tracker.track(black_box(&no_side)).unwrap())
+                });
+            },
+        );
     }
     group.finish();
 }

@@ -144,13 +144,13 @@ fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<(f64, i64)> 
 
 impl LaneTracker {
     /// Lane `i`'s estimate moved to the middle of a double line, if its rows show one (module
-    /// docs); over the rows `self.roi`. Returns whether it moved.
+    /// docs); over the rows `self.search_rows`. Returns whether it moved.
     pub(super) fn centre_on_double_line(&mut self, i: usize, image: &GreyImage<'_>) -> bool {
         let Some(c) = self.lanes[i].filter.as_ref().map(|f| f.coeffs()) else {
             return false;
         };
         let p = Parabola::from_coeffs(c);
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         let max_width_px = i64::from(self.cfg.gradient.stripe_max_width_px.max(1));
         let mut sides = [LineSums::default(); 2];
         for y in top..bottom {

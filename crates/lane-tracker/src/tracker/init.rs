@@ -38,24 +38,24 @@ impl LaneTracker {
             return Ok(());
         }
         let without = [!self.lanes[0].has_estimate(), !self.lanes[1].has_estimate()];
-        let roi = std::mem::replace(&mut self.roi, tall);
+        self.search_rows = tall;
         let searched = self.initialise_in_roi(image, without);
-        self.roi = roi;
+        self.search_rows = self.roi;
         for (lane, was_without) in self.lanes.iter_mut().zip(without) {
             lane.found_in_fallback = was_without && lane.initialised_now;
         }
         searched
     }
 
-    /// Stages I–II over the rows `self.roi`; with the joint initialisation, the Hough candidates
-    /// of the bands `vote[k]` only.
+    /// Stages I–II over the rows `self.search_rows`; with the joint initialisation, the Hough
+    /// candidates of the bands `vote[k]` only.
     fn initialise_in_roi(
         &mut self,
         image: &GreyImage<'_>,
         vote: [bool; 2],
     ) -> Result<(), TrackerError> {
         let outward = self.outward_col();
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         self.detector.detect(
             image,
             Region::Rows {
@@ -147,7 +147,7 @@ impl LaneTracker {
             votes: 0,
         };
         let n = self.cfg.init.candidate_lines.min(MAX_LINES);
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         let (yt, yb) = (top as f64, (bottom - 1) as f64);
         let mut lines = [none; 2 * MAX_LINES];
         let mut classes = [EdgeClass::LeftLane; 2 * MAX_LINES];
@@ -361,7 +361,7 @@ impl LaneTracker {
     /// in a band, or a degenerate fit. For the choice of the ego pair only: the chosen line is
     /// fitted by `fit_around_line` itself.
     fn row_fit(&self, line: &HoughLine) -> Option<Parabola> {
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         let band = self.init_params.band_px;
         let (sin_t, cos_t) = line.theta_rad.sin_cos();
         if cos_t.abs() < 1e-9 {
@@ -442,7 +442,7 @@ impl LaneTracker {
     /// texture or clutter, as dense beside it as on it, loses it); at least 0. Read row by row
     /// from `self.by_row`; no allocation.
     fn row_coverage(&self, p: &Parabola) -> f64 {
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         let band = self.init_params.band_px;
         let shift = BACKGROUND_SHIFT_BANDS * band;
         let cap = 2 * usize::from(self.cfg.gradient.stripe_paired_votes.max(1));
@@ -492,7 +492,7 @@ impl LaneTracker {
     /// Accept an initialisation of lane `i` (`self.candidates` holds the pixels it was fitted
     /// to): sanity checks, a fresh filter, the lane's state. `false` if refused.
     fn install(&mut self, i: usize, init: &LaneInit) -> bool {
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         // Sanity: the fit must cover a fair part of the ROI and stay near the image.
         let span_rows = init.rows_px.1 - init.rows_px.0;
         let min_span = 0.25 * (bottom - top) as f64;
@@ -505,7 +505,7 @@ impl LaneTracker {
         // extrapolated down over the ROI's rows: a short far segment sets its slope, not its
         // curvature. It starts as its chord over its rows (the refinement may bend it again).
         let (y0, y1) = init.rows_px;
-        let p = if y1 < self.cfg.roi_rows(self.height).0 as f64 && y1 > y0 {
+        let p = if y1 < self.roi.0 as f64 && y1 > y0 {
             let (x0, x1) = (init.parabola.col_at_row(y0), init.parabola.col_at_row(y1));
             let slope = (x1 - x0) / (y1 - y0);
             Parabola {

@@ -241,7 +241,11 @@ pub struct LaneTracker {
     estimator: Estimator,
     width: usize,
     height: usize,
+    /// The ROI's rows `[top, bottom)` (`roi.*_row_fraction`), px; fixed.
     roi: (usize, usize),
+    /// The rows the current stage reads, `[top, bottom)`, px: [`Self::roi`], or the second
+    /// search's taller rows while it runs and while a lane it found is refined.
+    search_rows: (usize, usize),
     /// The rows of the second search (`roi.fallback_top_row_fraction`), if any.
     fallback_roi: Option<(usize, usize)>,
     detector: GradientDetector,
@@ -338,6 +342,7 @@ impl LaneTracker {
             width,
             height,
             roi,
+            search_rows: roi,
             fallback_roi,
             detector,
             edges: EdgeBuffer::with_capacity(capacity),
@@ -516,10 +521,9 @@ impl LaneTracker {
             for i in 0..2 {
                 if self.lanes[i].initialised_now {
                     // A lane the second search found is refined over the rows it was found in.
-                    let roi = self.roi;
                     if let (true, Some(tall)) = (self.lanes[i].found_in_fallback, self.fallback_roi)
                     {
-                        self.roi = tall;
+                        self.search_rows = tall;
                     }
                     let mut refined = Ok(());
                     for _ in 0..self.cfg.track.refine_passes.max(1) {
@@ -531,7 +535,7 @@ impl LaneTracker {
                     if refined.is_ok() && self.cfg.init.double_line_middle {
                         self.centre_on_double_line(i, &image);
                     }
-                    self.roi = roi;
+                    self.search_rows = self.roi;
                     refined?;
                     let lane = &mut self.lanes[i];
                     if lane.state != LaneState::Tracking {

@@ -231,7 +231,7 @@ impl LaneTracker {
         coeffs: [f64; 3],
         w: i64,
     ) {
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         let max_points = self.cfg.track.max_points_per_lane;
         let lane = &mut self.lanes[i];
         // Outlier rejection: the residuals r = x − x̂(y) of the window pixels are histogrammed

@@ -48,7 +48,7 @@ impl LaneTracker {
     /// The measurement update of lane `i` with its selected points, then the jump gate at the
     /// top and bottom ROI rows.
     fn update_and_gate(&mut self, i: usize, coeffs: [f64; 3]) {
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         let mark_centres = self.cfg.track.mark_centres;
         let lane = &mut self.lanes[i];
         let Some(filter) = lane.filter.as_mut() else {
@@ -133,7 +133,7 @@ impl LaneTracker {
         if !(l.has_estimate() && r.has_estimate()) {
             return;
         }
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         let sep = self.cfg.track.min_lane_separation_px;
         // Lanes converge towards the horizon: at the top ROI row they need only be in order,
         // at the middle and bottom rows `sep` apart.

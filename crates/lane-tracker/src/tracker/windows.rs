@@ -24,7 +24,7 @@ impl LaneTracker {
     /// the lane has no filter or its prediction failed (then counted, kept in
     /// [`LaneTracker::last_filter_error`], and the lane is lost).
     pub(super) fn predict_windows(&mut self, i: usize, predict: bool) -> Option<[f64; 3]> {
-        let (top, bottom) = self.roi;
+        let (top, bottom) = self.search_rows;
         let w = self.window_half_width(predict);
         let lane = &mut self.lanes[i];
         let filter = lane.filter.as_mut()?;
