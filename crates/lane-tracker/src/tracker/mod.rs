@@ -14,6 +14,7 @@ use crate::{GreyFrame, TrackerConfig, TrackerError};
 
 mod double_line;
 mod init;
+mod kerb;
 mod points;
 #[cfg(test)]
 mod tests;
@@ -268,6 +269,8 @@ pub struct LaneTracker {
     row_start: Vec<u32>,
     row_next: Vec<u32>,
     scratch: Vec<Candidate>,
+    /// The rows' kerb feet `(row, offset)` read by `onto_kerb_foot` (capacity: the height).
+    kerb_rows: Vec<(f64, f64)>,
     row_norm: RowNorm,
     q: ProcessNoise<3>,
     p0: ThetaCov,
@@ -362,6 +365,7 @@ impl LaneTracker {
             paired_mask: vec![0; (width * height).div_ceil(64)],
             row_next: Vec::with_capacity(height),
             scratch: Vec::with_capacity(capacity),
+            kerb_rows: Vec::with_capacity(height),
             row_norm,
             q,
             p0,
@@ -532,8 +536,11 @@ impl LaneTracker {
                             break;
                         }
                     }
-                    if refined.is_ok() && self.cfg.init.double_line_middle {
-                        self.centre_on_double_line(i, &image);
+                    let doubled = refined.is_ok()
+                        && self.cfg.init.double_line_middle
+                        && self.centre_on_double_line(i, &image);
+                    if refined.is_ok() && !doubled && self.cfg.init.kerb_foot {
+                        self.onto_kerb_foot(i, &image);
                     }
                     self.search_rows = self.roi;
                     refined?;

@@ -315,3 +315,83 @@ fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
         assert!(d.abs() < 1.0, "row {y}: {d} px off the middle");
     }
 }
+
+/// `two_marks`' left mark, and on the right a raised kerb: the road (55) up to a groove (45)
+/// 2 px wide at the foot `right(y) − f(y)`, the face (55) from the foot to the top edge
+/// `right(y)`, the pavement (100) beyond it (the levels of a real one: the groove's edges stay
+/// below the gradient threshold); the face `f` widens towards the camera as on a
+/// real kerb (5 → 9 px over the ROI). `plain`: the same step with no face and no groove.
+fn kerb_right(w: usize, h: usize, plain: bool) -> GreyFrame {
+    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let mut pixels = vec![55u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        let (top, foot) = (kerb_top(y), kerb_foot_col(y));
+        if (x - left(y)).abs() < 2.5 {
+            *p = 200;
+        } else if x >= top {
+            *p = 100;
+        } else if !plain && x >= foot - 2.0 && x < foot {
+            *p = 45;
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+fn kerb_top(y: f64) -> f64 {
+    (230.0 + 0.45 * (y - 239.0)).round()
+}
+/// The foot's column: the face starts there, the groove ends just before it.
+fn kerb_foot_col(y: f64) -> f64 {
+    kerb_top(y) - (5.0 + 4.0 * (y - 140.0) / 100.0).round()
+}
+
+#[test]
+fn a_lane_on_a_kerbs_top_edge_is_moved_to_its_foot() {
+    let mut cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(cfg.init.kerb_foot, "the default reads kerbs");
+    cfg.init.kerb_foot = false;
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let rows = [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64];
+    let coeffs = |t: &LaneTracker| t.lanes[1].filter.as_ref().map(LaneFilter::coeffs);
+    let col = |c: Option<[f64; 3]>, y: f64| {
+        let c = c.expect("a right lane");
+        c[0] * y * y + c[1] * y + c[2]
+    };
+    fn image(f: &GreyFrame) -> GreyImage<'_> {
+        GreyImage::new(f.data(), 320, 240, 320).expect("an image")
+    }
+    // Without the rule the lane lies between the top edge (the step between top − 1 and
+    // top) and the groove (its corners on the rendered staircase pass the threshold), off the
+    // foot.
+    let kerb = kerb_right(320, 240, false);
+    tracker.track(&kerb).expect("a frame");
+    let on_top = coeffs(&tracker);
+    for y in rows {
+        let d = col(on_top, y) - (kerb_foot_col(y) - 0.5);
+        assert!(d > 2.0, "row {y}: the lane is {d} px from the foot");
+    }
+    // A plain step is not a kerb: nothing moves.
+    let plain = kerb_right(320, 240, true);
+    assert!(!tracker.onto_kerb_foot(1, &image(&plain)));
+    assert_eq!(coeffs(&tracker), on_top);
+    // Read across the kerb, the lane moves to its foot (the rise out of the groove, between
+    // foot − 1 and foot), without allocating.
+    let (moved, allocations) = allocations_in(|| tracker.onto_kerb_foot(1, &image(&kerb)));
+    assert!(moved);
+    assert_eq!(allocations, 0);
+    for y in rows {
+        let d = col(coeffs(&tracker), y) - (kerb_foot_col(y) - 0.5);
+        assert!(d.abs() < 1.0, "row {y}: {d} px off the foot");
+    }
+    // The default does it after its initialisation; the left lane (a mark) stays.
+    let default = TrackerConfig::default_preset().expect("the default preset");
+    let mut tracker = LaneTracker::new(&default, Estimator::Kif, 320, 240).expect("a tracker");
+    let report = tracker.track(&kerb).expect("a frame");
+    for y in rows {
+        let d = report.lanes[1].col_at_row(y).expect("a right lane") - (kerb_foot_col(y) - 0.5);
+        assert!(d.abs() < 1.0, "row {y}: {d} px off the foot");
+        let l = report.lanes[0].col_at_row(y).expect("a left lane") - (100.0 - 0.45 * (y - 239.0));
+        assert!(l.abs() < 1.5, "row {y}: the left lane {l} px off its mark");
+    }
+}
