@@ -163,8 +163,9 @@
 //!   any mark, with a band of the inner level (the kerb's face) on the road side ending in a
 //!   weaker edge of the same polarity 3 to `gradient.stripe_max_width_px` px away (the rise out
 //!   of the groove at the foot, or onto a lighter face), consistently over at least 30 % of the
-//!   rows, the estimate moves to that foot (fitted as a shift linear in the row), where the
-//!   road ends and lane labels put the boundary.
+//!   rows, the boundary reported moves to that foot (a shift linear in the row), where the
+//!   road ends and lane labels put the boundary; the filter keeps tracking the top edge its
+//!   windows measure, and the shift is kept until the lane's next initialisation.
 //!
 //! Measured on the labelled real sets (`cargo xtask eval-lanes`, `../shared/data/lanes`: 377
 //! stills in four sets, two road, two indoor; tuned on the development part only), TuSimple

@@ -150,9 +150,9 @@ pub struct InitConfig {
     /// double line's middle, when that did not move it), a lane on the top edge of a raised
     /// kerb — a step to a pavement wider than any mark, with the kerb's face a few pixels wide
     /// on the road side and a weaker edge of the same polarity at its foot, consistently over
-    /// the rows — is moved to the foot, where the road ends and lane labels put the boundary
-    /// (the image is read across the estimate row by row; `lane_tracker` crate docs). Default
-    /// `false` when absent.
+    /// the rows — is reported on the foot, where the road ends and lane labels put the
+    /// boundary, while its filter keeps tracking the top edge (the image is read across the
+    /// estimate row by row; `lane_tracker` crate docs). Default `false` when absent.
     #[serde(default)]
     pub kerb_foot: bool,
 }

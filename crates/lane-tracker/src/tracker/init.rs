@@ -541,6 +541,7 @@ impl LaneTracker {
         lane.filter = Some(filter);
         lane.predicted = None;
         lane.fresh = true;
+        lane.kerb_offset_px = [0.0; 2];
         lane.state = LaneState::Tracking;
         lane.misses = 0;
         lane.rows = [init.rows_px.0, init.rows_px.1];

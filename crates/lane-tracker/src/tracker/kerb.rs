@@ -26,9 +26,11 @@
 //! The lane is bounded by a kerb if at least [`MIN_ROW_FRACTION`] of its rows inside the image
 //! give a foot that agrees with `t(y) ≈ α + β·y` (least squares, refitted twice on the rows
 //! within [`INLIER_PX`] of the last fit: the face widens towards the camera, linearly in `y`
-//! on a straight road). Its estimate then moves to the foot, `(a1, a2 + β, a3 + α)`, and the
-//! filter restarts from it. No allocation (the rows' offsets go to a buffer of the image's
-//! height).
+//! on a straight road). The lane's reported boundary then moves to the foot, `(a1, a2 + β,
+//! a3 + α)`, while its filter keeps tracking the top edge — the edge its windows measure; a
+//! filter restarted at the foot would be pulled back to it over the next frames — with the
+//! offset kept until the lane's next initialisation. No allocation (the rows' offsets go to a
+//! buffer of the image's height).
 //!
 //! On the labelled `f1tenth` set (a scale-model city with raised kerbs) the labels of a kerb
 //! lie on its foot in most frames and on its top edge in some (no face visible to the
@@ -36,7 +38,6 @@
 //! 8 off them (README, "Lanes on real data").
 
 use hough_init::Parabola;
-use nalgebra::Vector3;
 use vision_gradient::GreyImage;
 
 use super::LaneTracker;
@@ -135,8 +136,9 @@ fn line_fit(rows: &[(f64, f64)], fit: Option<(f64, f64)>) -> Option<((f64, f64),
 }
 
 impl LaneTracker {
-    /// Lane `i`'s estimate moved to the foot of a kerb, if its rows show one (module docs);
-    /// over the rows `self.search_rows`. Returns whether it moved.
+    /// Lane `i`'s reported boundary moved to the foot of a kerb, if its rows show one (module
+    /// docs; the filter keeps the top edge); over the rows `self.search_rows`. Returns whether
+    /// it moved.
     pub(super) fn onto_kerb_foot(&mut self, i: usize, image: &GreyImage<'_>) -> bool {
         let Some(c) = self.lanes[i].filter.as_ref().map(|f| f.coeffs()) else {
             return false;
@@ -172,18 +174,8 @@ impl LaneTracker {
         let Some((alpha, beta)) = fit else {
             return false;
         };
-        let theta = Vector3::new(p.a1, p.a2 + beta, p.a3 + alpha);
-        match self.new_filter(&theta) {
-            Ok(filter) => {
-                self.lanes[i].filter = Some(filter);
-                true
-            }
-            Err(e) => {
-                self.counters.filter_failures[i] += 1;
-                self.last_failure[i] = Some(e);
-                false
-            }
-        }
+        self.lanes[i].kerb_offset_px = [alpha, beta];
+        true
     }
 }
 

@@ -168,6 +168,10 @@ struct Lane {
     /// Initialised on this frame by the second search (`roi.fallback_top_row_fraction`): its
     /// refinement runs over the taller rows.
     found_in_fallback: bool,
+    /// `[α, β]`: the boundary reported lies `α + β·y` px from the edge the filter tracks — a
+    /// kerb's foot from its top edge (`init.kerb_foot`); zero otherwise. Set after an
+    /// initialisation, kept while the filter tracks that edge, cleared by the next one.
+    kerb_offset_px: [f64; 2],
     updated_now: bool,
     fresh: bool,
 }
@@ -176,7 +180,11 @@ impl Lane {
     fn report(&self) -> LaneReport {
         let coeffs = match self.state {
             LaneState::Tracking | LaneState::Coasting => {
-                self.filter.as_ref().map(LaneFilter::coeffs)
+                let [alpha, beta] = self.kerb_offset_px;
+                self.filter
+                    .as_ref()
+                    .map(LaneFilter::coeffs)
+                    .map(|[a1, a2, a3]| [a1, a2 + beta, a3 + alpha])
             }
             LaneState::Initialising | LaneState::Lost => None,
         };
@@ -329,6 +337,7 @@ impl LaneTracker {
             points_now: 0,
             initialised_now: false,
             found_in_fallback: false,
+            kerb_offset_px: [0.0; 2],
             updated_now: false,
             fresh: false,
         };
@@ -407,6 +416,7 @@ impl LaneTracker {
             lane.state = LaneState::Initialising;
             lane.filter = None;
             lane.predicted = None;
+            lane.kerb_offset_px = [0.0; 2];
             lane.misses = 0;
             lane.points.clear();
             lane.weights.clear();

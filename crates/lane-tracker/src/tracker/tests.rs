@@ -346,18 +346,20 @@ fn kerb_foot_col(y: f64) -> f64 {
 }
 
 #[test]
-fn a_lane_on_a_kerbs_top_edge_is_moved_to_its_foot() {
+fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
     let mut cfg = TrackerConfig::default_preset().expect("the default preset");
     assert!(cfg.init.kerb_foot, "the default reads kerbs");
     cfg.init.kerb_foot = false;
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
     let (top, bottom) = tracker.roi;
     let rows = [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64];
-    let coeffs = |t: &LaneTracker| t.lanes[1].filter.as_ref().map(LaneFilter::coeffs);
+    let tracked = |t: &LaneTracker| t.lanes[1].filter.as_ref().map(LaneFilter::coeffs);
+    let reported = |t: &LaneTracker| t.lanes[1].report().coeffs;
     let col = |c: Option<[f64; 3]>, y: f64| {
         let c = c.expect("a right lane");
         c[0] * y * y + c[1] * y + c[2]
     };
+    let off_foot = |c: Option<[f64; 3]>, y: f64| col(c, y) - (kerb_foot_col(y) - 0.5);
     fn image(f: &GreyFrame) -> GreyImage<'_> {
         GreyImage::new(f.data(), 320, 240, 320).expect("an image")
     }
@@ -366,32 +368,52 @@ fn a_lane_on_a_kerbs_top_edge_is_moved_to_its_foot() {
     // foot.
     let kerb = kerb_right(320, 240, false);
     tracker.track(&kerb).expect("a frame");
-    let on_top = coeffs(&tracker);
+    let on_top = tracked(&tracker);
+    assert_eq!(reported(&tracker), on_top);
     for y in rows {
-        let d = col(on_top, y) - (kerb_foot_col(y) - 0.5);
+        let d = off_foot(on_top, y);
         assert!(d > 2.0, "row {y}: the lane is {d} px from the foot");
     }
     // A plain step is not a kerb: nothing moves.
     let plain = kerb_right(320, 240, true);
     assert!(!tracker.onto_kerb_foot(1, &image(&plain)));
-    assert_eq!(coeffs(&tracker), on_top);
-    // Read across the kerb, the lane moves to its foot (the rise out of the groove, between
-    // foot − 1 and foot), without allocating.
+    assert_eq!(reported(&tracker), on_top);
+    // Read across the kerb, the boundary reported moves to its foot (the rise out of the
+    // groove, between foot − 1 and foot), without allocating; the filter keeps the edge its
+    // windows measure.
     let (moved, allocations) = allocations_in(|| tracker.onto_kerb_foot(1, &image(&kerb)));
     assert!(moved);
     assert_eq!(allocations, 0);
+    assert_eq!(tracked(&tracker), on_top);
     for y in rows {
-        let d = col(coeffs(&tracker), y) - (kerb_foot_col(y) - 0.5);
+        let d = off_foot(reported(&tracker), y);
         assert!(d.abs() < 1.0, "row {y}: {d} px off the foot");
+    }
+    // Tracked on: the boundary stays on the foot (a filter restarted there would be pulled
+    // back to the top edge by its windows).
+    for frame in 0..10 {
+        let report = tracker.track(&kerb).expect("a frame");
+        assert!(!report.lanes[1].initialised);
+        for y in rows {
+            let d = off_foot(report.lanes[1].coeffs, y);
+            assert!(d.abs() < 1.0, "frame {frame}, row {y}: {d} px off the foot");
+        }
     }
     // The default does it after its initialisation; the left lane (a mark) stays.
     let default = TrackerConfig::default_preset().expect("the default preset");
     let mut tracker = LaneTracker::new(&default, Estimator::Kif, 320, 240).expect("a tracker");
     let report = tracker.track(&kerb).expect("a frame");
     for y in rows {
-        let d = report.lanes[1].col_at_row(y).expect("a right lane") - (kerb_foot_col(y) - 0.5);
+        let d = off_foot(report.lanes[1].coeffs, y);
         assert!(d.abs() < 1.0, "row {y}: {d} px off the foot");
         let l = report.lanes[0].col_at_row(y).expect("a left lane") - (100.0 - 0.45 * (y - 239.0));
         assert!(l.abs() < 1.5, "row {y}: the left lane {l} px off its mark");
+    }
+    // A new initialisation reads its own kerb: on the plain step, none.
+    tracker.reset();
+    let report = tracker.track(&plain).expect("a frame");
+    for y in rows {
+        let d = report.lanes[1].col_at_row(y).expect("a right lane") - (kerb_top(y) - 0.5);
+        assert!(d.abs() < 1.5, "row {y}: {d} px off the plain step");
     }
 }
