@@ -165,7 +165,8 @@
 //!   of the groove at the foot, or onto a lighter face), consistently over at least 30 % of the
 //!   rows, the boundary reported moves to that foot (a shift linear in the row), where the
 //!   road ends and lane labels put the boundary; the filter keeps tracking the top edge its
-//!   windows measure, and the shift is kept until the lane's next initialisation.
+//!   windows measure; on tracked frames the kerb is read again on every eighth row and the
+//!   shift follows it, or is dropped after `track.lost_after_frames` frames without a kerb.
 //!
 //! Measured on the labelled real sets (`cargo xtask eval-lanes`, `../shared/data/lanes`: 377
 //! stills in four sets, two road, two indoor; tuned on the development part only), TuSimple

@@ -148,8 +148,9 @@ pub struct InitConfig {
     pub double_line_middle: bool,
     /// An addition beyond the paper: after a fresh initialisation and its refinement (and the
     /// double line's middle, when that did not move it), a lane on the top edge of a raised
-    /// kerb — a step to a pavement wider than any mark, with the kerb's face a few pixels wide
-    /// on the road side and a weaker edge of the same polarity at its foot, consistently over
+    /// kerb — a step to a pavement wider than twice the widest mark
+    /// (`gradient.stripe_max_width_px`, at least 4 px with this on), with the kerb's face a
+    /// few pixels wide on the road side and a weaker edge of the same polarity at its foot, consistently over
     /// the rows — is reported on the foot, where the road ends and lane labels put the
     /// boundary, while its filter keeps tracking the top edge (the image is read across the
     /// estimate row by row; `lane_tracker` crate docs). Default `false` when absent.
@@ -510,6 +511,12 @@ impl TrackerConfig {
             "gradient.stripe_max_width_px",
             g.stripe_max_width_px,
             "must be in 0..=200 px",
+        )?;
+        check(
+            !self.init.kerb_foot || g.stripe_max_width_px >= 4,
+            "init.kerb_foot",
+            self.init.kerb_foot,
+            "needs gradient.stripe_max_width_px ≥ 4 px (a kerb's face is read from 3 px up to it)",
         )?;
         check(
             g.stripe_paired_votes <= 4,

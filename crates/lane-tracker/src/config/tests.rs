@@ -125,6 +125,10 @@ fn each_out_of_range_field_is_named() {
         ("filter.r_sigma_px", |c| c.filter.r_sigma_px = 0.0),
         ("filter.p0_sigma_px", |c| c.filter.p0_sigma_px[2] = f64::NAN),
         ("filter.wrls_lambda", |c| c.filter.wrls_lambda = 1.5),
+        ("init.kerb_foot", |c| {
+            c.init.kerb_foot = true;
+            c.gradient.stripe_max_width_px = 3;
+        }),
     ];
     for (field, edit) in cases {
         let mut cfg = TrackerConfig::outdoor().unwrap();

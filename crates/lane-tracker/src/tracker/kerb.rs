@@ -10,27 +10,36 @@
 //! grey levels `I(x)`, with `d = −1` for the left lane and `+1` for the right one (the side
 //! the road does not lie on) and the gradient towards that side `g(x) = I(x + d) − I(x − d)`:
 //!
-//! 1. the step: `x_s`, the column of the largest `|g|` within ±[`STEP_REACH_PX`] of `x̂(y)`;
-//!    its outer level `o = I(x_s + 2d)` and inner level `n = I(x_s − 2d)` differ by at least
+//! 1. the step: `x_s`, the column of the largest `|g|` within `r = max(1, w_max/4)` px of
+//!    `x̂(y)` (`w_max = gradient.stripe_max_width_px`; ties go to the road's side); its outer
+//!    level `o = I(x_s + 2d)` and inner level `n = I(x_s − 2d)` differ by at least
 //!    [`MIN_STEP_CONTRAST`] grey levels; `h = (o + n)/2`, `σ = sign(o − n)`;
-//! 2. not a mark: the outer side stays past `h` (`σ·(I − h) ≥ 0`) from `x_s + 2d` over
-//!    `2·w_max` px (`w_max = gradient.stripe_max_width_px`) or up to the image's edge — a
-//!    pavement, not a painted line or a tape;
-//! 3. the foot: `x_f`, the column of the largest `σ·g` between `3` and `w_max` px on the road
-//!    side of `x_s` (the same polarity as the step: the rise out of the groove, or from the
-//!    road onto a lighter face), at least [`MIN_FOOT_GRADIENT`] grey levels and
-//!    [`MIN_FOOT_RATIO`] of `|g(x_s)|`;
-//! 4. the face: every pixel from `x_s − 2d` to `x_f` stays on the inner side of `h`;
-//! 5. the row gives `t(y) = x_f − x̂(y)`.
+//! 2. not a mark: the outer side stays past `h` (`σ·(I − h) ≥ 0`) at `x_s + k·d` for
+//!    `k = 2 … 2·w_max` or up to the image's edge — a pavement, not a painted line or a tape;
+//! 3. the foot: `x_f`, the column of the largest `σ·g` at `x_s − k·d`, `k = r … w_max` (the
+//!    same polarity as the step: the rise out of the groove, or from the road onto a lighter
+//!    face), at least [`MIN_FOOT_GRADIENT`] grey levels and [`MIN_FOOT_RATIO`] of `|g(x_s)|`;
+//!    the row gives nothing if that range leaves the image;
+//! 4. a face between them: some column strictly between `x_s − d` and `x_f` has `σ·g` below
+//!    half the foot's (the foot is an edge of its own, not the tail of a blurred step), and
+//!    every pixel from `x_s − 2d` up to (not including) `x_f` stays on the inner side of `h`;
+//! 5. the row gives `t(y) = x_f* − x̂(y)`, `x_f*` the vertex of the parabola through `σ·g` at
+//!    `x_f − 1, x_f, x_f + 1` (within half a pixel of `x_f`: a sharp edge lies between two
+//!    columns).
 //!
-//! The lane is bounded by a kerb if at least [`MIN_ROW_FRACTION`] of its rows inside the image
-//! give a foot that agrees with `t(y) ≈ α + β·y` (least squares, refitted twice on the rows
-//! within [`INLIER_PX`] of the last fit: the face widens towards the camera, linearly in `y`
-//! on a straight road). The lane's reported boundary then moves to the foot, `(a1, a2 + β,
-//! a3 + α)`, while its filter keeps tracking the top edge — the edge its windows measure; a
-//! filter restarted at the foot would be pulled back to it over the next frames — with the
-//! offset kept until the lane's next initialisation. No allocation (the rows' offsets go to a
-//! buffer of the image's height).
+//! The lane is bounded by a kerb if at least [`MIN_ROWS`] rows (4 when every eighth row is
+//! read), and [`MIN_ROW_FRACTION`] of its rows read inside the image, give a foot that agrees with `t(y) ≈ α + β·y` (least squares, refitted
+//! twice on the rows within `max(0.5, w_max/8)` px of the last fit: the face widens towards the
+//! camera, linearly in `y` on a straight road), and the fitted foot lies on the road's side
+//! between `r − 1` and `w_max + 1` px from the estimate at the first and the last row searched.
+//! The lane's reported boundary then moves to the foot, `(a1, a2 + β, a3 + α)`, while its filter
+//! keeps tracking the top edge — the edge its windows measure; a filter restarted at the foot
+//! would be pulled back to it over the next frames. On each tracked frame the kerb is read
+//! again on every [`TRACKED_ROW_STEP`]-th row (the face widens or narrows as the vehicle moves):
+//! the offset follows the reading, and after `track.lost_after_frames` frames in a row without
+//! one (the kerb has ended) it is dropped; the next initialisation starts without one. The pixel distances scale with `w_max` (12 px at 320 px width in the default;
+//! `TrackerConfig::scale_pixels` scales it with the resolution). No allocation (the rows'
+//! offsets go to a buffer of the image's height).
 //!
 //! On the labelled `f1tenth` set (a scale-model city with raised kerbs) the labels of a kerb
 //! lie on its foot in most frames and on its top edge in some (no face visible to the
@@ -42,32 +51,47 @@ use vision_gradient::GreyImage;
 
 use super::LaneTracker;
 
-/// How far from the estimate the step is looked for, px.
-const STEP_REACH_PX: i64 = 3;
 /// Least grey-level difference across the step.
 const MIN_STEP_CONTRAST: f64 = 20.0;
 /// Least gradient `σ·g` of the foot, grey levels.
 const MIN_FOOT_GRADIENT: f64 = 6.0;
 /// Least gradient of the foot relative to the step's.
 const MIN_FOOT_RATIO: f64 = 0.15;
-/// Least fraction of the rows inside the image whose foot agrees with the fit.
+/// Least number of rows whose foot agrees with the fit (on every row; on every `k`-th row,
+/// `max(4, MIN_ROWS/k)` of them).
+const MIN_ROWS: usize = 8;
+/// Least fraction of the rows read inside the image whose foot agrees with the fit.
 const MIN_ROW_FRACTION: f64 = 0.3;
-/// A row's foot agrees with the fit within this many pixels.
-const INLIER_PX: f64 = 1.5;
+/// On a tracked frame the kerb is read on every this-many-th row (an eighth of the cost of the
+/// initialisation's reading: ≈ 1 µs a lane at 320×240).
+const TRACKED_ROW_STEP: usize = 8;
+
+/// The step's search radius and the face's least width, px: `max(1, w_max/4)`.
+fn step_reach_px(max_width_px: i64) -> i64 {
+    (max_width_px / 4).max(1)
+}
+
+/// A row's foot agrees with the fit within this many pixels: `max(0.5, w_max/8)`.
+fn inlier_px(max_width_px: i64) -> f64 {
+    (max_width_px as f64 / 8.0).max(0.5)
+}
 
 /// Row `row`'s kerb foot relative to `x_hat` for a boundary whose outer side is towards `dir`
-/// (`±1`), steps 1–5 of the module docs; `None` if the row shows no kerb.
+/// (`±1`), steps 1–5 of the module docs; `None` if the row shows no kerb or `x_hat` is not a
+/// column of the row.
 pub(super) fn kerb_foot(row: &[u8], x_hat: f64, dir: i64, max_width_px: i64) -> Option<f64> {
     let w = row.len() as i64;
-    let at = |x: i64| (0..w).contains(&x).then(|| f64::from(row[x as usize]));
-    let g = |x: i64| Some(at(x + dir)? - at(x - dir)?);
-    let x0 = x_hat.round();
-    if !x0.is_finite() {
+    if !(0.0..w as f64).contains(&x_hat) {
         return None;
     }
-    let x0 = x0 as i64;
+    let at = |x: i64| (0..w).contains(&x).then(|| f64::from(row[x as usize]));
+    let g = |x: i64| Some(at(x + dir)? - at(x - dir)?);
+    let x0 = x_hat.round() as i64;
+    let reach = step_reach_px(max_width_px);
+    // 1. The step, scanned from the road's side outwards (a tie goes to the road's side).
     let (mut xs, mut gs) = (None, 0.0f64);
-    for x in x0 - STEP_REACH_PX..=x0 + STEP_REACH_PX {
+    for k in -reach..=reach {
+        let x = x0 + k * dir;
         if let Some(v) = g(x).filter(|v| v.abs() > gs.abs()) {
             (xs, gs) = (Some(x), v);
         }
@@ -88,36 +112,54 @@ pub(super) fn kerb_foot(row: &[u8], x_hat: f64, dir: i64, max_width_px: i64) -> 
         }
     }
     // 3. The foot: the strongest gradient of the step's polarity on the road side.
-    let (mut xf, mut gf) = (None, 0.0f64);
-    for k in 3..=max_width_px {
-        let x = xs - k * dir;
-        let v = g(x)? * sign;
+    let (mut kf, mut gf) = (None, 0.0f64);
+    for k in reach..=max_width_px {
+        let v = g(xs - k * dir)? * sign;
         if v > gf {
-            (xf, gf) = (Some(x), v);
+            (kf, gf) = (Some(k), v);
         }
     }
-    let xf = xf?;
+    let kf = kf?;
     if gf < MIN_FOOT_GRADIENT || gf < MIN_FOOT_RATIO * gs.abs() {
         return None;
     }
-    // 4. The face stays on the inner side of the half level.
-    let mut x = xs - 2 * dir;
-    while x != xf {
-        if (at(x)? - half) * sign > 0.0 {
+    // 4. A face: the gradient dips between the step and the foot, and the levels stay on the
+    // inner side of the half level.
+    let mut dip = false;
+    for k in 2..kf {
+        dip |= g(xs - k * dir)? * sign < 0.5 * gf;
+        if (at(xs - k * dir)? - half) * sign > 0.0 {
             return None;
         }
-        x -= dir;
     }
-    Some(xf as f64 - x_hat)
+    if !dip {
+        return None;
+    }
+    // 5. The foot to a fraction of a pixel: the vertex of the parabola through σ·g at the
+    // columns x_f − 1, x_f, x_f + 1.
+    let xf = xs - kf * dir;
+    let v = |x: i64| g(x).map(|v| v * sign);
+    let (a, b, c) = (v(xf - 1)?, gf, v(xf + 1)?);
+    let curvature = a - 2.0 * b + c;
+    let vertex = if curvature < 0.0 {
+        (0.5 * (a - c) / curvature).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
+    Some(xf as f64 + vertex - x_hat)
 }
 
-/// `(α, β)` of `t ≈ α + β·y` by least squares over `rows` `(y, t)` within `INLIER_PX` of
+/// `(α, β)` of `t ≈ α + β·y` by least squares over `rows` `(y, t)` within `inlier_px` of
 /// `fit` (all of them without one), and how many there were; `None` if they do not
 /// determine it.
-fn line_fit(rows: &[(f64, f64)], fit: Option<(f64, f64)>) -> Option<((f64, f64), usize)> {
+fn line_fit(
+    rows: &[(f64, f64)],
+    fit: Option<(f64, f64)>,
+    inlier_px: f64,
+) -> Option<((f64, f64), usize)> {
     let (mut n, mut sy, mut syy, mut st, mut sty) = (0usize, 0.0, 0.0, 0.0, 0.0);
     for &(y, t) in rows {
-        if fit.is_some_and(|(a, b)| (t - a - b * y).abs() > INLIER_PX) {
+        if fit.is_some_and(|(a, b)| (t - a - b * y).abs() > inlier_px) {
             continue;
         }
         n += 1;
@@ -136,13 +178,51 @@ fn line_fit(rows: &[(f64, f64)], fit: Option<(f64, f64)>) -> Option<((f64, f64),
 }
 
 impl LaneTracker {
-    /// Lane `i`'s reported boundary moved to the foot of a kerb, if its rows show one (module
-    /// docs; the filter keeps the top edge); over the rows `self.search_rows`. Returns whether
-    /// it moved.
+    /// Lane `i`'s reported boundary moved to the foot of a kerb after its initialisation, if
+    /// its rows show one (module docs; the filter keeps the top edge); over the rows
+    /// `self.search_rows`. Returns whether it moved.
     pub(super) fn onto_kerb_foot(&mut self, i: usize, image: &GreyImage<'_>) -> bool {
-        let Some(c) = self.lanes[i].filter.as_ref().map(|f| f.coeffs()) else {
+        let Some(offset) = self.read_kerb_foot(i, image, 1) else {
             return false;
         };
+        let lane = &mut self.lanes[i];
+        lane.kerb_offset_px = offset;
+        lane.kerb_misses = 0;
+        true
+    }
+
+    /// On a tracked frame, lane `i`'s kerb read again on every [`TRACKED_ROW_STEP`]-th row (the
+    /// face widens or narrows as the vehicle moves; the kerb may end): the offset follows the
+    /// reading, and after `track.lost_after_frames` frames in a row without one it is dropped
+    /// and the lane reported on the edge it tracks. Only for a lane with an offset.
+    pub(super) fn recheck_kerb_foot(&mut self, i: usize, image: &GreyImage<'_>) {
+        if self.lanes[i].kerb_offset_px == [0.0; 2] {
+            return;
+        }
+        let reading = self.read_kerb_foot(i, image, TRACKED_ROW_STEP);
+        let lost_after = self.cfg.track.lost_after_frames;
+        let lane = &mut self.lanes[i];
+        if let Some(offset) = reading {
+            lane.kerb_offset_px = offset;
+            lane.kerb_misses = 0;
+        } else {
+            lane.kerb_misses += 1;
+            if lane.kerb_misses >= lost_after {
+                lane.kerb_offset_px = [0.0; 2];
+                lane.kerb_misses = 0;
+            }
+        }
+    }
+
+    /// The offset `[α, β]` of a kerb's foot from lane `i`'s tracked edge, read on every
+    /// `row_step`-th row of `self.search_rows` (module docs), or `None`.
+    fn read_kerb_foot(
+        &mut self,
+        i: usize,
+        image: &GreyImage<'_>,
+        row_step: usize,
+    ) -> Option<[f64; 2]> {
+        let c = self.lanes[i].filter.as_ref().map(|f| f.coeffs())?;
         let p = Parabola::from_coeffs(c);
         let (top, bottom) = self.search_rows;
         let max_width_px = i64::from(self.cfg.gradient.stripe_max_width_px.max(1));
@@ -150,7 +230,7 @@ impl LaneTracker {
         let feet = &mut self.kerb_rows;
         feet.clear();
         let mut inside = 0usize;
-        for y in top..bottom {
+        for y in (top..bottom).step_by(row_step.max(1)) {
             let Some(row) = image.row(y) else { continue };
             let x = p.col_at_row(y as f64);
             if !(0.0..row.len() as f64).contains(&x) {
@@ -163,19 +243,25 @@ impl LaneTracker {
                 feet.push((y as f64, t));
             }
         }
-        let enough = |n: usize| n > 0 && n as f64 >= MIN_ROW_FRACTION * inside as f64;
+        let min_rows = (MIN_ROWS / row_step.max(1)).max(4);
+        let enough = |n: usize| n >= min_rows && n as f64 >= MIN_ROW_FRACTION * inside as f64;
+        let inlier = inlier_px(max_width_px);
         let mut fit = None;
         for _ in 0..3 {
-            match line_fit(feet, fit) {
+            match line_fit(feet, fit, inlier) {
                 Some((f, n)) if enough(n) => fit = Some(f),
-                _ => return false,
+                _ => return None,
             }
         }
-        let Some((alpha, beta)) = fit else {
-            return false;
+        let (alpha, beta) = fit?;
+        // The fitted foot on the road's side of the estimate, within the reach of a row's, at
+        // both ends of the rows searched.
+        let reach = step_reach_px(max_width_px) as f64;
+        let plausible = |y: usize| {
+            let inward = -(dir as f64) * (alpha + beta * y as f64);
+            (reach - 1.0..=max_width_px as f64 + 1.0).contains(&inward)
         };
-        self.lanes[i].kerb_offset_px = [alpha, beta];
-        true
+        (plausible(top) && plausible(bottom - 1)).then_some([alpha, beta])
     }
 }
 
@@ -195,17 +281,26 @@ mod tests {
     #[test]
     fn a_row_reads_the_foot_of_a_kerb_and_nothing_else() {
         // The step lies between 39 and 40; the foot, the rise out of the groove, between
-        // 31 and 32 (the largest g = I(x + 1) − I(x − 1) of the step's sign is at 32).
+        // 31 and 32 (g = I(x + 1) − I(x − 1) is 11 at both: the vertex is their middle).
         let kerb = kerb_row();
-        assert_eq!(kerb_foot(&kerb, 39.5, 1, 12), Some(32.0 - 39.5));
-        // Mirrored: a left-hand kerb, the road to the right.
+        assert_eq!(kerb_foot(&kerb, 39.5, 1, 12), Some(31.5 - 39.5));
+        // Mirrored: a left-hand kerb, the road to the right; the same foot, mirrored.
         let mirrored: Vec<u8> = kerb.iter().rev().copied().collect();
-        assert_eq!(kerb_foot(&mirrored, 19.5, -1, 12), Some(27.0 - 19.5));
+        assert_eq!(kerb_foot(&mirrored, 19.5, -1, 12), Some(27.5 - 19.5));
         // A lighter face (no groove) rising from a darker road: the foot is that rise.
         let mut face = vec![85u8; 60];
         face[32..40].fill(104);
         face[40..].fill(150);
-        assert_eq!(kerb_foot(&face, 39.5, 1, 12), Some(32.0 - 39.5));
+        assert_eq!(kerb_foot(&face, 39.5, 1, 12), Some(31.5 - 39.5));
+        // A blurred edge: the vertex of σ·g, between the columns.
+        let mut soft = kerb_row();
+        soft[31] = 47;
+        soft[32] = 52;
+        let t = kerb_foot(&soft, 39.5, 1, 12).expect("a foot");
+        assert!((t - (31.5 - 39.5)).abs() < 0.5, "{t}");
+        // The estimate outside the row: nothing read.
+        assert_eq!(kerb_foot(&kerb, -1.0, 1, 12), None);
+        assert_eq!(kerb_foot(&kerb, f64::NAN, 1, 12), None);
         // A plain step (no face), a painted mark 8 px wide, a tape 20 px wide (< 2·w_max)
         // with a groove beside it, a low step, a face as bright as the pavement: no kerb.
         let mut step = vec![55u8; 60];
@@ -235,6 +330,18 @@ mod tests {
         let mut strong = kerb_row();
         strong[40..].fill(200);
         assert_eq!(kerb_foot(&strong, 39.5, 1, 12), None);
+        // A blurred plain step, on either side: its tail is no foot (no face between).
+        for (sigma_px, contrast) in [(1.5, 45.0), (2.0, 70.0), (3.0, 90.0)] {
+            let blurred: Vec<u8> = (0..60)
+                .map(|x| {
+                    let z = (f64::from(x) - 39.5) / sigma_px;
+                    (55.0 + contrast / (1.0 + (-1.7 * z).exp())).round() as u8
+                })
+                .collect();
+            assert_eq!(kerb_foot(&blurred, 39.5, 1, 12), None, "σ {sigma_px}");
+            let mirrored: Vec<u8> = blurred.iter().rev().copied().collect();
+            assert_eq!(kerb_foot(&mirrored, 19.5, -1, 12), None, "σ {sigma_px}");
+        }
     }
 
     #[test]
@@ -244,17 +351,17 @@ mod tests {
             .map(|k| (f64::from(k), 1.0 + 0.1 * f64::from(k)))
             .collect();
         rows[4].1 += 6.0;
-        let ((a, b), n) = line_fit(&rows, None).expect("a fit");
+        let ((a, b), n) = line_fit(&rows, None, 1.5).expect("a fit");
         assert_eq!(n, 10);
         assert!((a - 1.0).abs() > 0.1, "the first fit takes every row");
-        let ((a, b2), n) = line_fit(&rows, Some((a, b))).expect("a fit");
+        let ((a, b2), n) = line_fit(&rows, Some((a, b)), 1.5).expect("a fit");
         assert_eq!(n, 9, "the row 6 px off is dropped");
         assert!(
             (a - 1.0).abs() < 1e-9 && (b2 - 0.1).abs() < 1e-9,
             "{a} {b2}"
         );
         assert_eq!(
-            line_fit(&rows[..1], None),
+            line_fit(&rows[..1], None, 1.5),
             None,
             "one row does not fix a line"
         );

@@ -42,7 +42,8 @@ pub enum LaneState {
     /// Updated from this frame's points (or initialised on this frame).
     Tracking,
     /// Too few points (or a gated update) this frame, for fewer than
-    /// `track.lost_after_frames` frames in a row: the reported coefficients are the prediction.
+    /// `track.lost_after_frames` frames in a row: the reported coefficients are the prediction
+    /// (shifted to a kerb's foot where the lane has one, `init.kerb_foot`).
     Coasting,
     /// Too many missed frames in a row: no coefficients are reported and the lane is
     /// re-initialised (Hough + LS over the whole region of interest) every frame until it is found.
@@ -172,6 +173,8 @@ struct Lane {
     /// kerb's foot from its top edge (`init.kerb_foot`); zero otherwise. Set after an
     /// initialisation, kept while the filter tracks that edge, cleared by the next one.
     kerb_offset_px: [f64; 2],
+    /// Tracked frames in a row on which the kerb behind `kerb_offset_px` was not read again.
+    kerb_misses: u32,
     updated_now: bool,
     fresh: bool,
 }
@@ -230,7 +233,9 @@ pub struct InitCandidate {
     pub chosen: Option<Side>,
 }
 
-/// What an overlay needs of one lane: its windows, its points and its estimate.
+/// What an overlay needs of one lane: its windows, its points and its estimate. The windows
+/// and the points are those of the edge the filter tracks; on a kerb (`init.kerb_foot`) the
+/// reported boundary lies on the kerb's foot, a few pixels from them.
 #[derive(Debug, Clone, Copy)]
 pub struct LaneView<'a> {
     /// The lane's report for the last frame.
@@ -338,6 +343,7 @@ impl LaneTracker {
             initialised_now: false,
             found_in_fallback: false,
             kerb_offset_px: [0.0; 2],
+            kerb_misses: 0,
             updated_now: false,
             fresh: false,
         };
@@ -417,6 +423,7 @@ impl LaneTracker {
             lane.filter = None;
             lane.predicted = None;
             lane.kerb_offset_px = [0.0; 2];
+            lane.kerb_misses = 0;
             lane.misses = 0;
             lane.points.clear();
             lane.weights.clear();
@@ -437,7 +444,9 @@ impl LaneTracker {
 
     /// Covariance of one lane's reported coefficients `(a1, a2, a3)` in the pixel
     /// parameterisation (entry `(i, j)` in units of `a_i·a_j`), `None` when the lane has no
-    /// estimate (initialising or lost) or its information matrix cannot be inverted.
+    /// estimate (initialising or lost) or its information matrix cannot be inverted. A kerb's
+    /// offset (`init.kerb_foot`) is added to the reported coefficients as an exact shift: the
+    /// covariance is the tracked edge's.
     ///
     /// KIF: `P_px = T·Y_u⁻¹·Tᵀ`, the inverse of the information matrix the filter propagates in
     /// the normalised rows `u = (y − y_c)/s`, mapped by the exact linear map `T` between the
@@ -522,6 +531,9 @@ impl LaneTracker {
             lane.points_now = 0;
             if lane.has_estimate() {
                 self.track_lane(i, &image, true)?;
+                if self.lanes[i].has_estimate() {
+                    self.recheck_kerb_foot(i, &image);
+                }
             } else {
                 lane.spans.fill(ColSpan::EMPTY);
                 lane.points.clear();

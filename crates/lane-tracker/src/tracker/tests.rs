@@ -317,32 +317,40 @@ fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
 }
 
 /// `two_marks`' left mark, and on the right a raised kerb: the road (55) up to a groove (45)
-/// 2 px wide at the foot `right(y) − f(y)`, the face (55) from the foot to the top edge
-/// `right(y)`, the pavement (100) beyond it (the levels of a real one: the groove's edges stay
-/// below the gradient threshold); the face `f` widens towards the camera as on a
-/// real kerb (5 → 9 px over the ROI). `plain`: the same step with no face and no groove.
-fn kerb_right(w: usize, h: usize, plain: bool) -> GreyFrame {
+/// 2 px wide at the foot `kerb_foot_col(y)`, the face (55) from the foot to the top edge
+/// `kerb_top(y)`, the pavement (100) beyond it, each pixel the area average of what it covers
+/// (the levels and the soft edges of a real kerb: the groove's edges stay below the gradient
+/// threshold); the face widens towards the camera as on a real kerb (5 → 9 px over the ROI),
+/// `extra_px` wider still. `plain`: the same step with no face and no groove. Positions are
+/// continuous, pixel `x` covering `[x, x + 1)`: an edge at `e` lies between the pixels
+/// around `e − ½` in the tracker's column coordinates.
+fn kerb_right(w: usize, h: usize, plain: bool, extra_px: f64) -> GreyFrame {
     let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let overlap = |x: f64, a: f64, b: f64| (b.min(x + 1.0) - a.max(x)).clamp(0.0, 1.0);
     let mut pixels = vec![55u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
-        let (top, foot) = (kerb_top(y), kerb_foot_col(y));
-        if (x - left(y)).abs() < 2.5 {
-            *p = 200;
-        } else if x >= top {
-            *p = 100;
-        } else if !plain && x >= foot - 2.0 && x < foot {
-            *p = 45;
-        }
+        let (top, foot) = (kerb_top(y), kerb_foot_col(y, extra_px));
+        let pavement = overlap(x, top, f64::INFINITY);
+        let groove = if plain {
+            0.0
+        } else {
+            overlap(x, foot - 2.0, foot)
+        };
+        *p = if (x - left(y)).abs() < 2.5 {
+            200
+        } else {
+            (55.0 + 45.0 * pavement - 10.0 * groove).round() as u8
+        };
     }
     GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
 }
 fn kerb_top(y: f64) -> f64 {
-    (230.0 + 0.45 * (y - 239.0)).round()
+    230.0 + 0.45 * (y - 239.0)
 }
-/// The foot's column: the face starts there, the groove ends just before it.
-fn kerb_foot_col(y: f64) -> f64 {
-    kerb_top(y) - (5.0 + 4.0 * (y - 140.0) / 100.0).round()
+/// The foot's column: the face starts there, the groove ends there.
+fn kerb_foot_col(y: f64, extra_px: f64) -> f64 {
+    kerb_top(y) - (5.0 + extra_px + 4.0 * (y - 140.0) / 100.0)
 }
 
 #[test]
@@ -359,23 +367,25 @@ fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
         let c = c.expect("a right lane");
         c[0] * y * y + c[1] * y + c[2]
     };
-    let off_foot = |c: Option<[f64; 3]>, y: f64| col(c, y) - (kerb_foot_col(y) - 0.5);
+    let off_foot = |c: Option<[f64; 3]>, y: f64| col(c, y) - (kerb_foot_col(y, 0.0) - 0.5);
     fn image(f: &GreyFrame) -> GreyImage<'_> {
         GreyImage::new(f.data(), 320, 240, 320).expect("an image")
     }
-    // Without the rule the lane lies between the top edge (the step between top − 1 and
-    // top) and the groove (its corners on the rendered staircase pass the threshold), off the
-    // foot.
-    let kerb = kerb_right(320, 240, false);
+    // Without the rule the lane lies on the top edge (within a pixel of `kerb_top − ½`), off
+    // the foot.
+    let kerb = kerb_right(320, 240, false, 0.0);
     tracker.track(&kerb).expect("a frame");
     let on_top = tracked(&tracker);
     assert_eq!(reported(&tracker), on_top);
     for y in rows {
-        let d = off_foot(on_top, y);
-        assert!(d > 2.0, "row {y}: the lane is {d} px from the foot");
+        let d = col(on_top, y) - (kerb_top(y) - 0.5);
+        assert!(
+            d.abs() < 1.0,
+            "row {y}: the lane is {d} px off the top edge"
+        );
     }
     // A plain step is not a kerb: nothing moves.
-    let plain = kerb_right(320, 240, true);
+    let plain = kerb_right(320, 240, true, 0.0);
     assert!(!tracker.onto_kerb_foot(1, &image(&plain)));
     assert_eq!(reported(&tracker), on_top);
     // Read across the kerb, the boundary reported moves to its foot (the rise out of the
@@ -409,9 +419,50 @@ fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
         let l = report.lanes[0].col_at_row(y).expect("a left lane") - (100.0 - 0.45 * (y - 239.0));
         assert!(l.abs() < 1.5, "row {y}: the left lane {l} px off its mark");
     }
-    // A new initialisation reads its own kerb: on the plain step, none.
+    // Tracked on while the face widens by 2 px: the kerb is read again and the offset follows.
+    let wider = kerb_right(320, 240, false, 2.0);
+    for frame in 0..3 {
+        let report = tracker.track(&wider).expect("a frame");
+        assert!(!report.lanes[1].initialised);
+        for y in rows {
+            let d = report.lanes[1].col_at_row(y).expect("a right lane")
+                - (kerb_foot_col(y, 2.0) - 0.5);
+            assert!(
+                d.abs() < 1.5,
+                "frame {frame}, row {y}: {d} px off the wider foot"
+            );
+        }
+    }
+    // The kerb ends (a plain step): the offset outlasts a gap shorter than
+    // `track.lost_after_frames`, then goes, and the lane is reported on the edge it tracks.
+    let lost_after = default.track.lost_after_frames;
+    let bottom_row = rows[2];
+    for frame in 1..=lost_after {
+        let report = tracker.track(&plain).expect("a frame");
+        assert!(!report.lanes[1].initialised);
+        let d = report.lanes[1]
+            .col_at_row(bottom_row)
+            .expect("a right lane")
+            - (kerb_top(bottom_row) - 0.5);
+        if frame < lost_after {
+            assert!(
+                d < -5.0,
+                "frame {frame}: {d} px from the step, the offset dropped early"
+            );
+        } else {
+            assert!(d.abs() < 1.5, "frame {frame}: {d} px off the plain step");
+        }
+    }
+    // A new initialisation reads its own kerb (the last one's offset does not survive it):
+    // lost on the kerb, re-initialised on the plain step.
+    tracker.track(&kerb).expect("a frame");
     tracker.reset();
+    let report = tracker.track(&kerb).expect("a frame");
+    assert!(report.lanes[1].initialised);
+    assert_ne!(tracker.lanes[1].kerb_offset_px, [0.0; 2]);
+    tracker.lanes[1].state = LaneState::Lost;
     let report = tracker.track(&plain).expect("a frame");
+    assert!(report.lanes[1].initialised);
     for y in rows {
         let d = report.lanes[1].col_at_row(y).expect("a right lane") - (kerb_top(y) - 0.5);
         assert!(d.abs() < 1.5, "row {y}: {d} px off the plain step");

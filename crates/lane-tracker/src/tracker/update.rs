@@ -124,7 +124,9 @@ impl LaneTracker {
 
     /// Left and right lanes may not cross at the top ROI row, nor come closer than
     /// `min_lane_separation_px` at the middle and bottom ROI rows. The offending estimate is the one that changed on this
-    /// frame by initialisation, else the one backed by fewer points; it is undone.
+    /// frame by initialisation, else the one backed by fewer points; it is undone. The gate
+    /// compares the edges the filters track: a kerb's offset (`init.kerb_foot`, at most
+    /// `gradient.stripe_max_width_px + 1` px towards the road) is not part of it.
     pub(super) fn crossing_gate(&mut self) {
         let [l, r] = &self.lanes;
         let (Some(lf), Some(rf)) = (l.filter.as_ref(), r.filter.as_ref()) else {
