@@ -161,9 +161,9 @@
 //!   the same refinement (when the double line did not move the lane), the image is read across
 //!   the estimate row by row; where the estimate lies on a step to a pavement wider than twice
 //!   any mark, with a band of the inner level (the kerb's face) on the road side ending in a
-//!   weaker edge of the same polarity 3 to `gradient.stripe_max_width_px` px away (the rise out
-//!   of the groove at the foot, or onto a lighter face), consistently over at least 30 % of the
-//!   rows, the boundary reported moves to that foot (a shift linear in the row), where the
+//!   weaker edge of the same polarity `max(3, w_max/4)` to `w_max` px away (`w_max =
+//!   gradient.stripe_max_width_px`, 12 in the default; the rise out of the groove at the foot,
+//!   or onto a lighter face), consistently over at least 30 % of the rows, the boundary reported moves to that foot (a shift linear in the row), where the
 //!   road ends and lane labels put the boundary; the filter keeps tracking the top edge its
 //!   windows measure; on tracked frames the kerb is read again on every eighth row and the
 //!   shift follows it, or is dropped after `track.lost_after_frames` frames without a kerb.

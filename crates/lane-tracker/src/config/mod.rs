@@ -40,7 +40,8 @@ pub struct GradientConfig {
     /// keep only edge pixels that pair, along their row, with an edge of the same class and the
     /// opposite polarity within this many columns (rising on the left, falling on the right:
     /// the two sides of a bright mark), px, 0..=200; 0 (default when absent) keeps every edge
-    /// pixel (the paper).
+    /// pixel (the paper). Also the widest mark and the widest kerb face for `init.kerb_foot`,
+    /// which needs at least 4 px.
     #[serde(default)]
     pub stripe_max_width_px: u16,
     /// With stripe pairing that drops unpaired pixels (`stripe_paired_votes = 0`): also keep
@@ -516,7 +517,7 @@ impl TrackerConfig {
             !self.init.kerb_foot || g.stripe_max_width_px >= 4,
             "init.kerb_foot",
             self.init.kerb_foot,
-            "needs gradient.stripe_max_width_px ≥ 4 px (a kerb's face is read from 3 px up to it)",
+            "needs gradient.stripe_max_width_px ≥ 4 px (a kerb's face is read up to it)",
         )?;
         check(
             g.stripe_paired_votes <= 4,
@@ -636,8 +637,9 @@ impl TrackerConfig {
 
     /// Multiply every pixel-valued parameter by `k` (> 0): the presets are tuned for 320-px-wide
     /// frames, so a 1280-px frame takes `k = 4`. Scaled: window and inlier half-widths, jump
-    /// gate, lane separation, Hough band and candidate separation, stripe width, R, Q and P0 standard deviations. Not scaled: the
-    /// gradient threshold (grey levels), fractions, angles, counts.
+    /// gate, lane separation, Hough band and candidate separation, stripe width (at least 4 px
+    /// with `init.kerb_foot`, which reads a kerb's face within it), R, Q and P0 standard
+    /// deviations. Not scaled: the gradient threshold (grey levels), fractions, angles, counts.
     pub fn scale_pixels(&mut self, k: f64) {
         let t = &mut self.track;
         t.window_half_width_px = ((t.window_half_width_px as f64 * k).round() as usize).max(1);
@@ -650,6 +652,10 @@ impl TrackerConfig {
         self.init.candidate_separation_px *= k;
         let g = &mut self.gradient;
         g.stripe_max_width_px = (f64::from(g.stripe_max_width_px) * k).round().min(200.0) as u16;
+        if self.init.kerb_foot {
+            // The kerb's reading needs a face range (validated ≥ 4 px).
+            g.stripe_max_width_px = g.stripe_max_width_px.max(4);
+        }
         let f = &mut self.filter;
         f.r_sigma_px *= k;
         f.q_sigma_px = f.q_sigma_px.map(|q| q * k);

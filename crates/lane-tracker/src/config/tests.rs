@@ -245,3 +245,28 @@ fn the_second_search_rows_run_from_their_fraction_to_the_roi_bottom_and_are_off_
         .expect("the default searches again");
     assert!(tall_top < top && tall_bottom == bottom);
 }
+
+#[test]
+fn the_kerb_reading_needs_a_face_range_and_keeps_it_when_scaled() {
+    let mut cfg = TrackerConfig::default_preset().unwrap();
+    assert!(cfg.init.kerb_foot);
+    cfg.gradient.stripe_max_width_px = 4;
+    cfg.validate().unwrap();
+    cfg.gradient.stripe_max_width_px = 3;
+    assert!(matches!(
+        cfg.validate(),
+        Err(TrackerError::ConfigField {
+            field: "init.kerb_foot",
+            ..
+        })
+    ));
+    // A small frame: 12 px × 0.2 would round to 2; with the kerb reading it stays at 4.
+    let mut small = TrackerConfig::default_preset().unwrap();
+    small.scale_pixels(0.2);
+    assert_eq!(small.gradient.stripe_max_width_px, 4);
+    small.validate().unwrap();
+    small.init.kerb_foot = false;
+    small.gradient.stripe_max_width_px = 12;
+    small.scale_pixels(0.2);
+    assert_eq!(small.gradient.stripe_max_width_px, 2);
+}

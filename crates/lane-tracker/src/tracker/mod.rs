@@ -171,7 +171,9 @@ struct Lane {
     found_in_fallback: bool,
     /// `[α, β]`: the boundary reported lies `α + β·y` px from the edge the filter tracks — a
     /// kerb's foot from its top edge (`init.kerb_foot`); zero otherwise. Set after an
-    /// initialisation, kept while the filter tracks that edge, cleared by the next one.
+    /// initialisation, read again on each tracked frame and dropped after
+    /// `track.lost_after_frames` frames without a kerb; cleared by the next initialisation. A
+    /// kerb that appears later is not picked up until the lane is initialised again.
     kerb_offset_px: [f64; 2],
     /// Tracked frames in a row on which the kerb behind `kerb_offset_px` was not read again.
     kerb_misses: u32,
@@ -282,7 +284,8 @@ pub struct LaneTracker {
     row_start: Vec<u32>,
     row_next: Vec<u32>,
     scratch: Vec<Candidate>,
-    /// The rows' kerb feet `(row, offset)` read by `onto_kerb_foot` (capacity: the height).
+    /// The rows' kerb feet `(row, offset)` read by `onto_kerb_foot` and `recheck_kerb_foot`
+    /// (capacity: the height).
     kerb_rows: Vec<(f64, f64)>,
     row_norm: RowNorm,
     q: ProcessNoise<3>,
@@ -445,7 +448,8 @@ impl LaneTracker {
     /// Covariance of one lane's reported coefficients `(a1, a2, a3)` in the pixel
     /// parameterisation (entry `(i, j)` in units of `a_i·a_j`), `None` when the lane has no
     /// estimate (initialising or lost) or its information matrix cannot be inverted. A kerb's
-    /// offset (`init.kerb_foot`) is added to the reported coefficients as an exact shift: the
+    /// offset (`init.kerb_foot`) is added to the reported coefficients as a shift whose own
+    /// uncertainty (it is re-measured on each frame from a few rows) is not included: the
     /// covariance is the tracked edge's.
     ///
     /// KIF: `P_px = T·Y_u⁻¹·Tᵀ`, the inverse of the information matrix the filter propagates in
@@ -531,9 +535,6 @@ impl LaneTracker {
             lane.points_now = 0;
             if lane.has_estimate() {
                 self.track_lane(i, &image, true)?;
-                if self.lanes[i].has_estimate() {
-                    self.recheck_kerb_foot(i, &image);
-                }
             } else {
                 lane.spans.fill(ColSpan::EMPTY);
                 lane.points.clear();
@@ -577,6 +578,13 @@ impl LaneTracker {
             }
         }
         self.crossing_gate();
+        // A kerb is read again against the tracked lanes' final estimates (after the crossing
+        // gate, which may undo an update).
+        for i in 0..2 {
+            if self.lanes[i].has_estimate() && !self.lanes[i].initialised_now {
+                self.recheck_kerb_foot(i, &image);
+            }
+        }
         Ok(TrackReport {
             lanes: [self.lanes[0].report(), self.lanes[1].report()],
             full_gradient: need_init,

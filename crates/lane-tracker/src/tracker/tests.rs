@@ -436,6 +436,7 @@ fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
     // The kerb ends (a plain step): the offset outlasts a gap shorter than
     // `track.lost_after_frames`, then goes, and the lane is reported on the edge it tracks.
     let lost_after = default.track.lost_after_frames;
+    assert!(lost_after >= 2, "a gap shorter than the drop is tested");
     let bottom_row = rows[2];
     for frame in 1..=lost_after {
         let report = tracker.track(&plain).expect("a frame");
@@ -454,8 +455,8 @@ fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
         }
     }
     // A new initialisation reads its own kerb (the last one's offset does not survive it):
-    // lost on the kerb, re-initialised on the plain step.
-    tracker.track(&kerb).expect("a frame");
+    // initialised on the kerb, then lost (as after `lost_after_frames` misses), re-initialised
+    // on the plain step.
     tracker.reset();
     let report = tracker.track(&kerb).expect("a frame");
     assert!(report.lanes[1].initialised);
@@ -466,5 +467,26 @@ fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
     for y in rows {
         let d = report.lanes[1].col_at_row(y).expect("a right lane") - (kerb_top(y) - 0.5);
         assert!(d.abs() < 1.5, "row {y}: {d} px off the plain step");
+    }
+    // Mirrored (a left-hand kerb, the mark on the right): the left lane is reported on the
+    // kerb's foot, column c mapping to 319 − c.
+    let mirrored = GreyFrame::from_vec(
+        320,
+        240,
+        kerb.data()
+            .chunks(320)
+            .flat_map(|row| row.iter().rev().copied())
+            .collect(),
+    )
+    .expect("a whole frame");
+    let mut tracker = LaneTracker::new(&default, Estimator::Kif, 320, 240).expect("a tracker");
+    let report = tracker.track(&mirrored).expect("a frame");
+    for y in rows {
+        let d = report.lanes[0].col_at_row(y).expect("a left lane")
+            - (319.0 - (kerb_foot_col(y, 0.0) - 0.5));
+        assert!(
+            d.abs() < 1.0,
+            "row {y}: the left lane {d} px off the mirrored foot"
+        );
     }
 }
