@@ -24,8 +24,11 @@
 //! partner, on the same side in at least five rows of six. Its estimate then moves to the
 //! middle of the pair: `t(y) ≈ α + β·y` by least squares over the rows of that side (the gap
 //! widens towards the camera, linearly in `y` on a straight road) and
-//! `x(y) = x̂(y) + α + β·y`, i.e. `(a1, a2 + β, a3 + α)`; the filter restarts from it. No
-//! allocation.
+//! `x(y) = x̂(y) + α + β·y`, i.e. `(a1, a2 + β, a3 + α)`; the filter restarts from it. Its
+//! tracking windows then reach at least `2·max|α + β·y|` (twice the half gap at the widest
+//! row) to each side, so that they hold both lines: with windows that clip the far edge of one
+//! line the estimate drifts onto the other within a few frames (≈ 6 px off the middle on the
+//! rendered double line with ±10 px windows). No allocation.
 
 use hough_init::Parabola;
 use nalgebra::Vector3;
@@ -174,9 +177,12 @@ impl LaneTracker {
             return false;
         };
         let theta = Vector3::new(p.a1, p.a2 + beta, p.a3 + alpha);
+        let half_gap = |y: usize| (alpha + beta * y as f64).abs();
         match self.new_filter(&theta) {
             Ok(filter) => {
-                self.lanes[i].filter = Some(filter);
+                let lane = &mut self.lanes[i];
+                lane.filter = Some(filter);
+                lane.pair_half_gap_px = half_gap(top).max(half_gap(bottom - 1));
                 true
             }
             Err(e) => {

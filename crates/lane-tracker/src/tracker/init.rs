@@ -543,6 +543,7 @@ impl LaneTracker {
         lane.fresh = true;
         lane.kerb_offset_px = [0.0; 2];
         lane.kerb_misses = 0;
+        lane.pair_half_gap_px = 0.0;
         lane.state = LaneState::Tracking;
         lane.misses = 0;
         lane.rows = [init.rows_px.0, init.rows_px.1];

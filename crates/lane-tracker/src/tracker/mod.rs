@@ -177,6 +177,11 @@ struct Lane {
     kerb_offset_px: [f64; 2],
     /// Tracked frames in a row on which the kerb behind `kerb_offset_px` was not read again.
     kerb_misses: u32,
+    /// Half the distance between the two lines of the double line the lane was centred on
+    /// (`init.double_line_middle`: the largest shift over the rows, px), 0 otherwise. Its
+    /// tracking windows reach at least twice as far, so that they hold both lines; cleared by
+    /// the next initialisation.
+    pair_half_gap_px: f64,
     updated_now: bool,
     fresh: bool,
 }
@@ -347,6 +352,7 @@ impl LaneTracker {
             found_in_fallback: false,
             kerb_offset_px: [0.0; 2],
             kerb_misses: 0,
+            pair_half_gap_px: 0.0,
             updated_now: false,
             fresh: false,
         };
@@ -427,6 +433,7 @@ impl LaneTracker {
             lane.predicted = None;
             lane.kerb_offset_px = [0.0; 2];
             lane.kerb_misses = 0;
+            lane.pair_half_gap_px = 0.0;
             lane.misses = 0;
             lane.points.clear();
             lane.weights.clear();

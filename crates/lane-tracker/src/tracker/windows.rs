@@ -4,19 +4,30 @@
 use hough_init::Parabola;
 use vision_gradient::ColSpan;
 
+use super::points::MAX_WINDOW_HALF_WIDTH;
 use super::{LaneFilter, LaneState, LaneTracker};
 use crate::error::FilterFailure;
 
 impl LaneTracker {
-    /// Window half-width, px: `track.window_half_width_px` while tracking (`predict`); the
-    /// refinement of a fresh initialisation may take a wider one
+    /// Lane `i`'s window half-width, px: `track.window_half_width_px` while tracking
+    /// (`predict`); the refinement of a fresh initialisation may take a wider one
     /// (`track.refine_window_half_width_px`: the Hough line can sit a few pixels off the mark).
-    pub(super) fn window_half_width(&self, predict: bool) -> i64 {
-        if predict {
-            self.cfg.track.window_half_width_px as i64
+    /// A lane on the middle of a double line takes at least twice its half gap, so that its
+    /// windows hold both lines (`double_line` module docs); at most
+    /// `points::MAX_WINDOW_HALF_WIDTH`.
+    pub(super) fn window_half_width(&self, i: usize, predict: bool) -> i64 {
+        let base = if predict {
+            self.cfg.track.window_half_width_px
         } else {
-            self.cfg.track.refine_window_half_width() as i64
-        }
+            self.cfg.track.refine_window_half_width()
+        };
+        let pair = (2.0 * self.lanes[i].pair_half_gap_px).ceil();
+        let pair = if pair.is_finite() && pair > 0.0 {
+            pair as usize
+        } else {
+            0
+        };
+        base.max(pair).min(MAX_WINDOW_HALF_WIDTH) as i64
     }
 
     /// Time update of lane `i` (KIF eq. 24 when `predict`; WRLS forgets once per frame in its
@@ -25,7 +36,7 @@ impl LaneTracker {
     /// [`LaneTracker::last_filter_error`], and the lane is lost).
     pub(super) fn predict_windows(&mut self, i: usize, predict: bool) -> Option<[f64; 3]> {
         let (top, bottom) = self.search_rows;
-        let w = self.window_half_width(predict);
+        let w = self.window_half_width(i, predict);
         let lane = &mut self.lanes[i];
         let filter = lane.filter.as_mut()?;
         let predicted = match filter {
