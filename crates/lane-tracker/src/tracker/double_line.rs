@@ -41,10 +41,11 @@ const MIN_CONTRAST: f64 = 20.0;
 /// Least fraction of the rows searched that must show the pair.
 const MIN_ROW_FRACTION: f64 = 0.3;
 
-/// Least-squares sums of `t(y) = α + β·y` over the rows of one side.
+/// Least-squares sums of `t(y) = α + β·y` over rows (here those of one side of a double line;
+/// the kerb's feet too).
 #[derive(Default, Clone, Copy)]
-struct LineSums {
-    rows: usize,
+pub(super) struct LineSums {
+    pub(super) rows: usize,
     y: f64,
     yy: f64,
     t: f64,
@@ -52,7 +53,7 @@ struct LineSums {
 }
 
 impl LineSums {
-    fn add(&mut self, y: f64, t: f64) {
+    pub(super) fn add(&mut self, y: f64, t: f64) {
         self.rows += 1;
         self.y += y;
         self.yy += y * y;
@@ -61,7 +62,7 @@ impl LineSums {
     }
 
     /// `(α, β)`, `None` if the rows do not determine them.
-    fn fit(&self) -> Option<(f64, f64)> {
+    pub(super) fn fit(&self) -> Option<(f64, f64)> {
         let n = self.rows as f64;
         let det = n * self.yy - self.y * self.y;
         if self.rows < 2 || det.abs() < 1e-9 {

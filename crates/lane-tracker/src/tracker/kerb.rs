@@ -53,6 +53,7 @@ use hough_init::Parabola;
 use vision_gradient::GreyImage;
 
 use super::LaneTracker;
+use super::double_line::LineSums;
 
 /// Least grey-level difference across the step.
 const MIN_STEP_CONTRAST: f64 = 20.0;
@@ -161,24 +162,13 @@ fn line_fit(
     fit: Option<(f64, f64)>,
     inlier_px: f64,
 ) -> Option<((f64, f64), usize)> {
-    let (mut n, mut sy, mut syy, mut st, mut sty) = (0usize, 0.0, 0.0, 0.0, 0.0);
+    let mut sums = LineSums::default();
     for &(y, t) in rows {
-        if fit.is_some_and(|(a, b)| (t - a - b * y).abs() > inlier_px) {
-            continue;
+        if !fit.is_some_and(|(a, b)| (t - a - b * y).abs() > inlier_px) {
+            sums.add(y, t);
         }
-        n += 1;
-        sy += y;
-        syy += y * y;
-        st += t;
-        sty += t * y;
     }
-    let nf = n as f64;
-    let det = nf * syy - sy * sy;
-    if n < 2 || det.abs() < 1e-9 {
-        return None;
-    }
-    let beta = (nf * sty - sy * st) / det;
-    Some((((st - beta * sy) / nf, beta), n))
+    Some((sums.fit()?, sums.rows))
 }
 
 impl LaneTracker {
