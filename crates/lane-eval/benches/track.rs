@@ -102,53 +102,35 @@ fn tracking_frame(c: &mut Criterion) {
                 black_box(tracker.track(black_box(frame)).unwrap())
             });
         });
-        // The worst initialisation frame of the default: the right half of the ROI blanked, so
-        // that the right side is searched for again over the taller rows
-        // (`roi.fallback_top_row_fraction`).
+        // The worst initialisation frames of the default: the ROI's right half blanked, so that
+        // the right side is searched for again over the taller rows
+        // (`roi.fallback_top_row_fraction`), and the whole ROI blanked, both bands voting there.
         let (top, bottom) = tracker.roi_rows();
-        let mut one_side = frame.clone();
-        let w = one_side.width();
-        let fill = one_side.data()[top * w];
-        for row in one_side.data_mut()[top * w..bottom * w].chunks_mut(w) {
-            row[w / 2..].fill(fill);
+        let w = frame.width();
+        let fill = frame.data()[top * w];
+        for (case, from_col) in [
+            ("init_frame_default_second_search", w / 2),
+            ("init_frame_default_second_search_both", 0),
+        ] {
+            let mut blanked = frame.clone();
+            for row in blanked.data_mut()[top * w..bottom * w].chunks_mut(w) {
+                row[from_col..].fill(fill);
+            }
+            tracker.reset();
+            let r = tracker.track(&blanked).unwrap();
+            println!(
+                "{name}, ROI blanked from column {from_col} (ROI from row {top}): {} candidates, lanes {:?} / {:?}",
+                tracker.init_candidates().len(),
+                r.lanes[0].state,
+                r.lanes[1].state
+            );
+            group.bench_function(BenchmarkId::new(case, name), |b| {
+                b.iter(|| {
+                    tracker.reset();
+                    black_box(tracker.track(black_box(&blanked)).unwrap())
+                });
+            });
         }
-        tracker.reset();
-        let r = tracker.track(&one_side).unwrap();
-        println!(
-            "{name}, right half of the ROI blanked: {} candidates, right lane {:?} on rows {:?} (ROI from row {top})",
-            tracker.init_candidates().len(),
-            r.lanes[1].state,
-            r.lanes[1].rows
-        );
-        group.bench_function(
-            BenchmarkId::new("init_frame_default_second_search", name),
-            |b| {
-                b.iter(|| {
-                    tracker.reset();
-                    black_box(tracker.track(black_box(&one_side)).unwrap())
-                });
-            },
-        );
-        // Both sides missing: the whole ROI blanked, both bands vote over the taller rows.
-        let mut no_side = frame.clone();
-        no_side.data_mut()[top * w..bottom * w].fill(fill);
-        tracker.reset();
-        let r = tracker.track(&no_side).unwrap();
-        println!(
-            "{name}, whole ROI blanked: {} candidates, lanes {:?} / {:?}",
-            tracker.init_candidates().len(),
-            r.lanes[0].state,
-            r.lanes[1].state
-        );
-        group.bench_function(
-            BenchmarkId::new("init_frame_default_second_search_both", name),
-            |b| {
-                b.iter(|| {
-                    tracker.reset();
-                    black_box(tracker.track(black_box(&no_side)).unwrap())
-                });
-            },
-        );
     }
     group.finish();
 }
