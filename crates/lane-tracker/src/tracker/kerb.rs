@@ -67,7 +67,7 @@ const MIN_ROWS: usize = 8;
 /// Least fraction of the rows read inside the image whose foot agrees with the fit.
 const MIN_ROW_FRACTION: f64 = 0.3;
 /// On a tracked frame the kerb is read on every this-many-th row (an eighth of the cost of the
-/// initialisation's reading: ≈ 1.3 µs a kerb lane at 320×240).
+/// initialisation's reading; only for a lane with an offset).
 const TRACKED_ROW_STEP: usize = 8;
 
 /// The step's search radius `r` and the foot's least distance from the step (with step 4's
