@@ -403,26 +403,34 @@ impl HoughWorkspace {
     /// outside the band and beyond the ρ ends counting as zero) and its entry of `row_best`.
     fn smooth_row(&mut self, k: usize, k0: usize, k1: usize) {
         let nr = self.rho_bins;
+        // The θ-direction sum of the (up to) three rows first, into the ring's first row (a
+        // scratch row here; `peak_smoothed` rewrites it), then its ρ-direction 3-sums: the
+        // same integer sums as the 3×3 window, in two passes that vectorise.
+        let column = &mut self.ring[..nr];
+        column.copy_from_slice(&self.acc[k * nr..(k + 1) * nr]);
+        for kk in [
+            k.checked_sub(1).filter(|&kk| kk >= k0),
+            (k < k1).then_some(k + 1),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            for (d, &s) in column.iter_mut().zip(&self.acc[kk * nr..(kk + 1) * nr]) {
+                *d += s;
+            }
+        }
         let out = &mut self.smoothed[k * nr..(k + 1) * nr];
-        out.fill(0);
-        for kk in k.saturating_sub(1).max(k0)..=(k + 1).min(k1) {
-            let src = &self.acc[kk * nr..(kk + 1) * nr];
-            if nr < 2 {
-                out[0] += src[0];
-                continue;
-            }
-            out[0] += src[0] + src[1];
-            for (d, w) in out[1..nr - 1].iter_mut().zip(src.windows(3)) {
-                *d += w[0] + w[1] + w[2];
-            }
-            out[nr - 1] += src[nr - 2] + src[nr - 1];
+        hsum3(column, out);
+        if nr == 1 {
+            out[0] = column[0];
         }
-        let mut best = (0u32, 0usize);
-        for (r, &v) in out.iter().enumerate() {
-            if v > best.0 {
-                best = (v, r);
-            }
-        }
+        // The first largest cell (ties to the lower ρ), as a scan keeping the first maximum.
+        let max = out.iter().copied().max().unwrap_or(0);
+        let best = if max == 0 {
+            (0, 0)
+        } else {
+            (max, out.iter().position(|&v| v == max).unwrap_or(0))
+        };
         self.row_best[k] = best;
     }
 
@@ -749,8 +757,14 @@ fn hsum3(src: &[u32], dst: &mut [u32]) {
         return;
     }
     dst[0] = src[0] + src[1];
-    for (d, w) in dst[1..n - 1].iter_mut().zip(src.windows(3)) {
-        *d = w[0] + w[1] + w[2];
+    // Three shifted slices rather than `windows(3)`: the loop vectorises.
+    for (((d, &a), &b), &c) in dst[1..n - 1]
+        .iter_mut()
+        .zip(&src[..n - 2])
+        .zip(&src[1..n - 1])
+        .zip(&src[2..])
+    {
+        *d = a + b + c;
     }
     dst[n - 1] = src[n - 2] + src[n - 1];
 }

@@ -130,6 +130,18 @@ impl LaneTracker {
         }
     }
 
+    /// The number of pixels [`Self::fill_candidates`] would put in `self.candidates` for
+    /// `class`, without filling it.
+    fn candidate_count(&self, class: EdgeClass) -> usize {
+        let votes = usize::from(self.cfg.gradient.stripe_paired_votes);
+        let paired = if votes > 1 {
+            (votes - 1) * self.paired.iter_class(class).count()
+        } else {
+            0
+        };
+        self.edges.iter_class(class).count() + paired
+    }
+
     /// Joint initialisation (`init.candidate_lines > 0`, crate docs): the strongest
     /// `candidate_lines` Hough lines of each band (each pixel voting near its own edge normal
     /// with `init.orientation_tolerance_deg > 0`), the ego pair chosen among all of them by
@@ -158,12 +170,14 @@ impl LaneTracker {
         let first = self.init_candidates.len();
         for (k, _) in vote.into_iter().enumerate().filter(|&(_, votes)| votes) {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
-            self.fill_candidates(class);
-            if self.candidates.len() < self.init_params.min_points {
+            if self.candidate_count(class) < self.init_params.min_points {
                 continue;
             }
             if self.cfg.init.candidate_coverage || self.cfg.init.orientation_tolerance_deg > 0.0 {
                 self.sort_candidates_by_row(class);
+            }
+            if self.cfg.init.orientation_tolerance_deg <= 0.0 {
+                self.fill_candidates(class); // the plain vote's input
             }
             let (sep_deg, sep_px) = (
                 self.cfg.init.candidate_separation_deg,
@@ -349,7 +363,18 @@ impl LaneTracker {
             return &[];
         };
         let row = self.by_row.get(a as usize..b as usize).unwrap_or(&[]);
-        let from = row.partition_point(|p| f64::from(p.0) < lo);
+        // For an integer column c: c < lo ⟺ c < ⌈lo⌉; the search compares integers.
+        let lo = lo.ceil();
+        let from = if lo.is_nan() {
+            row.len()
+        } else if lo <= 0.0 {
+            0
+        } else if lo > f64::from(u16::MAX) {
+            row.len()
+        } else {
+            let lo = lo as u16; // exact: an integer in 1..=u16::MAX
+            row.partition_point(|p| p.0 < lo)
+        };
         row.get(from..).unwrap_or(&[])
     }
 
