@@ -146,6 +146,8 @@
 //!   found in the ROI kept in the pair as a tracked lane is; the lane is refined over the same
 //!   rows). A dashed mark whose near field falls in the gap between two dashes, or a camera
 //!   tilted down so that a mark is visible only far ahead, is then found where it is. A fit
+//!   needs as many rows as in the first search (a quarter of the ROI's, not of the taller
+//!   rows': a dash far ahead is no longer there than one near the camera). A fit
 //!   whose pixels all lie above the ROI starts as its chord over its rows, `x = a2·y + a3`: it
 //!   is extrapolated down over the ROI, and a short far segment fixes a slope, not a curvature.
 //!   The second search costs a second gradient, vote and choice, on the frames that need it

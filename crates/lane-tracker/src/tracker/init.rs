@@ -517,10 +517,12 @@ impl LaneTracker {
     /// Accept an initialisation of lane `i` (`self.candidates` holds the pixels it was fitted
     /// to): sanity checks, a fresh filter, the lane's state. `false` if refused.
     fn install(&mut self, i: usize, init: &LaneInit) -> bool {
-        let (top, bottom) = self.search_rows;
-        // Sanity: the fit must cover a fair part of the ROI and stay near the image.
+        let bottom = self.search_rows.1;
+        // Sanity: the fit must cover a fair part of the ROI (a quarter of its rows, in the second
+        // search too: a dash seen only over the taller rows is as long as one seen in the ROI)
+        // and stay near the image.
         let span_rows = init.rows_px.1 - init.rows_px.0;
-        let min_span = 0.25 * (bottom - top) as f64;
+        let min_span = 0.25 * (self.roi.1 - self.roi.0) as f64;
         let x_bottom = init.parabola.col_at_row((bottom - 1) as f64);
         let w = self.width as f64;
         if span_rows < min_span || !x_bottom.is_finite() || x_bottom < -w || x_bottom > 2.0 * w {

@@ -203,10 +203,13 @@ fn right(y: f64) -> f64 {
     260.0 + 0.3 * (y - 239.0)
 }
 fn right_mark_above_the_roi(w: usize, h: usize) -> GreyFrame {
+    right_dash_on_rows(w, h, 80.0..140.0)
+}
+fn right_dash_on_rows(w: usize, h: usize, rows: std::ops::Range<f64>) -> GreyFrame {
     let mut pixels = vec![60u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
-        if (x - left(y)).abs() < 2.5 || ((x - right(y)).abs() < 2.5 && (80.0..140.0).contains(&y)) {
+        if (x - left(y)).abs() < 2.5 || ((x - right(y)).abs() < 2.5 && rows.contains(&y)) {
             *p = 200;
         }
     }
@@ -255,6 +258,32 @@ fn a_side_missing_from_the_roi_is_found_by_the_second_search_over_the_taller_row
         .collect();
     assert_eq!(chosen.len(), 1, "{cands:?}");
     assert!(chosen[0] >= first_search, "{cands:?}");
+}
+
+/// The second search asks a lane for as many rows as the first one does (a quarter of the
+/// ROI's rows: 23 of 91 at 240 rows), not a quarter of its own taller rows (42 of 168): a dash
+/// of 30 rows above the ROI is found, one of 16 rows is not.
+#[test]
+fn the_second_search_accepts_a_dash_as_long_as_the_roi_would() {
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let (tall_top, _) = tracker.fallback_roi.expect("a second search");
+    let min_span = 0.25 * (bottom - top) as f64;
+    assert!(30.0 > min_span && 30.0 < 0.25 * (bottom - tall_top) as f64);
+    let report = tracker
+        .track(&right_dash_on_rows(320, 240, 110.0..140.0))
+        .expect("a frame");
+    let r = report.lanes[1];
+    assert!(r.initialised, "the 30-row dash is refused: {r:?}");
+    let err = (r.col_at_row(125.0).expect("a right lane") - right(125.0)).abs();
+    assert!(err < 1.5, "{err} px off the dash");
+    tracker.reset();
+    let report = tracker
+        .track(&right_dash_on_rows(320, 240, 124.0..140.0))
+        .expect("a frame");
+    assert!(16.0 < min_span);
+    assert_eq!(report.lanes[1].coeffs, None, "a 16-row dash is accepted");
 }
 
 /// `left(y) ± s(y)` for the two lines of a double line, `2·h(y)` wide, both growing towards
