@@ -389,10 +389,12 @@ impl HoughWorkspace {
                 let hi = kk * nr + (r + dr).min(nr - 1);
                 self.acc[lo..=hi].fill(0);
             }
-            // Clearing rows ka..=kb changes the 3×3 sums of one more row on each side only.
+            // Clearing rows ka..=kb changes the 3×3 sums of one more row on each side only, and
+            // of one more ρ cell on each side of the cleared ones.
             if smoothing {
+                let (lo, hi) = (r.saturating_sub(dr + 1), (r + dr + 1).min(nr - 1));
                 for kk in ka.saturating_sub(1).max(k0)..=(kb + 1).min(k1) {
-                    self.smooth_row(kk, k0, k1);
+                    self.resmooth_cells(kk, k0, k1, lo, hi);
                 }
             }
         }
@@ -432,6 +434,33 @@ impl HoughWorkspace {
             (max, out.iter().position(|&v| v == max).unwrap_or(0))
         };
         self.row_best[k] = best;
+    }
+
+    /// Cells `lo..=hi` of row `k` of `smoothed` recomputed after a suppression cleared votes
+    /// under them, and the row's best cell kept up to date: the cleared votes only lower these
+    /// sums, so a best cell outside `lo..=hi` stays the first largest; one inside is looked for
+    /// again over the whole row.
+    fn resmooth_cells(&mut self, k: usize, k0: usize, k1: usize, lo: usize, hi: usize) {
+        let nr = self.rho_bins;
+        let (ka, kb) = (k.saturating_sub(1).max(k0), (k + 1).min(k1));
+        for i in lo..=hi {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(nr - 1));
+            let mut sum = 0u32;
+            for kk in ka..=kb {
+                sum += self.acc[kk * nr + a..=kk * nr + b].iter().sum::<u32>();
+            }
+            self.smoothed[k * nr + i] = sum;
+        }
+        let (_, best) = self.row_best[k];
+        if (lo..=hi).contains(&best) {
+            let out = &self.smoothed[k * nr..(k + 1) * nr];
+            let max = out.iter().copied().max().unwrap_or(0);
+            self.row_best[k] = if max == 0 {
+                (0, 0)
+            } else {
+                (max, out.iter().position(|&v| v == max).unwrap_or(0))
+            };
+        }
     }
 
     /// The first largest cell of `smoothed` over the θ bins `k0..=k1` in scan order (θ, then
@@ -622,7 +651,13 @@ impl HoughWorkspace {
         let all = tolerance_deg >= 90.0 || 2 * half + 1 >= nt;
         let (k0i, k1i) = (k0 as i64, k1 as i64);
         // Nearest θ bin of an angle (θ_k = −90° + k·Δθ).
-        let bin = |deg: f64| ((deg + 90.0) / step).round() as i64;
+        // Rounded half away from zero like `f64::round`, by a truncating cast (`round` is a libm
+        // call on the baseline x86-64 target, three a point here).
+        let bin = |deg: f64| {
+            let v = (deg + 90.0) / step;
+            let t = (v.abs() + 0.5) as i64;
+            if v < 0.0 { -t } else { t }
+        };
         for p in points {
             let x = (f64::from(p.col_px) - cx) as f32;
             let y = (f64::from(p.row_px) - cy) as f32;
@@ -640,14 +675,15 @@ impl HoughWorkspace {
                 if a > b {
                     continue;
                 }
-                for k in a as usize..=b as usize {
-                    let (c, s) = (self.cos_over_step[k], self.sin_over_step[k]);
-                    let r = rho_bin(x, y, c, s, offset) as usize;
+                let (a, b) = (a as usize, b as usize);
+                let rows = self.acc[a * nr..(b + 1) * nr].chunks_exact_mut(nr);
+                for ((row, &c), &s) in rows
+                    .zip(&self.cos_over_step[a..=b])
+                    .zip(&self.sin_over_step[a..=b])
+                {
                     // In range by construction (as in `vote`); a bad index is skipped, never
                     // spilled into the next θ row.
-                    if r < nr
-                        && let Some(cell) = self.acc.get_mut(k * nr + r)
-                    {
+                    if let Some(cell) = row.get_mut(rho_bin(x, y, c, s, offset) as usize) {
                         *cell += votes;
                     }
                 }

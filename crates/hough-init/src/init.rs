@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::parabola::fit_impl;
+use crate::parabola::{fit_impl, fit_normalised};
 use crate::{
     AngleBand, HoughError, HoughLine, HoughWorkspace, LaneInitParams, Parabola, PixelPoint,
     PointSet,
@@ -81,21 +81,40 @@ where
     let band_px = params.band_px;
     let (sin_t, cos_t) = line.theta_rad.sin_cos();
     let rho_px = line.rho_px;
-    let mut fit = fit_impl(
-        points.clone(),
-        |x, y| (x * cos_t + y * sin_t - rho_px).abs() <= band_px,
-        params.min_points,
-        PointSet::NearLine,
-    )?;
-    for _ in 0..params.refit_iterations {
-        let p = fit.parabola;
-        fit = fit_impl(
+    let near_line = |x: f64, y: f64| (x * cos_t + y * sin_t - rho_px).abs() <= band_px;
+    // The fits that only select the next one's points skip the residual pass.
+    let fit = if params.refit_iterations == 0 {
+        fit_impl(
+            points.clone(),
+            near_line,
+            params.min_points,
+            PointSet::NearLine,
+        )?
+    } else {
+        let mut p = fit_normalised(
+            points.clone(),
+            &near_line,
+            params.min_points,
+            PointSet::NearLine,
+        )?
+        .parabola()?;
+        for _ in 1..params.refit_iterations {
+            let near = |x: f64, y: f64| (x - p.col_at_row(y)).abs() <= band_px;
+            p = fit_normalised(
+                points.clone(),
+                &near,
+                params.min_points,
+                PointSet::NearParabola,
+            )?
+            .parabola()?;
+        }
+        fit_impl(
             points.clone(),
             |x, y| (x - p.col_at_row(y)).abs() <= band_px,
             params.min_points,
             PointSet::NearParabola,
-        )?;
-    }
+        )?
+    };
     Ok(LaneInit {
         parabola: fit.parabola,
         line,

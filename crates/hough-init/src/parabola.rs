@@ -123,6 +123,88 @@ where
     I::Item: PixelPoint,
     F: Fn(f64, f64) -> bool,
 {
+    let fit = fit_normalised(points.clone(), &keep, min_points, set)?;
+    // Pass 3: residuals, evaluated in the normalised form (better conditioned).
+    let mut ss = 0.0f64;
+    for p in points {
+        let (x, y) = (p.col_px(), p.row_px());
+        if !keep(x, y) {
+            continue;
+        }
+        let r = x - fit.col_at_row(y);
+        ss += r * r;
+    }
+    let rms_residual_px = (ss * fit.inv_n).sqrt();
+    let parabola = fit.parabola()?;
+    if !rms_residual_px.is_finite() {
+        return Err(HoughError::NonFiniteResult {
+            what: "RMS residual",
+        });
+    }
+    Ok(ParabolaFit {
+        parabola,
+        points_used: fit.count,
+        rms_residual_px,
+        rows_px: fit.rows_px,
+    })
+}
+
+/// A least-squares parabola in the normalised row `u = (y − y0)/s` over the kept points' rows:
+/// `x = b0 + b1·u + b2·u²`.
+pub(crate) struct NormalisedFit {
+    b: [f64; 3],
+    y0: f64,
+    inv_s: f64,
+    inv_n: f64,
+    pub(crate) count: usize,
+    pub(crate) rows_px: (f64, f64),
+}
+
+impl NormalisedFit {
+    /// The fitted column at row `y`, evaluated in the normalised form.
+    fn col_at_row(&self, y: f64) -> f64 {
+        let u = (y - self.y0) * self.inv_s;
+        (self.b[2] * u + self.b[1]) * u + self.b[0]
+    }
+
+    /// The coefficients in the pixel convention of eq. 1.
+    ///
+    /// # Errors
+    /// [`HoughError::NonFiniteResult`] naming the first coefficient that overflowed.
+    pub(crate) fn parabola(&self) -> Result<Parabola, HoughError> {
+        let (b, y0, inv_s) = (self.b, self.y0, self.inv_s);
+        let inv_s2 = inv_s * inv_s;
+        let parabola = Parabola {
+            a1: b[2] * inv_s2,
+            a2: b[1] * inv_s - 2.0 * b[2] * y0 * inv_s2,
+            a3: b[0] - b[1] * y0 * inv_s + b[2] * y0 * y0 * inv_s2,
+        };
+        for (what, v) in [
+            ("coefficient a1", parabola.a1),
+            ("coefficient a2", parabola.a2),
+            ("coefficient a3", parabola.a3),
+        ] {
+            if !v.is_finite() {
+                return Err(HoughError::NonFiniteResult { what });
+            }
+        }
+        Ok(parabola)
+    }
+}
+
+/// Passes 1–2 of [`fit_impl`] (range, normal equations), without the residuals: what a fit
+/// that only selects the points of the next one needs.
+pub(crate) fn fit_normalised<I, F>(
+    points: I,
+    keep: &F,
+    min_points: usize,
+    set: PointSet,
+) -> Result<NormalisedFit, HoughError>
+where
+    I: IntoIterator + Clone,
+    I::Item: PixelPoint,
+    F: Fn(f64, f64) -> bool,
+{
     let min_points = min_points.max(3);
     // Pass 1: finiteness, count, row span.
     let mut count = 0usize;
@@ -187,40 +269,12 @@ where
     ];
     let rhs = [sxy[0] * inv_n, sxy[1] * inv_n, sxy[2] * inv_n];
     let b = solve_spd3(&m, &rhs)?;
-
-    // Pass 3: residuals, evaluated in the normalised form (better conditioned).
-    let mut ss = 0.0f64;
-    for p in points {
-        let (x, y) = (p.col_px(), p.row_px());
-        if !keep(x, y) {
-            continue;
-        }
-        let u = (y - y0) * inv_s;
-        let r = x - ((b[2] * u + b[1]) * u + b[0]);
-        ss += r * r;
-    }
-    let rms_residual_px = (ss * inv_n).sqrt();
-
-    let inv_s2 = inv_s * inv_s;
-    let parabola = Parabola {
-        a1: b[2] * inv_s2,
-        a2: b[1] * inv_s - 2.0 * b[2] * y0 * inv_s2,
-        a3: b[0] - b[1] * y0 * inv_s + b[2] * y0 * y0 * inv_s2,
-    };
-    for (what, v) in [
-        ("coefficient a1", parabola.a1),
-        ("coefficient a2", parabola.a2),
-        ("coefficient a3", parabola.a3),
-        ("RMS residual", rms_residual_px),
-    ] {
-        if !v.is_finite() {
-            return Err(HoughError::NonFiniteResult { what });
-        }
-    }
-    Ok(ParabolaFit {
-        parabola,
-        points_used: count,
-        rms_residual_px,
+    Ok(NormalisedFit {
+        b,
+        y0,
+        inv_s,
+        inv_n,
+        count,
         rows_px: (row_min, row_max),
     })
 }

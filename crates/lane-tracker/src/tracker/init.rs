@@ -363,17 +363,16 @@ impl LaneTracker {
             return &[];
         };
         let row = self.by_row.get(a as usize..b as usize).unwrap_or(&[]);
-        // For an integer column c: c < lo ⟺ c < ⌈lo⌉; the search compares integers.
-        let lo = lo.ceil();
-        let from = if lo.is_nan() {
+        // For an integer column c: c < lo ⟺ c < ⌈lo⌉; the search compares integers (⌈lo⌉ by a
+        // truncating cast: `ceil` is a libm call on the baseline x86-64 target).
+        let from = if lo.is_nan() || lo > f64::from(u16::MAX) {
             row.len()
         } else if lo <= 0.0 {
             0
-        } else if lo > f64::from(u16::MAX) {
-            row.len()
         } else {
-            let lo = lo as u16; // exact: an integer in 1..=u16::MAX
-            row.partition_point(|p| p.0 < lo)
+            let t = lo as u16; // ⌊lo⌋ for 0 < lo ≤ u16::MAX
+            let ceil = if f64::from(t) < lo { t + 1 } else { t }; // ≤ u16::MAX: lo ≤ u16::MAX
+            row.partition_point(|p| p.0 < ceil)
         };
         row.get(from..).unwrap_or(&[])
     }
