@@ -96,6 +96,12 @@ pub struct HoughWorkspace {
     smoothed: Vec<u32>,
     /// Per θ bin of `smoothed`: its first largest value and that value's ρ bin.
     row_best: Vec<(u32, usize)>,
+    /// The oriented vote's runs of θ bins, `(x, y, votes)` of their point, sorted by the run's
+    /// first bin (`vote_oriented`), with the index of each first bin's runs and a cursor per
+    /// bin; reserved by [`HoughWorkspace::reserve_oriented_points`].
+    runs: Vec<(f32, f32, u32)>,
+    run_starts: Vec<u32>,
+    run_next: Vec<u32>,
 }
 
 impl core::fmt::Debug for HoughWorkspace {
@@ -193,6 +199,9 @@ impl HoughWorkspace {
             ring: vec![0; 4 * rho_bins],
             smoothed: vec![0; cells],
             row_best: vec![(0, 0); theta_bins],
+            runs: Vec::new(),
+            run_starts: Vec::with_capacity(2 * theta_bins + 2),
+            run_next: Vec::with_capacity(2 * theta_bins + 1),
         })
     }
 
@@ -206,6 +215,13 @@ impl HoughWorkspace {
     #[must_use]
     pub fn height_px(&self) -> usize {
         self.height_px
+    }
+
+    /// Reserve room for [`Self::find_lines_oriented`] with up to `points` points, so that it
+    /// does not allocate (without it, the first calls grow a buffer of at most three entries a
+    /// point and keep it).
+    pub fn reserve_oriented_points(&mut self, points: usize) {
+        self.runs.reserve(3 * points);
     }
 
     /// The parameters the workspace was built with.
@@ -658,34 +674,84 @@ impl HoughWorkspace {
             let t = (v.abs() + 0.5) as i64;
             if v < 0.0 { -t } else { t }
         };
-        for p in points {
-            let x = (f64::from(p.col_px) - cx) as f32;
-            let y = (f64::from(p.row_px) - cy) as f32;
-            let votes = u32::from(p.votes);
-            let theta = f64::from(p.normal_deg);
-            // The point's window and its copies one half-turn either way, as bin runs; they
-            // do not overlap (2·half + 1 < nt bins, each copy 180° away).
-            let runs = if all {
-                [(0, nt - 1), (1, 0), (1, 0)]
-            } else {
-                [theta, theta + 180.0, theta - 180.0].map(|t| (bin(t) - half, bin(t) + half))
-            };
-            for (a, b) in runs {
-                let (a, b) = (a.max(k0i), b.min(k1i));
-                if a > b {
-                    continue;
-                }
-                let (a, b) = (a as usize, b as usize);
-                let rows = self.acc[a * nr..(b + 1) * nr].chunks_exact_mut(nr);
+        let centred = |p: &OrientedPoint| {
+            (
+                (f64::from(p.col_px) - cx) as f32,
+                (f64::from(p.row_px) - cy) as f32,
+            )
+        };
+        if all {
+            for p in points {
+                let (x, y) = centred(p);
+                let votes = u32::from(p.votes);
+                let rows = self.acc[k0 * nr..(k1 + 1) * nr].chunks_exact_mut(nr);
                 for ((row, &c), &s) in rows
-                    .zip(&self.cos_over_step[a..=b])
-                    .zip(&self.sin_over_step[a..=b])
+                    .zip(&self.cos_over_step[k0..=k1])
+                    .zip(&self.sin_over_step[k0..=k1])
                 {
                     // In range by construction (as in `vote`); a bad index is skipped, never
                     // spilled into the next θ row.
                     if let Some(cell) = row.get_mut(rho_bin(x, y, c, s, offset) as usize) {
                         *cell += votes;
                     }
+                }
+            }
+            return;
+        }
+        // The point's window and its copies one half-turn either way, as runs of L = 2·half + 1
+        // bins starting at a; they do not overlap (L < nt bins, each copy 180° away). A run
+        // meets the band iff its start lies in base..=k1, base = k0 − L + 1.
+        let len = 2 * half + 1;
+        let base = k0i - len + 1;
+        let starts_of = |p: &OrientedPoint| {
+            let theta = f64::from(p.normal_deg);
+            [theta, theta + 180.0, theta - 180.0].map(|t| bin(t) - half)
+        };
+        // θ-major: the runs counting-sorted by their start, so that the runs through bin k are
+        // those starting in k − L + 1..=k, one slice; each θ row then takes its votes while it
+        // sits in the cache, instead of every point touching L rows. The same votes as a
+        // point-major loop (integer sums do not depend on their order).
+        let buckets = (k1i - base + 1) as usize;
+        let counts = &mut self.run_starts;
+        counts.clear();
+        counts.resize(buckets + 1, 0);
+        for p in points {
+            for a in starts_of(p) {
+                if (base..=k1i).contains(&a) {
+                    counts[(a - base) as usize + 1] += 1;
+                }
+            }
+        }
+        for i in 0..buckets {
+            counts[i + 1] += counts[i];
+        }
+        let total = counts[buckets] as usize;
+        let runs = &mut self.runs;
+        runs.clear();
+        runs.resize(total, (0.0, 0.0, 0));
+        let next = &mut self.run_next;
+        next.clear();
+        next.extend_from_slice(&counts[..buckets]);
+        for p in points {
+            let (x, y) = centred(p);
+            for a in starts_of(p) {
+                if (base..=k1i).contains(&a) {
+                    let slot = &mut next[(a - base) as usize];
+                    runs[*slot as usize] = (x, y, u32::from(p.votes));
+                    *slot += 1;
+                }
+            }
+        }
+        for k in k0..=k1 {
+            // Runs starting in k − L + 1 ..= k: buckets (k − L + 1 − base) ..= (k − base).
+            let lo = (k as i64 - len + 1 - base) as usize;
+            let hi = (k as i64 - base) as usize;
+            let (c, s) = (self.cos_over_step[k], self.sin_over_step[k]);
+            let row = &mut self.acc[k * nr..(k + 1) * nr];
+            for &(x, y, votes) in &runs[counts[lo] as usize..counts[hi + 1] as usize] {
+                // In range by construction (as in `vote`); a bad index is skipped.
+                if let Some(cell) = row.get_mut(rho_bin(x, y, c, s, offset) as usize) {
+                    *cell += votes;
                 }
             }
         }
@@ -820,6 +886,67 @@ fn parabolic_offset(a: f64, b: f64, c: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::Point;
+
+    /// The θ-major oriented vote (runs counting-sorted by their first bin) fills the same
+    /// accumulator as a point-major reference: every point, every bin of the band, a vote
+    /// where the bin is within `⌊tolerance/Δθ⌋` bins of the bin nearest the point's normal
+    /// taken modulo 180° (every bin for a window covering the half circle) — with θ steps that
+    /// do and do not divide 180°, narrow and wide windows, bands at both ends of the range, and
+    /// weighted points.
+    #[test]
+    fn the_theta_major_oriented_vote_equals_a_point_major_reference() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for step in [1.0, 0.7, 2.5] {
+            let params = HoughParams {
+                theta_step_deg: step,
+                ..HoughParams::default()
+            };
+            let mut ws = HoughWorkspace::new(160, 120, params).unwrap();
+            let (nr, nt) = (ws.rho_bins, ws.theta_bins);
+            let points: Vec<OrientedPoint> = (0..400)
+                .map(|_| OrientedPoint {
+                    col_px: (next() % 160) as f32,
+                    row_px: (next() % 120) as f32,
+                    normal_deg: -90.0 + (next() % 18_000) as f32 / 100.0,
+                    votes: (next() % 4) as u16,
+                })
+                .collect();
+            ws.reserve_oriented_points(points.len());
+            for (k0, k1) in [(0, nt - 1), (0, nt / 6), (nt / 3, nt / 2), (nt - 5, nt - 1)] {
+                for tolerance_deg in [0.0, 1.0, 15.0, 40.0, 89.0, 90.0] {
+                    ws.vote_oriented(&points, k0, k1, tolerance_deg);
+                    let half = (tolerance_deg / step + 1e-9).floor() as i64;
+                    // A window covering the half circle votes in every bin.
+                    let every = tolerance_deg >= 90.0 || 2 * half + 1 >= nt as i64;
+                    let mut expected = vec![0u32; (k1 - k0 + 1) * nr];
+                    let (cx, cy) = (ws.center_col_px, ws.center_row_px);
+                    for p in &points {
+                        let x = (f64::from(p.col_px) - cx) as f32;
+                        let y = (f64::from(p.row_px) - cy) as f32;
+                        let centres = [0.0, 180.0, -180.0]
+                            .map(|d| ((f64::from(p.normal_deg) + d + 90.0) / step).round() as i64);
+                        for k in k0..=k1 {
+                            if every || centres.iter().any(|&c| (k as i64 - c).abs() <= half) {
+                                let (c, s) = (ws.cos_over_step[k], ws.sin_over_step[k]);
+                                let r = rho_bin(x, y, c, s, ws.rho_zero_bin as f32) as usize;
+                                expected[(k - k0) * nr + r] += u32::from(p.votes);
+                            }
+                        }
+                    }
+                    assert!(
+                        ws.acc[k0 * nr..(k1 + 1) * nr] == expected[..],
+                        "step {step}, band {k0}..={k1}, tolerance {tolerance_deg}"
+                    );
+                }
+            }
+        }
+    }
 
     /// Deterministic pseudo-random votes (xorshift), no external RNG needed here.
     fn fill_votes(ws: &mut HoughWorkspace, k0: usize, k1: usize, seed: u64) {

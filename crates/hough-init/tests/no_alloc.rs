@@ -1,6 +1,6 @@
-//! Initialisation with an existing workspace does not allocate (counting global allocator from
-//! `alloc-counter`, which counts only the measuring thread's allocations, so the test harness's
-//! own threads cannot disturb the count).
+//! Initialisation with an existing workspace does not allocate, the oriented vote once its
+//! points are reserved (counting global allocator from `alloc-counter`, which counts only the
+//! measuring thread's allocations, so the test harness's own threads cannot disturb the count).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use alloc_counter::allocations_in;
@@ -38,6 +38,7 @@ fn repeated_initialisations_do_not_allocate() {
             votes: 1,
         })
         .collect();
+    ws.reserve_oriented_points(oriented.len());
     let mut lines = [HoughLine {
         rho_px: 0.0,
         theta_rad: 0.0,

@@ -321,7 +321,8 @@ impl LaneTracker {
         let fallback_roi = cfg.fallback_roi_rows(height);
         // The buffers hold the pixels of the tallest region searched.
         let capacity = width * (roi.1 - fallback_roi.map_or(roi.0, |r| r.0));
-        let hough = HoughWorkspace::new(width, height, cfg.init.hough_params())?;
+        let mut hough = HoughWorkspace::new(width, height, cfg.init.hough_params())?;
+        hough.reserve_oriented_points(capacity);
         let init_params = cfg.init.lane_params();
         init_params.validate()?;
         let center = (roi.0 + roi.1 - 1) as f64 / 2.0;
