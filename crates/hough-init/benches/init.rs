@@ -2,7 +2,9 @@
 //!
 //! Scenes: two 7-px-wide (320×240) or 3-px-wide (640×480, "sparse") / 15-px-wide (640×480,
 //! "dense") curved marks from a horizon at 0.4·H, σ = 0.5 px column noise, plus 30 % uniform
-//! clutter per lane. Run:
+//! clutter per lane. `oriented-8` is the default tracker's vote: each pixel carries its edge
+//! normal (the mark's, or a pseudo-random one for clutter) and votes within ±15° of it, and the
+//! 8 strongest separated lines of each band are taken. Run:
 //! `cargo bench -p hough-init --bench init -- --warm-up-time 1 --measurement-time 3`
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
@@ -14,7 +16,8 @@ use std::hint::black_box;
 use common::{clutter, draw_mark};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use hough_init::{
-    AngleBand, HoughParams, HoughWorkspace, LaneInitParams, Parabola, Point, init_lane,
+    AngleBand, HoughLine, HoughParams, HoughWorkspace, LaneInitParams, OrientedPoint, Parabola,
+    Point, init_lane,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -30,15 +33,46 @@ fn lane(h: f64, x_top: f64, x_bot: f64, sag_px: f64) -> Parabola {
     }
 }
 
-fn candidates(width: usize, height: usize, half_width_px: f64, seed: u64) -> [Vec<Point>; 2] {
-    let (w, h) = (width as f64, height as f64);
+/// The points with a normal angle each: the lane's own (`dx/dy = −tan θ`) within two mark
+/// widths of it, a pseudo-random one (seeded) elsewhere.
+fn with_normals(
+    pts: &[Point],
+    lane: &Parabola,
+    half_width_px: f64,
+    seed: u64,
+) -> Vec<OrientedPoint> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let row_lo = (0.4 * h) as usize;
-    let lanes = [
+    pts.iter()
+        .map(|p| {
+            let on_mark = (p.col_px - lane.col_at_row(p.row_px)).abs() <= 2.0 * half_width_px;
+            let normal_deg = if on_mark {
+                (-(2.0 * lane.a1 * p.row_px + lane.a2)).atan().to_degrees()
+            } else {
+                rand::Rng::random_range(&mut rng, -90.0..90.0)
+            };
+            OrientedPoint {
+                col_px: p.col_px as f32,
+                row_px: p.row_px as f32,
+                normal_deg: normal_deg as f32,
+                votes: 1,
+            }
+        })
+        .collect()
+}
+
+fn lanes(width: usize, height: usize) -> [Parabola; 2] {
+    let (w, h) = (width as f64, height as f64);
+    [
         lane(h, 0.45 * w, 0.1 * w, 0.025 * h),
         lane(h, 0.55 * w, 0.9 * w, 0.025 * h),
-    ];
-    lanes.map(|p| {
+    ]
+}
+
+fn candidates(width: usize, height: usize, half_width_px: f64, seed: u64) -> [Vec<Point>; 2] {
+    let h = height as f64;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let row_lo = (0.4 * h) as usize;
+    lanes(width, height).map(|p| {
         let mut pts = draw_mark(width, height, &p, row_lo, half_width_px, 0.5, &mut rng);
         let n = (0.3 * pts.len() as f64) as usize;
         pts.extend(clutter(width, height, n, &mut rng));
@@ -80,6 +114,40 @@ fn bench_init(c: &mut Criterion) {
                 });
             });
         }
+        let [lane_l, lane_r] = lanes(width, height);
+        let left_o = with_normals(&left, &lane_l, half_width, 2);
+        let right_o = with_normals(&right, &lane_r, half_width, 3);
+        ws.reserve_oriented_points(left_o.len().max(right_o.len()));
+        let mut found = [HoughLine {
+            rho_px: 0.0,
+            theta_rad: 0.0,
+            votes: 0,
+        }; 8];
+        group.bench_with_input(BenchmarkId::new("oriented-8", label), &(), |b, ()| {
+            b.iter(|| {
+                let l = ws
+                    .find_lines_oriented(
+                        black_box(&left_o),
+                        &AngleBand::LEFT_LANE,
+                        15.0,
+                        3.0,
+                        8.0,
+                        &mut found,
+                    )
+                    .unwrap();
+                let r = ws
+                    .find_lines_oriented(
+                        black_box(&right_o),
+                        &AngleBand::RIGHT_LANE,
+                        15.0,
+                        3.0,
+                        8.0,
+                        &mut found,
+                    )
+                    .unwrap();
+                black_box((l, r))
+            });
+        });
         let mut ws_fast = HoughWorkspace::new(
             width,
             height,
