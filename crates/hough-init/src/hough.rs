@@ -321,7 +321,10 @@ impl HoughWorkspace {
     /// tolerance should not be much below ~10°.
     ///
     /// Each point casts [`OrientedPoint::votes`] votes per bin (in the accumulator, the same as
-    /// repeating it; the minimum of two points counts points).
+    /// repeating it; the minimum of two points counts points). The vote runs θ-major (each θ
+    /// row takes the votes of the points whose window covers it, from one slice of the points
+    /// sorted by their window's first bin); it allocates nothing once
+    /// [`Self::reserve_oriented_points`] has reserved room for as many points.
     ///
     /// # Errors
     /// As [`Self::find_lines`]; [`HoughError::InvalidParam`] for a `tolerance_deg` that is not

@@ -92,7 +92,9 @@
 //! peak search ≡ a brute-force 3×3 argmax; least squares exact on noiseless points (1e-9
 //! relative, rows up to 480), equal to an independent SVD solve of the raw-pixel problem,
 //! unbiased with the theoretical spread σ²(ΦᵀΦ)⁻¹ under noise; degenerate inputs → errors;
-//! no allocation once the workspace exists; labelled real frames (lanenet ground truth)
+//! no allocation once the workspace exists (the oriented vote once its points are reserved,
+//! `HoughWorkspace::reserve_oriented_points`); the θ-major oriented vote ≡ a point-major
+//! reference; labelled real frames (lanenet ground truth)
 //! within the TuSimple tolerance.
 //!
 //! # Beyond the paper: several candidates and a joint ego-pair choice
