@@ -2,9 +2,10 @@
 //!
 //! Scenes: two 7-px-wide (320×240) or 3-px-wide (640×480, "sparse") / 15-px-wide (640×480,
 //! "dense") curved marks from a horizon at 0.4·H, σ = 0.5 px column noise, plus 30 % uniform
-//! clutter per lane. `oriented-8` is the default tracker's vote: each pixel carries its edge
-//! normal (the mark's, or a pseudo-random one for clutter) and votes within ±15° of it, and the
-//! 8 strongest separated lines of each band are taken. Run:
+//! clutter per lane. `oriented-8` is the default tracker's vote without its stripe weights: a
+//! 1° θ step as in `configs/default.toml`, each pixel carrying its edge normal (the mark's, or a
+//! pseudo-random one for clutter) and voting within ±15° of it, the 8 strongest lines of each
+//! band at least 3° / 8 px apart. Run:
 //! `cargo bench -p hough-init --bench init -- --warm-up-time 1 --measurement-time 3`
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
@@ -117,7 +118,16 @@ fn bench_init(c: &mut Criterion) {
         let [lane_l, lane_r] = lanes(width, height);
         let left_o = with_normals(&left, &lane_l, half_width, 2);
         let right_o = with_normals(&right, &lane_r, half_width, 3);
-        ws.reserve_oriented_points(left_o.len().max(right_o.len()));
+        let mut ws_oriented = HoughWorkspace::new(
+            width,
+            height,
+            HoughParams {
+                theta_step_deg: 1.0,
+                ..HoughParams::default()
+            },
+        )
+        .unwrap();
+        ws_oriented.reserve_oriented_points(left_o.len().max(right_o.len()));
         let mut found = [HoughLine {
             rho_px: 0.0,
             theta_rad: 0.0,
@@ -125,7 +135,7 @@ fn bench_init(c: &mut Criterion) {
         }; 8];
         group.bench_with_input(BenchmarkId::new("oriented-8", label), &(), |b, ()| {
             b.iter(|| {
-                let l = ws
+                let l = ws_oriented
                     .find_lines_oriented(
                         black_box(&left_o),
                         &AngleBand::LEFT_LANE,
@@ -135,7 +145,7 @@ fn bench_init(c: &mut Criterion) {
                         &mut found,
                     )
                     .unwrap();
-                let r = ws
+                let r = ws_oriented
                     .find_lines_oriented(
                         black_box(&right_o),
                         &AngleBand::RIGHT_LANE,

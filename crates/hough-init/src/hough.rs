@@ -218,10 +218,12 @@ impl HoughWorkspace {
     }
 
     /// Reserve room for [`Self::find_lines_oriented`] with up to `points` points, so that it
-    /// does not allocate (without it, the first calls grow a buffer of at most three entries a
-    /// point and keep it).
+    /// does not allocate (without it, the first calls grow a buffer and keep it). The buffer
+    /// holds at most two entries a point: of a point's window and its two copies 180° away,
+    /// all three can meet a band only if the window covers the half circle, and that case
+    /// votes without the buffer.
     pub fn reserve_oriented_points(&mut self, points: usize) {
-        self.runs.reserve(3 * points);
+        self.runs.reserve(2 * points);
     }
 
     /// The parameters the workspace was built with.
@@ -381,9 +383,12 @@ impl HoughWorkspace {
         sep_rho_px: f64,
         out: &mut [HoughLine],
     ) -> usize {
-        let dk = (sep_theta_deg / self.params.theta_step_deg).round() as usize;
-        let dr = (sep_rho_px / self.params.rho_step_px).round() as usize;
         let nr = self.rho_bins;
+        // A separation wider than the accumulator clears all of it: clamped, so that the index
+        // arithmetic below cannot overflow (a finite separation may saturate the cast).
+        let dk =
+            ((sep_theta_deg / self.params.theta_step_deg).round() as usize).min(self.theta_bins);
+        let dr = ((sep_rho_px / self.params.rho_step_px).round() as usize).min(nr);
         let smoothing = self.params.peak_smoothing;
         if smoothing {
             for k in k0..=k1 {
@@ -670,11 +675,14 @@ impl HoughWorkspace {
         let all = tolerance_deg >= 90.0 || 2 * half + 1 >= nt;
         let (k0i, k1i) = (k0 as i64, k1 as i64);
         // Nearest θ bin of an angle (θ_k = −90° + k·Δθ).
-        // Rounded half away from zero like `f64::round`, by a truncating cast (`round` is a libm
-        // call on the baseline x86-64 target, three a point here).
+        // Rounded half away from zero as `f64::round` does, by a truncating cast (`round` is a
+        // libm call on the baseline x86-64 target, three a point here): the fraction
+        // |v| − ⌊|v|⌋ is exact, so the comparison with ½ decides as `round` does.
         let bin = |deg: f64| {
             let v = (deg + 90.0) / step;
-            let t = (v.abs() + 0.5) as i64;
+            let a = v.abs();
+            let t = a as i64;
+            let t = if a - t as f64 >= 0.5 { t + 1 } else { t };
             if v < 0.0 { -t } else { t }
         };
         let centred = |p: &OrientedPoint| {

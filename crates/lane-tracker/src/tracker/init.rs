@@ -518,8 +518,8 @@ impl LaneTracker {
     fn install(&mut self, i: usize, init: &LaneInit) -> bool {
         let bottom = self.search_rows.1;
         // Sanity: the fit must cover a fair part of the ROI (a quarter of its rows, in the second
-        // search too: a dash seen only over the taller rows is as long as one seen in the ROI)
-        // and stay near the image.
+        // search too: a dash seen only over the taller rows, far ahead, is no longer than one
+        // seen in the ROI) and stay near the image.
         let span_rows = init.rows_px.1 - init.rows_px.0;
         let min_span = 0.25 * (self.roi.1 - self.roi.0) as f64;
         let x_bottom = init.parabola.col_at_row((bottom - 1) as f64);

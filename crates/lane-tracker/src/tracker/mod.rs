@@ -322,7 +322,10 @@ impl LaneTracker {
         // The buffers hold the pixels of the tallest region searched.
         let capacity = width * (roi.1 - fallback_roi.map_or(roi.0, |r| r.0));
         let mut hough = HoughWorkspace::new(width, height, cfg.init.hough_params())?;
-        hough.reserve_oriented_points(capacity);
+        if cfg.init.orientation_tolerance_deg > 0.0 {
+            // The oriented vote's points: one class of the tallest region's pixels at most.
+            hough.reserve_oriented_points(capacity);
+        }
         let init_params = cfg.init.lane_params();
         init_params.validate()?;
         let center = (roi.0 + roi.1 - 1) as f64 / 2.0;

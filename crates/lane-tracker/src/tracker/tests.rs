@@ -6,7 +6,7 @@ use info_filter::KifError;
 use vision_gradient::GreyImage;
 use wrls::WrlsError;
 
-use super::{Estimator, LaneFilter, LaneState, LaneTracker, Side};
+use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, Side};
 use crate::{FilterFailure, GreyFrame, TrackerConfig};
 
 #[global_allocator]
@@ -262,7 +262,8 @@ fn a_side_missing_from_the_roi_is_found_by_the_second_search_over_the_taller_row
 
 /// The second search asks a lane for as many rows as the first one does (a quarter of the
 /// ROI's rows: 23 of 91 at 240 rows), not a quarter of its own taller rows (42 of 168): a dash
-/// of 30 rows above the ROI is found, one of 16 rows is not.
+/// of 30 rows above the ROI is found; one of 20 rows, a Hough candidate of the second search,
+/// is refused for its span.
 #[test]
 fn the_second_search_accepts_a_dash_as_long_as_the_roi_would() {
     let cfg = TrackerConfig::default_preset().expect("the default preset");
@@ -280,10 +281,20 @@ fn the_second_search_accepts_a_dash_as_long_as_the_roi_would() {
     assert!(err < 1.5, "{err} px off the dash");
     tracker.reset();
     let report = tracker
-        .track(&right_dash_on_rows(320, 240, 124.0..140.0))
+        .track(&right_dash_on_rows(320, 240, 120.0..140.0))
         .expect("a frame");
-    assert!(16.0 < min_span);
-    assert_eq!(report.lanes[1].coeffs, None, "a 16-row dash is accepted");
+    assert!(20.0 < min_span);
+    assert_eq!(report.lanes[1].coeffs, None, "a 20-row dash is accepted");
+    // It was a candidate: the refusal is the span's, not the vote's.
+    let on_dash = |c: &InitCandidate| {
+        let x = c.coeffs[0] * 130.0 * 130.0 + c.coeffs[1] * 130.0 + c.coeffs[2];
+        c.band == Side::Right && (x - right(130.0)).abs() < 2.0
+    };
+    assert!(
+        tracker.init_candidates().iter().any(on_dash),
+        "{:?}",
+        tracker.init_candidates()
+    );
 }
 
 /// `left(y) ± s(y)` for the two lines of a double line, `2·h(y)` wide, both growing towards
