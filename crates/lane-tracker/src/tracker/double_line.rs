@@ -79,11 +79,12 @@ impl LineSums {
 fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<(f64, i64)> {
     let w = row.len() as i64;
     let at = |x: i64| (0..w).contains(&x).then(|| f64::from(row[x as usize]));
-    let x0 = x_hat.round();
-    if !x0.is_finite() {
+    // Far outside any row (or not a number): no mark under it. Within ±1e9 the integer
+    // arithmetic below cannot overflow.
+    if x_hat.is_nan() || x_hat.abs() > 1e9 {
         return None;
     }
-    let x0 = x0 as i64;
+    let x0 = x_hat.round() as i64;
     let mut xp = x0;
     for x in x0 - 2..=x0 + 2 {
         if at(x) > at(xp) {
@@ -92,7 +93,12 @@ fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<(f64, i64)> 
     }
     let peak = at(xp)?;
     let span = 3 * max_width_px;
-    let background = (xp - span..=xp + span).filter_map(at).fold(peak, f64::min);
+    // The darkest pixel within `span` of the peak (the row clipped to the image; `xp` is in it).
+    let (lo, hi) = ((xp - span).max(0) as usize, (xp + span).min(w - 1) as usize);
+    let background = row
+        .get(lo..=hi)
+        .and_then(|s| s.iter().copied().min())
+        .map_or(peak, |v| f64::from(v).min(peak));
     if peak - background < MIN_CONTRAST {
         return None;
     }
@@ -234,5 +240,24 @@ mod tests {
         let mut dim = row(&[(40, 45), (50, 55)]);
         dim[50..55].fill(140);
         assert_eq!(pair_middle(&dim, 42.0, 12), None);
+    }
+
+    /// An estimate far off the row or not a number reads nothing, without overflow (a
+    /// diverged estimate must not panic the reading); one just past an end still reads the
+    /// mark at that end.
+    #[test]
+    fn an_estimate_off_the_row_reads_nothing() {
+        let double = row(&[(0, 5), (10, 15)]);
+        for x_hat in [
+            1e19,
+            -1e19,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            1e9 + 1.0,
+        ] {
+            assert_eq!(pair_middle(&double, x_hat, 12), None, "{x_hat}");
+        }
+        assert_eq!(pair_middle(&double, -0.4, 12), Some((7.4, 1)));
     }
 }
