@@ -450,14 +450,7 @@ impl HoughWorkspace {
         if nr == 1 {
             out[0] = column[0];
         }
-        // The first largest cell (ties to the lower ρ), as a scan keeping the first maximum.
-        let max = out.iter().copied().max().unwrap_or(0);
-        let best = if max == 0 {
-            (0, 0)
-        } else {
-            (max, out.iter().position(|&v| v == max).unwrap_or(0))
-        };
-        self.row_best[k] = best;
+        self.row_best[k] = first_max(out);
     }
 
     /// Cells `lo..=hi` of row `k` of `smoothed` recomputed after a suppression cleared votes
@@ -477,13 +470,7 @@ impl HoughWorkspace {
         }
         let (_, best) = self.row_best[k];
         if (lo..=hi).contains(&best) {
-            let out = &self.smoothed[k * nr..(k + 1) * nr];
-            let max = out.iter().copied().max().unwrap_or(0);
-            self.row_best[k] = if max == 0 {
-                (0, 0)
-            } else {
-                (max, out.iter().position(|&v| v == max).unwrap_or(0))
-            };
+            self.row_best[k] = first_max(&self.smoothed[k * nr..(k + 1) * nr]);
         }
     }
 
@@ -862,6 +849,17 @@ impl HoughWorkspace {
     }
 }
 
+/// The first largest value of `row` and its index (ties to the lower index), `(0, 0)` for a row
+/// of zeros: a scan keeping the first maximum, as two passes that vectorise.
+fn first_max(row: &[u32]) -> (u32, usize) {
+    let max = row.iter().copied().max().unwrap_or(0);
+    if max == 0 {
+        (0, 0)
+    } else {
+        (max, row.iter().position(|&v| v == max).unwrap_or(0))
+    }
+}
+
 /// `dst[r] = src[r − 1] + src[r] + src[r + 1]` (missing neighbours count as zero); both
 /// slices have the same length ≥ 2.
 fn hsum3(src: &[u32], dst: &mut [u32]) {
@@ -907,12 +905,7 @@ mod tests {
     #[test]
     fn the_theta_major_oriented_vote_equals_a_point_major_reference() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = move || xorshift(&mut state);
         for step in [1.0, 0.7, 2.5] {
             let params = HoughParams {
                 theta_step_deg: step,
@@ -959,15 +952,20 @@ mod tests {
         }
     }
 
-    /// Deterministic pseudo-random votes (xorshift), no external RNG needed here.
+    /// The next value of a xorshift sequence (`state` never 0): deterministic, no external RNG.
+    fn xorshift(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    /// Deterministic pseudo-random votes (xorshift).
     fn fill_votes(ws: &mut HoughWorkspace, k0: usize, k1: usize, seed: u64) {
         let mut state = seed | 1;
         let nr = ws.rho_bins;
         for v in &mut ws.acc[k0 * nr..(k1 + 1) * nr] {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            *v = (state % 50) as u32;
+            *v = (xorshift(&mut state) % 50) as u32;
         }
     }
 
