@@ -97,9 +97,11 @@ pub struct HoughWorkspace {
     /// Per θ bin of `smoothed`: its first largest value and that value's ρ bin.
     row_best: Vec<(u32, usize)>,
     /// The oriented vote's runs of θ bins, `(x, y, votes)` of their point, sorted by the run's
-    /// first bin (`vote_oriented`), with the index of each first bin's runs and a cursor per
-    /// bin; reserved by [`HoughWorkspace::reserve_oriented_points`].
+    /// first bin (`vote_oriented`), with the runs as `(point index, first bin − base)` in point
+    /// order, the index of each first bin's runs and a cursor per bin; `runs` and `run_keys`
+    /// reserved by [`HoughWorkspace::reserve_oriented_points`].
     runs: Vec<(f32, f32, u32)>,
+    run_keys: Vec<(u32, u32)>,
     run_starts: Vec<u32>,
     run_next: Vec<u32>,
 }
@@ -200,6 +202,7 @@ impl HoughWorkspace {
             smoothed: vec![0; cells],
             row_best: vec![(0, 0); theta_bins],
             runs: Vec::new(),
+            run_keys: Vec::new(),
             run_starts: Vec::with_capacity(2 * theta_bins + 2),
             run_next: Vec::with_capacity(2 * theta_bins + 1),
         })
@@ -224,6 +227,7 @@ impl HoughWorkspace {
     /// votes without the buffer.
     pub fn reserve_oriented_points(&mut self, points: usize) {
         self.runs.reserve(2 * points);
+        self.run_keys.reserve(2 * points);
     }
 
     /// The parameters the workspace was built with.
@@ -713,10 +717,16 @@ impl HoughWorkspace {
         let counts = &mut self.run_starts;
         counts.clear();
         counts.resize(buckets + 1, 0);
-        for p in points {
+        // The runs that meet the band as (point, bucket), in point order: their starts are
+        // computed once.
+        let keys = &mut self.run_keys;
+        keys.clear();
+        for (i, p) in points.iter().enumerate() {
             for a in starts_of(p) {
                 if (base..=k1i).contains(&a) {
-                    counts[(a - base) as usize + 1] += 1;
+                    let bucket = (a - base) as usize;
+                    counts[bucket + 1] += 1;
+                    keys.push((i as u32, bucket as u32)); // i < 2³²: reserve_oriented_points
                 }
             }
         }
@@ -730,14 +740,11 @@ impl HoughWorkspace {
         let next = &mut self.run_next;
         next.clear();
         next.extend_from_slice(&counts[..buckets]);
-        for p in points {
-            let (x, y) = centred(p);
-            for a in starts_of(p) {
-                if (base..=k1i).contains(&a) {
-                    let slot = &mut next[(a - base) as usize];
-                    runs[*slot as usize] = (x, y, u32::from(p.votes));
-                    *slot += 1;
-                }
+        for &(i, bucket) in keys.iter() {
+            if let (Some(p), Some(slot)) = (points.get(i as usize), next.get_mut(bucket as usize)) {
+                let (x, y) = centred(p);
+                runs[*slot as usize] = (x, y, u32::from(p.votes));
+                *slot += 1;
             }
         }
         for k in k0..=k1 {

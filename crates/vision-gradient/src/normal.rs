@@ -33,11 +33,9 @@ pub fn gradient_normal_deg(gx: i16, gy: i16) -> Option<f32> {
     }
     let (ax, ay) = (f32::from(gx.unsigned_abs()), f32::from(gy.unsigned_abs()));
     let atan_deg = |z: f32| z * (45.0 + 15.64 * (1.0 - z));
-    let a = if ay <= ax {
-        atan_deg(ay / ax)
-    } else {
-        90.0 - atan_deg(ax / ay)
-    };
+    // The smaller over the larger, one division, and a select (no branch to mispredict).
+    let t = atan_deg(ay.min(ax) / ay.max(ax));
+    let a = if ay <= ax { t } else { 90.0 - t };
     // a ∈ [0°, 90°]; the normal leans towards +y when gx and gy share their sign.
     Some(if (gx > 0) == (gy >= 0) {
         if a >= 90.0 { -90.0 } else { a }

@@ -103,7 +103,16 @@ fn regions_select_exactly_their_pixels() {
             "case {i}: test geometry"
         );
         assert_eq!(got, want, "case {i}");
-        assert_eq!(stats.left_count + stats.right_count, want.len());
+        let left = want
+            .iter()
+            .filter(|p| p.class == vision_gradient::EdgeClass::LeftLane)
+            .count();
+        assert!(left > 0 && left < want.len(), "case {i}: both classes");
+        assert_eq!(
+            (stats.left_count, stats.right_count),
+            (left, want.len() - left),
+            "case {i}: the counts per class"
+        );
         for r in 0..h {
             for c in 0..w {
                 let expect = if inside(c, r) { full_cls[r * w + c] } else { 0 };

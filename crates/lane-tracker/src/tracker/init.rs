@@ -10,7 +10,8 @@ use hough_init::{
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
 use vision_gradient::{
-    EdgeClass, GreyImage, Region, gradient_normal_deg, keep_bright_stripes, split_stripes,
+    EdgeClass, EdgePixel, GreyImage, Region, gradient_normal_deg, keep_bright_stripes,
+    split_stripes,
 };
 
 use super::points::fit_profile;
@@ -24,6 +25,25 @@ use crate::wrls_lane::WrlsLane;
 /// The background of a candidate's row coverage is read on the parallel curves this many LS band
 /// half-widths to each side (a gap of one band between them and the band of the candidate).
 const BACKGROUND_SHIFT_BANDS: f64 = 3.0;
+
+/// Appends the `(column, row)` of the pixels of `class` among `pixels`, in their order, without a
+/// branch on the class (the classes alternate along a row: such a branch is mispredicted
+/// often). Needs room for `pixels.len() + 1` more in `points`' capacity not to allocate.
+pub(super) fn extend_with_class(
+    points: &mut Vec<(f32, f32)>,
+    pixels: &[EdgePixel],
+    class: EdgeClass,
+) {
+    let mut n = points.len();
+    points.resize(n + pixels.len() + 1, (0.0, 0.0));
+    for p in pixels {
+        if let Some(slot) = points.get_mut(n) {
+            *slot = (f32::from(p.col_px), f32::from(p.row_px));
+        }
+        n += usize::from(p.class == class);
+    }
+    points.truncate(n);
+}
 
 impl LaneTracker {
     /// Initialise the sides without an estimate in the ROI, then, with
@@ -112,20 +132,12 @@ impl LaneTracker {
     /// `self.candidates` = the edge pixels of `class` (from the last full-ROI gradient).
     fn fill_candidates(&mut self, class: EdgeClass) {
         self.candidates.clear();
-        self.candidates.extend(
-            self.edges
-                .iter_class(class)
-                .map(|p| (f32::from(p.col_px), f32::from(p.row_px))),
-        );
+        extend_with_class(&mut self.candidates, self.edges.pixels(), class);
         // Weighted stripe pairing: the sides of bright stripes count `stripe_paired_votes`
         // times in all, the other edge pixels once.
         if self.cfg.gradient.stripe_paired_votes > 0 {
             for _ in 1..self.cfg.gradient.stripe_paired_votes {
-                self.candidates.extend(
-                    self.paired
-                        .iter_class(class)
-                        .map(|p| (f32::from(p.col_px), f32::from(p.row_px))),
-                );
+                extend_with_class(&mut self.candidates, self.paired.pixels(), class);
             }
         }
     }
@@ -302,7 +314,23 @@ impl LaneTracker {
         }
         let starts = &mut self.row_start;
         starts.fill(0);
-        for e in self.edges.iter_class(class) {
+        // The indices of the pixels of `class`, selected without a branch on the class (the
+        // classes alternate along a row: such a branch is mispredicted often).
+        let pixels = self.edges.pixels();
+        let of_class = &mut self.of_class;
+        of_class.clear();
+        of_class.resize(pixels.len() + 1, 0);
+        let mut n = 0;
+        for (i, e) in pixels.iter().enumerate() {
+            if let Some(slot) = of_class.get_mut(n) {
+                *slot = i as u32; // < capacity ≤ width·height < 2³²
+            }
+            n += usize::from(e.class == class);
+        }
+        of_class.truncate(n);
+        let of_class = &*of_class;
+        let in_class = || of_class.iter().filter_map(|&i| pixels.get(i as usize));
+        for e in in_class() {
             if let Some(c) = starts.get_mut(usize::from(e.row_px) + 1) {
                 *c += 1;
             }
@@ -319,7 +347,7 @@ impl LaneTracker {
         let oriented = &mut self.oriented;
         oriented.clear();
         let with_normals = self.cfg.init.orientation_tolerance_deg > 0.0;
-        for e in self.edges.iter_class(class) {
+        for e in in_class() {
             let paired = mask
                 .get(bit(e) / 64)
                 .is_some_and(|word| word & (1 << (bit(e) % 64)) != 0);

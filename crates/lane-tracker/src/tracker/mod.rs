@@ -288,6 +288,9 @@ pub struct LaneTracker {
     paired_mask: Vec<u64>,
     row_start: Vec<u32>,
     row_next: Vec<u32>,
+    /// The indices in `edges` of one class's pixels while `by_row` is built (capacity: the
+    /// buffer's, plus one).
+    of_class: Vec<u32>,
     scratch: Vec<Candidate>,
     /// The rows' kerb feet `(row, offset)` read by `onto_kerb_foot` and `recheck_kerb_foot`
     /// (capacity: the height).
@@ -380,8 +383,10 @@ impl LaneTracker {
             paired: EdgeBuffer::with_capacity(capacity),
             hough,
             init_params,
+            // The pixels of one class, paired ones repeated, and a spare slot for the last
+            // branch-free append.
             candidates: Vec::with_capacity(
-                usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity,
+                usize::from(cfg.gradient.stripe_paired_votes.max(1)) * capacity + 1,
             ),
             oriented: Vec::with_capacity(if cfg.init.orientation_tolerance_deg > 0.0 {
                 capacity
@@ -392,6 +397,7 @@ impl LaneTracker {
             row_start: vec![0; height + 1],
             paired_mask: vec![0; (width * height).div_ceil(64)],
             row_next: Vec::with_capacity(height),
+            of_class: Vec::with_capacity(capacity + 1),
             scratch: Vec::with_capacity(capacity),
             kerb_rows: Vec::with_capacity(height),
             row_norm,

@@ -545,3 +545,48 @@ fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
         );
     }
 }
+
+/// The branch-free append of one class's pixels keeps exactly those pixels, in their order,
+/// after the points already there, and within the room it documents (`pixels.len() + 1`
+/// beyond the points held) it does not allocate.
+#[test]
+fn the_branch_free_append_keeps_one_class_in_order_without_allocating() {
+    use vision_gradient::{EdgeClass, EdgePixel};
+    let mut state = 0x9E37_79B9_u32;
+    let pixels: Vec<EdgePixel> = (0..200u16)
+        .map(|i| {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            EdgePixel {
+                col_px: i,
+                row_px: 239 - i / 40,
+                magnitude: 100,
+                class: if state.is_multiple_of(3) {
+                    EdgeClass::LeftLane
+                } else {
+                    EdgeClass::RightLane
+                },
+                gx: 50,
+            }
+        })
+        .collect();
+    for class in [EdgeClass::LeftLane, EdgeClass::RightLane] {
+        let want: Vec<(f32, f32)> = [(-1.0, -1.0)]
+            .into_iter()
+            .chain(
+                pixels
+                    .iter()
+                    .filter(|p| p.class == class)
+                    .map(|p| (f32::from(p.col_px), f32::from(p.row_px))),
+            )
+            .collect();
+        assert!(want.len() > 40 && want.len() < 160, "both classes drawn");
+        let mut points = Vec::with_capacity(1 + pixels.len() + 1);
+        points.push((-1.0, -1.0));
+        let (_, allocations) =
+            allocations_in(|| super::init::extend_with_class(&mut points, &pixels, class));
+        assert_eq!(allocations, 0);
+        assert_eq!(points, want);
+    }
+}
