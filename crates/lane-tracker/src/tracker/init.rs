@@ -26,23 +26,36 @@ use crate::wrls_lane::WrlsLane;
 /// half-widths to each side (a gap of one band between them and the band of the candidate).
 const BACKGROUND_SHIFT_BANDS: f64 = 3.0;
 
-/// Appends the `(column, row)` of the pixels of `class` among `pixels`, in their order, without a
-/// branch on the class (the classes alternate along a row: such a branch is mispredicted
-/// often). Needs room for `pixels.len() + 1` more in `points`' capacity not to allocate.
+/// Appends `item(index, pixel)` for the pixels of `class` among `pixels`, in their order, without
+/// a branch on the class (the classes alternate along a row: such a branch is mispredicted
+/// often). Needs room for `pixels.len() + 1` more in `out`'s capacity not to allocate.
+fn extend_with_class_by<T: Copy + Default>(
+    out: &mut Vec<T>,
+    pixels: &[EdgePixel],
+    class: EdgeClass,
+    item: impl Fn(usize, &EdgePixel) -> T,
+) {
+    let mut n = out.len();
+    out.resize(n + pixels.len() + 1, T::default());
+    for (i, p) in pixels.iter().enumerate() {
+        if let Some(slot) = out.get_mut(n) {
+            *slot = item(i, p);
+        }
+        n += usize::from(p.class == class);
+    }
+    out.truncate(n);
+}
+
+/// The `(column, row)` of the pixels of `class` among `pixels` appended to `points`
+/// ([`extend_with_class_by`]).
 pub(super) fn extend_with_class(
     points: &mut Vec<(f32, f32)>,
     pixels: &[EdgePixel],
     class: EdgeClass,
 ) {
-    let mut n = points.len();
-    points.resize(n + pixels.len() + 1, (0.0, 0.0));
-    for p in pixels {
-        if let Some(slot) = points.get_mut(n) {
-            *slot = (f32::from(p.col_px), f32::from(p.row_px));
-        }
-        n += usize::from(p.class == class);
-    }
-    points.truncate(n);
+    extend_with_class_by(points, pixels, class, |_, p| {
+        (f32::from(p.col_px), f32::from(p.row_px))
+    });
 }
 
 impl LaneTracker {
@@ -319,15 +332,8 @@ impl LaneTracker {
         let pixels = self.edges.pixels();
         let of_class = &mut self.of_class;
         of_class.clear();
-        of_class.resize(pixels.len() + 1, 0);
-        let mut n = 0;
-        for (i, e) in pixels.iter().enumerate() {
-            if let Some(slot) = of_class.get_mut(n) {
-                *slot = i as u32; // < capacity ≤ width·height < 2³²
-            }
-            n += usize::from(e.class == class);
-        }
-        of_class.truncate(n);
+        // i < the buffer's capacity ≤ width·height < 2³².
+        extend_with_class_by(of_class, pixels, class, |i, _| i as u32);
         let of_class = &*of_class;
         let in_class = || of_class.iter().filter_map(|&i| pixels.get(i as usize));
         for e in in_class() {
