@@ -55,8 +55,9 @@ pub struct EvalLanesArgs {
     #[arg(long)]
     no_peer: bool,
     /// Also report where the default configuration loses the ego label lanes of the development
-    /// part, stage by stage (`lane_eval::labelled::census_set`: no Hough candidate, candidate not
-    /// chosen, lost after the choice, found by the refinement).
+    /// part, stage by stage (`lane_eval::labelled::census_set`: no Hough candidate — and of
+    /// those, no edge near the label — candidate not chosen, lost after the choice, found by the
+    /// refinement).
     #[arg(long)]
     census: bool,
 }
@@ -173,17 +174,19 @@ fn render_census(censuses: &[(String, StageCensus)]) -> String {
          Label lanes on frames with a joint initialisation, by the TuSimple rule \
          (`lane_eval::labelled::census_set`).\n\n\
          | set | label lanes | matched | … found by the refinement | no Hough candidate | \
-         candidate not chosen | lost after the choice | not classified |\n\
-         |---|---|---|---|---|---|---|---|\n",
+         … no edge near the label | candidate not chosen | lost after the choice | \
+         not classified |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
     );
     let mut total = StageCensus::default();
     let row = |name: &str, c: &StageCensus| {
         format!(
-            "| {name} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             c.label_lanes,
             c.matched,
             c.found_by_refinement,
             c.no_candidate,
+            c.no_edge_near_label,
             c.not_chosen,
             c.lost_after_choice,
             c.not_classified

@@ -52,6 +52,9 @@ pub enum EvalError {
     /// The tracker refused its configuration or a frame (crate `lane-tracker`).
     #[error(transparent)]
     Tracker(#[from] lane_tracker::TrackerError),
+    /// The census's edge detector refused its parameters or a frame (crate `vision-gradient`).
+    #[error(transparent)]
+    Gradient(#[from] vision_gradient::GradientError),
 }
 
 /// serde_json's message without its own " at line L column C" (the message names them once, in

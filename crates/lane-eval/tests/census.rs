@@ -1,5 +1,6 @@
 //! `census_set` puts every scored ego label lane in the stage where it is lost: a label on the
-//! tracked mark is matched, a label where no mark is has no candidate, a label on a mark the
+//! tracked mark is matched, a label where no mark is has no candidate and no edge near it, a
+//! label a little beside a mark has no candidate but an edge near it, a label on a mark the
 //! ego-pair choice passed over is "not chosen", a lane tracked from the previous frame is not
 //! classified.
 
@@ -49,7 +50,11 @@ fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
     // Frame 0: labels on the two marks. Frame 1: the right label 40 px right of any mark.
     // Frame 2: a neighbour's mark too, and the right label on it. Frames 3 and 4: one clip of
     // two frames with the labels on the marks (the second frame is tracked, not initialised).
+    // Frame 5: the right label 9 px right of the mark's centre line (its edge 6.5 px away:
+    // beyond the TuSimple tolerance of 5 / cos(atan 0.6) = 5.8 px, within the census's
+    // 5 + 12/2 = 11 px of an edge).
     let shifted: fn(f64) -> f64 = |y| right(y) + 40.0;
+    let beside: fn(f64) -> f64 = |y| right(y) + 9.0;
     let frames = [
         (
             marks(&[left, right]),
@@ -71,14 +76,19 @@ fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
             marks(&[left, right]),
             [label("left", left), label("right", right)],
         ),
+        (
+            marks(&[left, right]),
+            [label("left", left), label("right", beside)],
+        ),
     ];
+    let clips = [0, 1, 2, 3, 3, 5];
     let mut entries = Vec::new();
     for (i, (img, lanes)) in frames.iter().enumerate() {
         let file = format!("frames/{i:04}.png");
         img.save(dir.join(&file)).unwrap();
         entries.push(format!(
             r#"{{"index": {i}, "file": "{file}", "clip": "c{}", "lanes": [{}]}}"#,
-            i.min(3),
+            clips[i],
             lanes.join(", ")
         ));
     }
@@ -94,28 +104,32 @@ fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
     let census = |frames| census_set(&dir, &set, &cfg, Estimator::Kif, frames, &rules).unwrap();
 
     // Every class of every range, so a lane counted in a wrong class fails too.
-    let counts = |matched, no_candidate, not_chosen, not_classified| StageCensus {
+    let counts = |matched, no_candidate, no_edge, not_chosen, not_classified| StageCensus {
         label_lanes: 2,
         matched,
         found_by_refinement: 0,
         no_candidate,
+        no_edge_near_label: no_edge,
         not_chosen,
         lost_after_choice: 0,
         not_classified,
     };
     let first = census(0..1);
-    assert_eq!(first, counts(2, 0, 0, 0));
+    assert_eq!(first, counts(2, 0, 0, 0, 0));
     let nowhere = census(1..2);
-    assert_eq!(nowhere, counts(1, 1, 0, 0));
+    assert_eq!(nowhere, counts(1, 1, 1, 0, 0));
     let passed_over = census(2..3);
-    assert_eq!(passed_over, counts(1, 0, 1, 0));
+    assert_eq!(passed_over, counts(1, 0, 0, 1, 0));
     // A tracked frame's lanes are not classified; its clip's first frame's are.
     let clip = census(3..5);
-    assert_eq!(clip, counts(2, 0, 0, 2));
+    assert_eq!(clip, counts(2, 0, 0, 0, 2));
+    // Beside the mark: no candidate, but the mark's edge is near the label.
+    let off = census(5..6);
+    assert_eq!(off, counts(1, 1, 0, 0, 0));
     // Ranges of separate clips add up.
-    let all = census(0..5);
+    let all = census(0..6);
     let mut sum = StageCensus::default();
-    for c in [first, nowhere, passed_over, clip] {
+    for c in [first, nowhere, passed_over, clip, off] {
         sum.add(&c);
     }
     assert_eq!(all, sum);

@@ -15,7 +15,15 @@
 //!    least-squares refit, the windowed refinement or a gate moved or dropped it);
 //!
 //! and, among the matched ones, those **found by the refinement**: matched by the output but not
-//! by the chosen candidate (the windows corrected a candidate that was off). A label lane whose
+//! by the chosen candidate (the windows corrected a candidate that was off); among those with no
+//! candidate, those with **no edge near the label**: on fewer than half of the label's scored
+//! points in the ROI rows does the configuration's gradient stage (threshold and edge-angle band,
+//! before stripe pairing; [`lane_tracker::GradientConfig::params`]) keep an edge pixel within
+//! `r = t + gradient.stripe_max_width_px / 2` columns of the point, `t` the TuSimple tolerance at
+//! this width (the edges of a mark up to a stripe width wide centred within `t` of the label).
+//! No mark detector fits a lane there: the label runs where the image shows nothing this
+//! detector keeps (a lane boundary without paint, a mark worn away, hidden, or outside the
+//! edge-angle band). It is a lower bound of such labels: clutter near a label counts as an edge. A label lane whose
 //! side kept the estimate tracked from the previous frame of its clip, or on a frame without a
 //! joint initialisation (both lanes tracked, or the paper's one line per band,
 //! `init.candidate_lines = 0`), is only counted as **not classified**.
@@ -25,7 +33,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use lane_tracker::{Estimator, Side, TrackerConfig};
+use lane_tracker::{Estimator, GreyFrame, Side, TrackerConfig};
+use vision_gradient::{EdgeBuffer, GradientDetector, GreyImage, Region};
 
 use super::{
     LabelSet, LabelSide, ScoringRules, run_label_set, scored_points, tusimple_lane_accuracy,
@@ -44,6 +53,9 @@ pub struct StageCensus {
     pub found_by_refinement: u64,
     /// Not matched, and no Hough candidate matched either.
     pub no_candidate: u64,
+    /// … of which the gradient stage keeps no edge near the label on half of its scored ROI
+    /// points or more (module docs).
+    pub no_edge_near_label: u64,
     /// Not matched; a candidate matched but not the one chosen for the side.
     pub not_chosen: u64,
     /// Not matched; the chosen candidate matched.
@@ -60,6 +72,7 @@ impl StageCensus {
         self.matched += o.matched;
         self.found_by_refinement += o.found_by_refinement;
         self.no_candidate += o.no_candidate;
+        self.no_edge_near_label += o.no_edge_near_label;
         self.not_chosen += o.not_chosen;
         self.lost_after_choice += o.lost_after_choice;
         self.not_classified += o.not_classified;
@@ -84,16 +97,23 @@ pub fn census_set(
     let y_top = rules.eval_top_fraction * set.height as f64;
     let tus_px = rules.tusimple_px_at_1280 * set.width as f64 / 1280.0;
     let joint = cfg.init.candidate_lines > 0;
+    let (roi_top, roi_bottom) = cfg.roi_rows(set.height);
+    let reach_px = tus_px + 0.5 * f64::from(cfg.gradient.stripe_max_width_px);
+    let detector = GradientDetector::new(cfg.gradient.params())?;
+    let mut edges = EdgeBuffer::with_capacity(set.width * (roi_bottom - roi_top));
+    // Per ROI pixel: does the gradient stage keep an edge there.
+    let mut edge_at = vec![false; set.width * (roi_bottom - roi_top)];
     run_label_set(
         dir,
         set,
         cfg,
         estimator,
         frames.end,
-        |position, labels, tracker, report| {
+        |position, labels, tracker, report, frame| {
             if !frames.contains(&position) {
-                return;
+                return Ok(());
             }
+            let mut edges_read = false;
             let candidates = tracker.init_candidates();
             for (k, (label_side, side)) in [
                 (LabelSide::Left, Side::Left),
@@ -132,9 +152,88 @@ pub fn census_set(
                     census.not_chosen += 1;
                 } else {
                     census.no_candidate += 1;
+                    if !edges_read {
+                        mark_edges(
+                            &detector,
+                            frame,
+                            (roi_top, roi_bottom),
+                            &mut edges,
+                            &mut edge_at,
+                        )?;
+                        edges_read = true;
+                    }
+                    let (mut in_roi, mut with_edge) = (0usize, 0usize);
+                    for &[x, y] in &pts {
+                        let row = y.round();
+                        if row >= roi_top as f64 && row < roi_bottom as f64 {
+                            in_roi += 1;
+                            let near = edge_near(&edge_at, set.width, roi_top, (x, y), reach_px);
+                            with_edge += usize::from(near);
+                        }
+                    }
+                    if 2 * with_edge < in_roi {
+                        census.no_edge_near_label += 1;
+                    }
                 }
             }
+            Ok(())
         },
     )?;
     Ok(census)
+}
+
+/// `edge_at[(r − top)·W + c]` = the gradient stage keeps an edge pixel at row `r`, column `c`
+/// of `frame`, for the rows `[top, bottom)`.
+fn mark_edges(
+    detector: &GradientDetector,
+    frame: &GreyFrame,
+    (top, bottom): (usize, usize),
+    edges: &mut EdgeBuffer,
+    edge_at: &mut [bool],
+) -> Result<(), EvalError> {
+    let (w, h) = (frame.width(), frame.height());
+    let image = GreyImage::new(frame.data(), w, h, w)?;
+    detector.detect(
+        &image,
+        Region::Rows {
+            row_start_px: top,
+            row_end_px: bottom,
+        },
+        edges,
+        None,
+    )?;
+    edge_at.fill(false);
+    for p in edges.pixels() {
+        let r = usize::from(p.row_px);
+        if let Some(cell) = r
+            .checked_sub(top)
+            .and_then(|dr| edge_at.get_mut(dr * w + usize::from(p.col_px)))
+        {
+            *cell = true;
+        }
+    }
+    Ok(())
+}
+
+/// Whether `edge_at` (rows from `top`, `width` columns) holds an edge on the row of `(x, y)`
+/// within `reach_px` columns of `x`.
+fn edge_near(
+    edge_at: &[bool],
+    width: usize,
+    top: usize,
+    (x, y): (f64, f64),
+    reach_px: f64,
+) -> bool {
+    let (lo, hi) = ((x - reach_px).ceil(), (x + reach_px).floor());
+    if !(lo.is_finite() && hi.is_finite()) || hi < 0.0 || lo > (width - 1) as f64 {
+        return false;
+    }
+    let (lo, hi) = (lo.max(0.0) as usize, hi.min((width - 1) as f64) as usize);
+    let Some(row) = (y.round() as usize)
+        .checked_sub(top)
+        .and_then(|dr| edge_at.get(dr * width..(dr + 1) * width))
+    else {
+        return false;
+    };
+    row.get(lo..=hi).is_some_and(|cols| cols.iter().any(|&e| e))
 }

@@ -442,22 +442,36 @@ pub fn track_label_set(
     estimator: Estimator,
 ) -> Result<Vec<EgoPrediction>, EvalError> {
     let mut out = Vec::with_capacity(set.frames.len());
-    run_label_set(dir, set, cfg, estimator, set.frames.len(), |_, _, _, r| {
-        out.push([r.lanes[0].coeffs, r.lanes[1].coeffs]);
-    })?;
+    run_label_set(
+        dir,
+        set,
+        cfg,
+        estimator,
+        set.frames.len(),
+        |_, _, _, r, _| {
+            out.push([r.lanes[0].coeffs, r.lanes[1].coeffs]);
+            Ok(())
+        },
+    )?;
     Ok(out)
 }
 
 /// Run a tracker over the frames of a labelled set before position `until`, clip by clip (reset
-/// at the start of every clip), calling `on_frame(position in the set, labels, tracker, report)`
-/// after every frame, in set order.
+/// at the start of every clip), calling `on_frame(position in the set, labels, tracker, report,
+/// frame)` after every frame, in set order; its first error stops the run and is returned.
 fn run_label_set(
     dir: &Path,
     set: &LabelSet,
     cfg: &TrackerConfig,
     estimator: Estimator,
     until: usize,
-    mut on_frame: impl FnMut(usize, &LabelFrame, &LaneTracker, &TrackReport),
+    mut on_frame: impl FnMut(
+        usize,
+        &LabelFrame,
+        &LaneTracker,
+        &TrackReport,
+        &GreyFrame,
+    ) -> Result<(), EvalError>,
 ) -> Result<(), EvalError> {
     let mut tracker = LaneTracker::new(cfg, estimator, set.width, set.height)?;
     let mut frame = GreyFrame::default();
@@ -483,7 +497,7 @@ fn run_label_set(
                 });
             }
             let r = tracker.track(&frame)?;
-            on_frame(position, f, &tracker, &r);
+            on_frame(position, f, &tracker, &r, &frame)?;
             position += 1;
         }
     }
