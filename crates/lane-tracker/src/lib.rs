@@ -112,8 +112,9 @@
 //!   (`init.ego_pair.width_weight`: the nearest boundary on each side). With
 //!   `init.candidate_coverage` a candidate is seen as the least-squares parabola it would be
 //!   initialised with, its support the row coverage of that parabola (paired pixels in the LS
-//!   band per ROI row, capped) minus that of the parallel curves three bands to each side
-//!   (texture and clutter are as dense beside a line as on it). Lanes are sided
+//!   band per ROI row, unpaired ones at most a step's two a row, capped) minus that of the
+//!   parallel curves three bands to each side (texture and clutter are as dense beside a line as
+//!   on it; a step through noise no longer matches a bright stripe). Lanes are sided
 //!   by position, not lean; a frame with no plausible pair reports the single best line on its
 //!   side of the centre. A lane still tracked stays in the pair. While tracking, each row takes
 //!   the edge class of the predicted slope (either class where the mark is near vertical);

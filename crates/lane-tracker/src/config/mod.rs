@@ -130,6 +130,7 @@ pub struct InitConfig {
     /// its row coverage: the sum over the ROI rows of the candidate pixels (stripe-paired ones
     /// counted `gradient.stripe_paired_votes` times) within `band_half_width_px` of the
     /// parabola, at most `2·max(stripe_paired_votes, 1)` per row (both edges of a paired mark),
+    /// the unpaired ones at most 2 per row when `stripe_paired_votes ≥ 2` (a step's worth),
     /// so a line seen over the whole ROI beats a short strong one; net of the clutter beside
     /// it (minus the mean coverage of the parallel curves `3·band_half_width_px` to each side,
     /// at least 0), so a line through texture counts for little. A candidate whose fit fails

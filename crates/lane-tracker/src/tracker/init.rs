@@ -25,6 +25,11 @@ use crate::wrls_lane::WrlsLane;
 /// The background of a candidate's row coverage is read on the parallel curves this many LS band
 /// half-widths to each side (a gap of one band between them and the band of the candidate).
 const BACKGROUND_SHIFT_BANDS: f64 = 3.0;
+/// Unpaired edge pixels counted per row and band by the row coverage (where a paired pixel
+/// weighs more): a single step (a kerb, a road's edge, a shadow's border) gives one or two a
+/// row under the 3×3 Sobel; more unpaired pixels on one row within a band are texture or
+/// noise.
+const UNPAIRED_PER_ROW: usize = 2;
 
 /// Appends `item(index, pixel)` for the pixels of `class` among `pixels`, in their order, without
 /// a branch on the class (the classes alternate along a row: such a branch is mispredicted
@@ -497,13 +502,25 @@ impl LaneTracker {
     /// (`±band_half_width_px`) of `p`, at most `2·max(gradient.stripe_paired_votes, 1)` per
     /// row, summed; minus the mean of the same sum for the two parallel curves
     /// `p ± 3·band_half_width_px` (a mark on a clean floor keeps its coverage, a line through
-    /// texture or clutter, as dense beside it as on it, loses it); at least 0. Read row by row
-    /// from `self.by_row`; no allocation.
-    fn row_coverage(&self, p: &Parabola) -> f64 {
+    /// texture or clutter, as dense beside it as on it, loses it); at least 0. Where a paired
+    /// pixel weighs more than an unpaired one (`stripe_paired_votes ≥ 2`), a band's unpaired
+    /// pixels count at most [`UNPAIRED_PER_ROW`] a row: one step's worth, so that a step edge
+    /// through noise or texture (which adds unpaired pixels on it as beside it) no longer
+    /// reaches a bright stripe's coverage row for row. Read row by row from `self.by_row`; no
+    /// allocation.
+    pub(super) fn row_coverage(&self, p: &Parabola) -> f64 {
         let (top, bottom) = self.search_rows;
         let band = self.init_params.band_px;
         let shift = BACKGROUND_SHIFT_BANDS * band;
-        let cap = 2 * usize::from(self.cfg.gradient.stripe_paired_votes.max(1));
+        let votes = self.cfg.gradient.stripe_paired_votes;
+        let cap = 2 * usize::from(votes.max(1));
+        // Where a paired pixel weighs more than an unpaired one, the unpaired ones of a band
+        // count at most `UNPAIRED_PER_ROW` a row.
+        let unpaired_cap = if votes > 1 {
+            UNPAIRED_PER_ROW
+        } else {
+            usize::MAX
+        };
         let (mut on, mut beside) = (0usize, 0usize);
         for r in top..bottom {
             let x = p.col_at_row(r as f64);
@@ -511,23 +528,28 @@ impl LaneTracker {
                 continue;
             }
             // The three bands do not overlap (shift = 3·band > 2·band): one scan.
-            let [mut left, mut centre, mut right] = [0usize; 3];
+            // Per band (left, centre, right): [paired weight, unpaired pixels].
+            let mut sums = [[0usize; 2]; 3];
             for &(col, weight) in self.row_from(r, x - shift - band) {
                 let d = f64::from(col) - x;
                 if d > shift + band {
                     break;
                 }
-                let w = usize::from(weight);
-                if d.abs() <= band {
-                    centre += w;
+                let b = if d.abs() <= band {
+                    1
                 } else if (d - shift).abs() <= band {
-                    right += w;
+                    2
                 } else if (d + shift).abs() <= band {
-                    left += w;
-                }
+                    0
+                } else {
+                    continue;
+                };
+                sums[b][usize::from(weight == 1)] += usize::from(weight);
             }
-            on += centre.min(cap);
-            beside += left.min(cap) + right.min(cap);
+            let [left, centre, right] =
+                sums.map(|[paired, unpaired]| (paired + unpaired.min(unpaired_cap)).min(cap));
+            on += centre;
+            beside += left + right;
         }
         (on as f64 - 0.5 * beside as f64).max(0.0)
     }

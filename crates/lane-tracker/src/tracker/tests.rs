@@ -8,6 +8,7 @@ use wrls::WrlsError;
 
 use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, Side};
 use crate::{FilterFailure, GreyFrame, TrackerConfig};
+use hough_init::Parabola;
 
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator::new();
@@ -136,7 +137,7 @@ fn the_joint_initialisation_reports_its_candidates_and_the_chosen_pair() {
         let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
         let (top, bottom) = tracker.roi;
         let (yt, yb) = (top as f64, (bottom - 1) as f64);
-        tracker.track(&frame).expect("a frame");
+        let report = tracker.track(&frame).expect("a frame");
         let cands = tracker.init_candidates();
         assert!(!cands.is_empty() && cands.len() <= 2 * cfg.init.candidate_lines);
         for (side, truth) in [
@@ -148,15 +149,22 @@ fn the_joint_initialisation_reports_its_candidates_and_the_chosen_pair() {
             let c = chosen[0];
             assert_eq!(c.band, side, "a straight mark votes in its own band");
             // A Hough line (1° steps) may sit on one side of the 5 px mark; its LS parabola on
-            // the middle.
+            // the mark (the candidates of one mark tie on their row coverage, each row's cap
+            // reached, and the pair's width term picks among them), and the lane reported after
+            // the refinement on its middle.
             let tol_px = if cfg.init.candidate_coverage {
-                1.5
+                2.5
             } else {
                 5.0
             };
+            let reported = report.lanes[side as usize]
+                .coeffs
+                .expect("a lane on each mark");
             for y in [yt, yb] {
                 let err = (col(c.coeffs, y) - truth(y)).abs();
                 assert!(err < tol_px, "{side:?} at row {y}: {err} px, {c:?}");
+                let err = (col(reported, y) - truth(y)).abs();
+                assert!(err < 1.0, "{side:?} reported at row {y}: {err} px");
             }
             assert!(c.support > 0.0);
             if !cfg.init.candidate_coverage {
@@ -589,4 +597,61 @@ fn the_branch_free_append_keeps_one_class_in_order_without_allocating() {
         assert_eq!(allocations, 0);
         assert_eq!(points, want);
     }
+}
+
+#[test]
+fn unpaired_pixels_count_one_steps_worth_a_row_in_the_row_coverage() {
+    // The row table filled by hand around the vertical curve x = 100 over the ROI rows: each
+    // row holds `pixels` as (column, weight), weight 3 = a paired pixel (the default's
+    // `stripe_paired_votes`), 1 = an unpaired one.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert_eq!(cfg.gradient.stripe_paired_votes, 3);
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.search_rows;
+    let rows = (bottom - top) as f64;
+    let line = Parabola {
+        a1: 0.0,
+        a2: 0.0,
+        a3: 100.0,
+    };
+    let mut coverage = |pixels: &[(u16, u16)]| {
+        tracker.by_row.clear();
+        tracker.row_start.fill(0);
+        for r in 0..tracker.height {
+            if (top..bottom).contains(&r) {
+                tracker.by_row.extend_from_slice(pixels);
+            }
+            tracker.row_start[r + 1] = tracker.by_row.len() as u32;
+        }
+        tracker.row_coverage(&line)
+    };
+    // A bright stripe: its two paired sides, 6 a row (the row cap).
+    assert_eq!(coverage(&[(98, 3), (102, 3)]), 6.0 * rows);
+    // A single step: one unpaired pixel a row.
+    assert_eq!(coverage(&[(100, 1)]), rows);
+    // Texture on the curve: five unpaired pixels a row count as two (they counted 5 before).
+    assert_eq!(
+        coverage(&[(98, 1), (99, 1), (100, 1), (101, 1), (102, 1)]),
+        2.0 * rows
+    );
+    // A stripe with unpaired texture around it keeps its 6; texture beside the curve (12 px
+    // off, the background bands) is capped alike: 4 unpaired a side count 2, and the stripe
+    // keeps 6 − (2 + 2)/2 = 4 a row (6 − (4 + 4)/2 = 2 before).
+    assert_eq!(
+        coverage(&[(97, 1), (98, 3), (102, 3), (103, 1)]),
+        6.0 * rows
+    );
+    let beside = [
+        (86, 1),
+        (87, 1),
+        (88, 1),
+        (89, 1),
+        (98, 3),
+        (102, 3),
+        (111, 1),
+        (112, 1),
+        (113, 1),
+        (114, 1),
+    ];
+    assert_eq!(coverage(&beside), 4.0 * rows);
 }
