@@ -23,9 +23,9 @@
 //! this width (the edges of a mark up to a stripe width wide centred within `t` of the label).
 //! No mark detector fits a lane there: the label runs where the image shows nothing this
 //! detector keeps (a lane boundary without paint, a mark worn away, hidden, or outside the
-//! edge-angle band). It is a lower bound of such labels: clutter near a label counts as an edge. A label lane whose
-//! side kept the estimate tracked from the previous frame of its clip, or on a frame without a
-//! joint initialisation (both lanes tracked, or the paper's one line per band,
+//! edge-angle band). It is a lower bound of such labels: clutter near a label counts as an edge.
+//! A label lane whose side kept the estimate tracked from the previous frame of its clip, or on
+//! a frame without a joint initialisation (both lanes tracked, or the paper's one line per band,
 //! `init.candidate_lines = 0`), is only counted as **not classified**.
 
 use std::ops::Range;
