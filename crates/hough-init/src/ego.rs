@@ -46,6 +46,12 @@ pub struct EgoPairParams {
     /// image centre on each side win over a wider pair of stronger lines (the ego lane's
     /// boundaries are the nearest marks on each side of the camera). Default `0.0`.
     pub width_weight: f64,
+    /// Without a plausible pair, a candidate is reported alone only if its chord leans at least
+    /// this many degrees from the vertical over the ROI rows, in `[0, 90)`; `0` = any lean.
+    /// One still gives no ground plane: a vertical line alone (a door frame, a pole, a wall's
+    /// corner) is as likely a vertical structure as a mark straight ahead, while a mark straight
+    /// ahead is still found with its partner. Default `0.0`.
+    pub lone_min_lean_deg: f64,
 }
 
 impl Default for EgoPairParams {
@@ -58,6 +64,7 @@ impl Default for EgoPairParams {
             centre_weight: 2.0,
             min_support_frac: 0.2,
             width_weight: 0.0,
+            lone_min_lean_deg: 0.0,
         }
     }
 }
@@ -121,6 +128,13 @@ impl EgoPairParams {
                 "must be in [0, 1]",
             );
         }
+        if !(0.0..90.0).contains(&self.lone_min_lean_deg) {
+            return bad(
+                "lone_min_lean_deg",
+                self.lone_min_lean_deg,
+                "must be in [0, 90)",
+            );
+        }
         Ok(())
     }
 }
@@ -148,12 +162,15 @@ pub struct EgoChoice {
 /// nearest boundary on each side over a wider pair). With
 /// `locked = Some(i)`, only pairs containing chord `i` are considered (a boundary already
 /// tracked). Without a plausible pair, the single candidate with the best
-/// `s/s_max − centre_weight·|bottom − W/2|/W` is returned on the side of the centre its bottom
-/// lies (or `locked` alone). Candidates with non-finite columns or support below
-/// `min_support_frac·s_max` are skipped. No allocation.
+/// `s/s_max − centre_weight·|bottom − W/2|/W` among those whose lean from the vertical,
+/// `atan(|top − bottom| / chord_rows_px)`, is at least `lone_min_lean_deg` is returned on the
+/// side of the centre its bottom lies (or `locked` alone). `chord_rows_px` is the number of rows
+/// between a chord's top and bottom rows (`> 0`). Candidates with non-finite columns or support
+/// below `min_support_frac·s_max` are skipped. No allocation.
 pub fn choose_ego_pair(
     chords: &[Chord],
     image_width_px: f64,
+    chord_rows_px: f64,
     params: &EgoPairParams,
     locked: Option<usize>,
 ) -> EgoChoice {
@@ -211,11 +228,17 @@ pub fn choose_ego_pair(
             right: Some(r),
         };
     }
+    // tan of the least lean a lone candidate needs (0 when the rule is off).
+    let min_lean = params.lone_min_lean_deg.to_radians().tan();
+    let leans = |i: usize| {
+        let ch = &chords[i];
+        (ch.col_top_px - ch.col_bottom_px).abs() >= min_lean * chord_rows_px
+    };
     let single = match locked {
         Some(k) if k < chords.len() => Some(k),
         Some(_) => None,
         None => (0..chords.len())
-            .filter(|&i| usable(i))
+            .filter(|&i| usable(i) && leans(i))
             .map(|i| {
                 let ch = &chords[i];
                 let s =
@@ -260,7 +283,7 @@ mod tests {
             ch(180.0, 260.0, 80.0),
         ];
         let p = EgoPairParams::default();
-        let got = choose_ego_pair(&chords, 320.0, &p, None);
+        let got = choose_ego_pair(&chords, 320.0, 100.0, &p, None);
         assert_eq!(
             got,
             EgoChoice {
@@ -274,7 +297,7 @@ mod tests {
     fn boundaries_leaning_the_same_way_on_a_curve_form_a_pair() {
         // Both lean `\` (top left of bottom), converging upwards.
         let chords = [ch(20.0, 100.0, 50.0), ch(120.0, 300.0, 50.0)];
-        let got = choose_ego_pair(&chords, 320.0, &EgoPairParams::default(), None);
+        let got = choose_ego_pair(&chords, 320.0, 100.0, &EgoPairParams::default(), None);
         assert_eq!(
             got,
             EgoChoice {
@@ -289,15 +312,15 @@ mod tests {
         let p = EgoPairParams::default();
         // Crossing inside the ROI (wider at the top than at the bottom, crossed).
         let crossed = [ch(250.0, 60.0, 50.0), ch(70.0, 260.0, 50.0)];
-        let got = choose_ego_pair(&crossed, 320.0, &p, None);
+        let got = choose_ego_pair(&crossed, 320.0, 100.0, &p, None);
         assert!(got.left.is_none() || got.right.is_none());
         // Too narrow: two edges of one mark.
         let narrow = [ch(150.0, 100.0, 50.0), ch(152.0, 108.0, 50.0)];
-        let got = choose_ego_pair(&narrow, 320.0, &p, None);
+        let got = choose_ego_pair(&narrow, 320.0, 100.0, &p, None);
         assert!(got.left.is_none() || got.right.is_none());
         // Both right of the centre: no pair; the single best is reported on its side.
         let right_only = [ch(200.0, 250.0, 50.0), ch(230.0, 400.0, 40.0)];
-        let got = choose_ego_pair(&right_only, 320.0, &p, None);
+        let got = choose_ego_pair(&right_only, 320.0, 100.0, &p, None);
         assert_eq!(
             got,
             EgoChoice {
@@ -305,6 +328,74 @@ mod tests {
                 right: Some(0)
             }
         );
+    }
+
+    #[test]
+    fn a_vertical_line_is_reported_in_a_pair_but_not_alone() {
+        // 320 px wide, chords over 100 rows. A door frame: vertical at column 176.
+        let door = [ch(176.0, 176.0, 100.0)];
+        let lean = EgoPairParams {
+            lone_min_lean_deg: 5.0,
+            ..EgoPairParams::default()
+        };
+        assert_eq!(
+            choose_ego_pair(&door, 320.0, 100.0, &lean, None),
+            EgoChoice::default()
+        );
+        // Without the rule it is reported on its side.
+        let any = EgoPairParams {
+            lone_min_lean_deg: 0.0,
+            ..lean
+        };
+        assert_eq!(
+            choose_ego_pair(&door, 320.0, 100.0, &any, None),
+            EgoChoice {
+                left: None,
+                right: Some(0)
+            }
+        );
+        // 6 px over 100 rows leans 3.4°: still too steep alone; a weaker line leaning 10° is
+        // reported instead of it.
+        let two = [ch(170.0, 176.0, 100.0), ch(182.6, 200.0, 40.0)];
+        assert_eq!(
+            choose_ego_pair(&two, 320.0, 100.0, &lean, None),
+            EgoChoice {
+                left: None,
+                right: Some(1)
+            }
+        );
+        // The same chords over 50 rows: 6 px lean 6.8°, and the stronger line is reported.
+        assert_eq!(
+            choose_ego_pair(&two, 320.0, 50.0, &lean, None),
+            EgoChoice {
+                left: None,
+                right: Some(0)
+            }
+        );
+        // A mark straight ahead (vertical, left of the centre) with its partner: the pair.
+        let pair = [ch(130.0, 130.0, 100.0), ch(200.0, 300.0, 80.0)];
+        assert_eq!(
+            choose_ego_pair(&pair, 320.0, 100.0, &lean, None),
+            EgoChoice {
+                left: Some(0),
+                right: Some(1)
+            }
+        );
+        // A tracked (locked) vertical lane stays, alone too.
+        assert_eq!(
+            choose_ego_pair(&door, 320.0, 100.0, &lean, Some(0)),
+            EgoChoice {
+                left: None,
+                right: Some(0)
+            }
+        );
+        for bad in [-1.0, 90.0, f64::NAN] {
+            let p = EgoPairParams {
+                lone_min_lean_deg: bad,
+                ..lean
+            };
+            assert!(p.validate().is_err(), "{bad}");
+        }
     }
 
     #[test]
@@ -316,7 +407,7 @@ mod tests {
             ch(f64::NAN, 200.0, 500.0), // bad
             ch(185.0, 250.0, 5.0),      // below min_support_frac
         ];
-        let got = choose_ego_pair(&chords, 320.0, &p, Some(0));
+        let got = choose_ego_pair(&chords, 320.0, 100.0, &p, Some(0));
         assert_eq!(
             got,
             EgoChoice {
@@ -324,7 +415,10 @@ mod tests {
                 right: Some(1)
             }
         );
-        assert_eq!(choose_ego_pair(&[], 320.0, &p, None), EgoChoice::default());
+        assert_eq!(
+            choose_ego_pair(&[], 320.0, 100.0, &p, None),
+            EgoChoice::default()
+        );
         assert!(p.validate().is_ok());
         let bad = EgoPairParams {
             max_top_width_ratio: 1.5,

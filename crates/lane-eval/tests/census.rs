@@ -52,7 +52,7 @@ fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
     // two frames with the labels on the marks (the second frame is tracked, not initialised).
     // Frame 5: the right label 9 px right of the mark's centre line (its edge 6.5 px away:
     // beyond the TuSimple tolerance of 5 / cos(atan 0.6) = 5.8 px, within the census's
-    // 5 + 12/2 = 11 px of an edge).
+    // 5 + 16/2 = 13 px of an edge: the default's stripe width).
     let shifted: fn(f64) -> f64 = |y| right(y) + 40.0;
     let beside: fn(f64) -> f64 = |y| right(y) + 9.0;
     let frames = [

@@ -501,6 +501,7 @@ impl TrackerConfig {
                     "max_top_width_ratio" => "init.ego_pair.max_top_width_ratio",
                     "centre_weight" => "init.ego_pair.centre_weight",
                     "width_weight" => "init.ego_pair.width_weight",
+                    "lone_min_lean_deg" => "init.ego_pair.lone_min_lean_deg",
                     _ => "init.ego_pair.min_support_frac",
                 },
                 value,

@@ -125,6 +125,15 @@ fn each_out_of_range_field_is_named() {
         ("filter.r_sigma_px", |c| c.filter.r_sigma_px = 0.0),
         ("filter.p0_sigma_px", |c| c.filter.p0_sigma_px[2] = f64::NAN),
         ("filter.wrls_lambda", |c| c.filter.wrls_lambda = 1.5),
+        ("init.ego_pair.width_weight", |c| {
+            c.init.ego_pair.width_weight = -1.0
+        }),
+        ("init.ego_pair.min_support_frac", |c| {
+            c.init.ego_pair.min_support_frac = 1.5
+        }),
+        ("init.ego_pair.lone_min_lean_deg", |c| {
+            c.init.ego_pair.lone_min_lean_deg = 90.0
+        }),
         ("init.kerb_foot", |c| {
             c.init.kerb_foot = true;
             c.gradient.stripe_max_width_px = 3;

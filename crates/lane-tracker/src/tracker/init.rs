@@ -283,6 +283,7 @@ impl LaneTracker {
         let choice = choose_ego_pair(
             &chords[..m],
             self.width as f64,
+            yb - yt,
             &self.cfg.init.ego_pair,
             locked.map(|(j, _)| j),
         );
