@@ -51,8 +51,9 @@
 //! `cargo xtask vivid` boots Debian's kernel under qemu with the `vivid` driver (input 1
 //! `"S-Video 0"`, NTSC) and runs the real `nav-app --device` (statically linked; it reads frames
 //! through this crate and tracks lanes on each) through: 60 frames of
-//! 320×240 in each of GREY, YUYV, YU12, UYVY, BGR24, RGB565 and BGR32 with increasing sequence
-//! numbers and timestamps and mean grey levels consistent with GREY's; PAL; input by index;
+//! 320×240 in each of GREY, YUYV, YU12, UYVY, BGR24, RGB565 and BGR32 with sequence numbers in
+//! order (vivid may repeat one when its thread wakes twice in a frame period), increasing
+//! timestamps and mean grey levels consistent with GREY's; PAL; input by index;
 //! an unknown input name (typed error); vivid's "Inject V4L2_BUF_FLAG_ERROR" (frames dropped and
 //! counted), "Percentage of Dropped Buffers" (sequence gaps counted), "Standard Signal Mode" =
 //! No Signal (frames flagged, then restored), 100 % dropped (timeout, restart, recovery) and

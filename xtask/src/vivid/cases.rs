@@ -12,7 +12,8 @@ pub(super) const EXIT_TIMEOUTS: i64 = 4;
 /// What a case requires of the guest's output.
 #[derive(Clone, Copy)]
 pub(super) enum Expect {
-    /// `frames` frames of 320×240 in `fourcc`, strictly increasing sequence and timestamps,
+    /// `frames` frames of 320×240 in `fourcc`, strictly increasing timestamps, sequence numbers
+    /// never going back (`judge::check_frames`: vivid may repeat one),
     /// NTSC-M set, exit 0. `optional`: a driver lacking the format skips instead of failing.
     Stream {
         fourcc: &'static str,

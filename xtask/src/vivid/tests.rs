@@ -15,17 +15,23 @@ fn frame(n: u64, seq: u64, ts: u64) -> String {
 }
 
 fn stream_log(seqs: &[u64], rc: i32) -> SerialLog {
+    let stamped: Vec<(u64, u64)> = seqs.iter().map(|&s| (s, 1000 + s)).collect();
+    stream_log_stamped(&stamped, rc)
+}
+
+/// A stream case's log with these `(sequence, timestamp_us)` frames.
+fn stream_log_stamped(frames: &[(u64, u64)], rc: i32) -> SerialLog {
     let mut lines = vec!["VIVID-CASE-BEGIN s".to_owned()];
-    for (i, s) in seqs.iter().enumerate() {
+    for (i, &(s, ts)) in frames.iter().enumerate() {
         // Kernel noise on the console must not confuse the parser.
         lines.push(format!(
             "[    1.0] some kernel line {}",
-            frame(i as u64, *s, 1000 + *s)
+            frame(i as u64, s, ts)
         ));
     }
     lines.push(format!(
         r#"{{"schema":1,"summary":{{"device":{{"device":"/dev/video0","input_index":1,"std_id":4096,"width_px":320,"height_px":240,"format":"GREY","stride_bytes":320,"buffers":4}},"frames":{},"errored_dropped":0,"sequence_gaps":0,"controls_set":0,"exit":"max-frames","exit_code":0,"error":null}}}}"#,
-        seqs.len()
+        frames.len()
     ));
     lines.push(format!("VIVID-CASE-END s rc={rc}"));
     SerialLog {
@@ -68,6 +74,33 @@ fn stream_case_passes_only_with_increasing_sequence_and_exit_zero() {
         verdict(&stream_log(&[0, 1], 0), GREY3),
         Verdict::Fail(_)
     ));
+}
+
+#[test]
+fn a_repeated_sequence_number_passes_only_with_a_later_timestamp() {
+    // vivid derives a buffer's sequence number from the time since streaming started: a thread
+    // woken twice within one frame period (a stalled emulated machine) fills two buffers with the
+    // same number, 18 ms apart (seen in CI). Two distinct frames, in order: not a fault of ours.
+    let repeated = [(0, 4_642_968), (0, 4_661_025), (1, 4_678_687)];
+    assert!(matches!(
+        verdict(&stream_log_stamped(&repeated, 0), GREY3),
+        Verdict::Pass(_)
+    ));
+    // The same buffer delivered twice (same number, same timestamp), a timestamp going back, or
+    // a number going back still fail.
+    for bad in [
+        [(0, 1000), (0, 1000), (1, 1033)],
+        [(0, 1000), (1, 990), (2, 1066)],
+        [(1, 1000), (0, 1033), (2, 1066)],
+    ] {
+        assert!(
+            matches!(
+                verdict(&stream_log_stamped(&bad, 0), GREY3),
+                Verdict::Fail(_)
+            ),
+            "{bad:?}"
+        );
+    }
 }
 
 #[test]
