@@ -105,7 +105,9 @@
 //! bottom ROI row, boundaries that converge towards a vanishing point above the ROI, the camera
 //! inside the lane, the pair nearest the image centre — so a neighbour lane's stronger line, a
 //! crosswalk stripe or a car edge leaning the wrong way no longer wins on votes alone, and on a
-//! curve the two boundaries may lean the same way. [`fit_around_line`] is the least-squares
+//! curve the two boundaries may lean the same way. Without a plausible pair a single line is
+//! reported, with `EgoPairParams::lone_min_lean_deg` not a near-vertical one (alone, it may be a
+//! door frame or a pole). [`fit_around_line`] is the least-squares
 //! half of [`init_lane`] for a chosen line.
 //!
 //! [`HoughWorkspace::find_lines_oriented`] restricts the vote by orientation: an
