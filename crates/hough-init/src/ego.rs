@@ -332,63 +332,43 @@ mod tests {
 
     #[test]
     fn a_vertical_line_is_reported_in_a_pair_but_not_alone() {
-        // 320 px wide, chords over 100 rows. A door frame: vertical at column 176.
+        let pick = |left, right| EgoChoice { left, right };
+        // 320 px wide, chords over 100 rows (unless stated). A door frame: vertical at 176.
         let door = [ch(176.0, 176.0, 100.0)];
         let lean = EgoPairParams {
             lone_min_lean_deg: 5.0,
             ..EgoPairParams::default()
         };
-        assert_eq!(
-            choose_ego_pair(&door, 320.0, 100.0, &lean, None),
-            EgoChoice::default()
-        );
-        // Without the rule it is reported on its side.
         let any = EgoPairParams {
             lone_min_lean_deg: 0.0,
             ..lean
         };
-        assert_eq!(
-            choose_ego_pair(&door, 320.0, 100.0, &any, None),
-            EgoChoice {
-                left: None,
-                right: Some(0)
-            }
-        );
-        // 6 px over 100 rows leans 3.4°: still too steep alone; a weaker line leaning 10° is
-        // reported instead of it.
+        // 6 px over 100 rows leans 3.4°: too steep alone, and a weaker line leaning 10° is
+        // reported instead; over 50 rows the same 6 px lean 6.8° and the stronger line wins.
         let two = [ch(170.0, 176.0, 100.0), ch(182.6, 200.0, 40.0)];
-        assert_eq!(
-            choose_ego_pair(&two, 320.0, 100.0, &lean, None),
-            EgoChoice {
-                left: None,
-                right: Some(1)
-            }
-        );
-        // The same chords over 50 rows: 6 px lean 6.8°, and the stronger line is reported.
-        assert_eq!(
-            choose_ego_pair(&two, 320.0, 50.0, &lean, None),
-            EgoChoice {
-                left: None,
-                right: Some(0)
-            }
-        );
-        // A mark straight ahead (vertical, left of the centre) with its partner: the pair.
+        // A mark straight ahead (vertical, left of the centre) with its partner.
         let pair = [ch(130.0, 130.0, 100.0), ch(200.0, 300.0, 80.0)];
-        assert_eq!(
-            choose_ego_pair(&pair, 320.0, 100.0, &lean, None),
-            EgoChoice {
-                left: Some(0),
-                right: Some(1)
-            }
+        // (chords, rows of a chord, parameters, locked chord, the choice wanted)
+        type Case<'a> = (
+            &'a [Chord],
+            f64,
+            &'a EgoPairParams,
+            Option<usize>,
+            EgoChoice,
         );
-        // A tracked (locked) vertical lane stays, alone too.
-        assert_eq!(
-            choose_ego_pair(&door, 320.0, 100.0, &lean, Some(0)),
-            EgoChoice {
-                left: None,
-                right: Some(0)
-            }
-        );
+        let cases: [Case; 6] = [
+            (&door, 100.0, &lean, None, pick(None, None)),
+            (&door, 100.0, &any, None, pick(None, Some(0))),
+            (&two, 100.0, &lean, None, pick(None, Some(1))),
+            (&two, 50.0, &lean, None, pick(None, Some(0))),
+            (&pair, 100.0, &lean, None, pick(Some(0), Some(1))),
+            // A tracked (locked) vertical lane stays, alone too.
+            (&door, 100.0, &lean, Some(0), pick(None, Some(0))),
+        ];
+        for (k, (chords, rows, params, locked, want)) in cases.into_iter().enumerate() {
+            let got = choose_ego_pair(chords, 320.0, rows, params, locked);
+            assert_eq!(got, want, "case {k}");
+        }
         for bad in [-1.0, 90.0, f64::NAN] {
             let p = EgoPairParams {
                 lone_min_lean_deg: bad,
