@@ -1,13 +1,15 @@
 //! Criterion benches of the directional gradient: full frame (fixed and adaptive threshold,
-//! AVX2 and portable backends) at 320×240 and 640×480, and the tracking mode (two windows).
+//! AVX2 and portable backends) at 320×240 and 640×480, and the tracking mode (two windows);
+//! and of the periodic-stripe filter on a frame's edges.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 use vision_gradient::{
-    Backend, ColSpan, EdgeBuffer, GradientDetector, GradientParams, GreyImage, Region, Threshold,
+    Backend, ColSpan, EdgeBuffer, GradientDetector, GradientParams, GreyImage,
+    PeriodicStripeParams, Region, Threshold, drop_periodic_stripes,
 };
 
 /// Road-like test frame: textured grey with two bright diagonal marks.
@@ -121,5 +123,51 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// `frame` with a crosswalk across the lower quarter: eight bright stripes, 5 % of the width
+/// wide and as far apart, leaning as the marks do.
+fn crosswalk_frame(w: usize, h: usize) -> Vec<u8> {
+    let mut data = frame(w, h);
+    for y in h * 3 / 4..h {
+        for x in 0..w {
+            let along = x as f64 + (y as f64 - h as f64) * 0.3;
+            if along.rem_euclid(0.1 * w as f64) < 0.05 * w as f64 {
+                data[y * w + x] = 210;
+            }
+        }
+    }
+    data
+}
+
+/// `drop_periodic_stripes` on the whole-frame edges of `crosswalk_frame` (default gradient,
+/// four-stripe chains), the edge list copied afresh for each call outside the timing.
+fn bench_periodic(c: &mut Criterion) {
+    let mut group = c.benchmark_group("periodic_stripes");
+    let (w, h) = (320usize, 240usize);
+    let data = crosswalk_frame(w, h);
+    let img = GreyImage::new(&data, w, h, w).unwrap();
+    let mut edges = EdgeBuffer::with_capacity(w * h);
+    GradientDetector::new(GradientParams::default())
+        .unwrap()
+        .detect(&img, Region::Full, &mut edges, None)
+        .unwrap();
+    let params = PeriodicStripeParams {
+        min_stripes: 4,
+        ..PeriodicStripeParams::default()
+    };
+    let mut probe = edges.clone();
+    assert!(
+        drop_periodic_stripes(&mut probe, &params) > 0,
+        "no chain in the bench frame"
+    );
+    group.bench_function(BenchmarkId::new("drop", format!("{w}x{h}")), |b| {
+        b.iter_batched_ref(
+            || edges.clone(),
+            |e| drop_periodic_stripes(black_box(e), &params),
+            BatchSize::SmallInput,
+        )
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_periodic);
 criterion_main!(benches);

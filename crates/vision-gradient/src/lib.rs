@@ -95,6 +95,15 @@
 //! [`GradientDetector::detect`] on its output (any region), read the Sobel `gx` the detector stored
 //! with each pixel, scan its row neighbours, and allocate nothing.
 //!
+//! ## Periodic stripes (an addition beyond the paper; [`drop_periodic_stripes`])
+//! A crosswalk's stripes, painted letters and a railing's bars are bright stripes along the road
+//! like a mark, but they cross a row many times at a steady pitch, where a mark crosses it once
+//! and a double line twice. [`drop_periodic_stripes`] drops the edge pixels of each chain of at
+//! least [`PeriodicStripeParams::min_stripes`] stripes of like width and close spacing along a
+//! row that a chain on an adjacent row confirms, on its row and the two beside it (the
+//! module's docs give the rule and its known gap). It also runs on the detector's output and
+//! allocates nothing.
+//!
 //! ## Defaults
 //! [`GradientParams::default`]: band 15°..80°, fixed threshold 120 (a 45° step of 20 grey
 //! levels). On the Udacity 320×240 frames (`shared/data/udacity`) this keeps both marks of the
@@ -147,6 +156,7 @@ mod kernel;
 mod normal;
 mod params;
 mod ridge;
+mod zebra;
 
 pub use edges::{EdgeBuffer, EdgeClass, EdgePixel, EdgeStats};
 pub use error::GradientError;
@@ -154,6 +164,7 @@ pub use image::{GreyImage, MAX_SIDE_PX};
 pub use normal::gradient_normal_deg;
 pub use params::{GradientParams, Threshold};
 pub use ridge::{keep_bright_stripes, split_stripes};
+pub use zebra::{PeriodicStripeParams, drop_periodic_stripes};
 
 use kernel::{Band, CheckedRegion, HIST_BINS, Sink};
 

@@ -60,6 +60,21 @@ pub struct GradientConfig {
     /// steps still count. Default `false`.
     #[serde(default)]
     pub stripe_drop_dark: bool,
+    /// Periodic stripes (an addition beyond the paper; `vision_gradient::drop_periodic_stripes`):
+    /// before the initialisation's vote, drop the edge pixels of every chain of at least this
+    /// many bright stripes along a row, neighbours within a factor 2 in width and at most three
+    /// widths apart, that a chain on an adjacent row overlaps, on its row and the two adjacent
+    /// ones (a crosswalk, road text, a railing; a double line is two). Count, 0 or 3..=16;
+    /// 0 (default when absent) drops nothing. Tracking windows are not filtered.
+    #[serde(default)]
+    pub periodic_min_stripes: usize,
+    /// Widest stripe of such a chain, px (along the row), 1..=200. Default 48 when absent.
+    #[serde(default = "default_periodic_max_width_px")]
+    pub periodic_max_width_px: u16,
+}
+
+fn default_periodic_max_width_px() -> u16 {
+    48
 }
 
 /// Region of interest: the rows where lanes are looked for (the sky is not lane).
@@ -187,6 +202,16 @@ impl GradientConfig {
             min_edge_angle_deg: self.min_edge_angle_deg,
             max_edge_angle_deg: self.max_edge_angle_deg,
             threshold,
+        }
+    }
+
+    /// The periodic-stripe rule of `periodic_min_stripes` and `periodic_max_width_px` (the other
+    /// bounds are `vision_gradient::PeriodicStripeParams`'s defaults).
+    pub fn periodic_params(&self) -> vision_gradient::PeriodicStripeParams {
+        vision_gradient::PeriodicStripeParams {
+            min_stripes: self.periodic_min_stripes,
+            max_width_px: f64::from(self.periodic_max_width_px),
+            ..Default::default()
         }
     }
 
@@ -522,6 +547,18 @@ impl TrackerConfig {
             "needs gradient.stripe_max_width_px ≥ 4 px (a kerb's face is read up to it)",
         )?;
         check(
+            g.periodic_min_stripes == 0 || (3..=16).contains(&g.periodic_min_stripes),
+            "gradient.periodic_min_stripes",
+            g.periodic_min_stripes,
+            "must be 0 (off) or in 3..=16 (a double line is two stripes)",
+        )?;
+        check(
+            (1..=200).contains(&g.periodic_max_width_px),
+            "gradient.periodic_max_width_px",
+            g.periodic_max_width_px,
+            "must be in 1..=200 px",
+        )?;
+        check(
             g.stripe_paired_votes <= 4,
             "gradient.stripe_paired_votes",
             g.stripe_paired_votes,
@@ -639,7 +676,8 @@ impl TrackerConfig {
 
     /// Multiply every pixel-valued parameter by `k` (> 0): the presets are tuned for 320-px-wide
     /// frames, so a 1280-px frame takes `k = 4`. Scaled: window and inlier half-widths, jump
-    /// gate, lane separation, Hough band and candidate separation, stripe width (at least 4 px
+    /// gate, lane separation, Hough band and candidate separation, stripe width and the periodic
+    /// stripes' widest (at least 4 px
     /// with `init.kerb_foot`, which reads a kerb's face within it), R, Q and P0 standard
     /// deviations. Not scaled: the gradient threshold (grey levels), fractions, angles, counts.
     pub fn scale_pixels(&mut self, k: f64) {
@@ -654,6 +692,9 @@ impl TrackerConfig {
         self.init.candidate_separation_px *= k;
         let g = &mut self.gradient;
         g.stripe_max_width_px = (f64::from(g.stripe_max_width_px) * k).round().min(200.0) as u16;
+        g.periodic_max_width_px = (f64::from(g.periodic_max_width_px) * k)
+            .round()
+            .clamp(1.0, 200.0) as u16;
         if self.init.kerb_foot {
             // The kerb's reading needs a face range (validated ≥ 4 px).
             g.stripe_max_width_px = g.stripe_max_width_px.max(4);

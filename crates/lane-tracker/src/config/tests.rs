@@ -75,6 +75,15 @@ fn each_out_of_range_field_is_named() {
         ("gradient.max_edge_angle_deg", |c| {
             c.gradient.max_edge_angle_deg = 5.0
         }),
+        ("gradient.periodic_min_stripes", |c| {
+            c.gradient.periodic_min_stripes = 2
+        }),
+        ("gradient.periodic_min_stripes", |c| {
+            c.gradient.periodic_min_stripes = 17
+        }),
+        ("gradient.periodic_max_width_px", |c| {
+            c.gradient.periodic_max_width_px = 0
+        }),
         ("roi.top_row_fraction", |c| c.roi.top_row_fraction = 1.0),
         ("roi.bottom_row_fraction", |c| {
             c.roi.bottom_row_fraction = 0.1
@@ -218,7 +227,13 @@ fn scale_pixels_scales_pixel_fields_only() {
         c.init.band_half_width_px,
         4.0 * base.init.band_half_width_px
     );
-    assert_eq!(c.gradient, base.gradient);
+    assert_eq!(
+        c.gradient.periodic_max_width_px,
+        4 * base.gradient.periodic_max_width_px
+    );
+    let mut unscaled = c.gradient;
+    unscaled.periodic_max_width_px = base.gradient.periodic_max_width_px;
+    assert_eq!(unscaled, base.gradient);
     assert_eq!(c.roi, base.roi);
     assert_eq!(c.track.max_points_per_lane, base.track.max_points_per_lane);
 }

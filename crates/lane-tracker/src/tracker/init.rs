@@ -10,8 +10,8 @@ use hough_init::{
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
 use vision_gradient::{
-    EdgeClass, EdgePixel, GreyImage, Region, gradient_normal_deg, keep_bright_stripes,
-    split_stripes,
+    EdgeClass, EdgePixel, GreyImage, Region, drop_periodic_stripes, gradient_normal_deg,
+    keep_bright_stripes, split_stripes,
 };
 
 use super::points::fit_profile;
@@ -103,6 +103,7 @@ impl LaneTracker {
             &mut self.edges,
             None,
         )?;
+        drop_periodic_stripes(&mut self.edges, &self.cfg.gradient.periodic_params());
         if self.cfg.gradient.stripe_paired_votes > 0 {
             split_stripes(
                 &mut self.edges,

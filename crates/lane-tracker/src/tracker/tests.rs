@@ -655,3 +655,83 @@ fn unpaired_pixels_count_one_steps_worth_a_row_in_the_row_coverage() {
     ];
     assert_eq!(coverage(&beside), 4.0 * rows);
 }
+
+/// A crosswalk across the near rows (165..225) of a dark floor, right of the camera: five
+/// bright stripes along the road (towards a vanishing point at (160, 100)), 14 px wide and 16 px
+/// apart at the bottom row from column 185, narrowing with distance, anti-aliased; with `marks`,
+/// over `two_marks` (painted over the right mark, as a real crosswalk is). Every stripe leans
+/// (≥ 10° from the vertical): a vertical stripe's edges have no lean and are no edge pixels, so
+/// it would leave the chain (the module docs of `vision_gradient::drop_periodic_stripes`).
+fn crosswalk(w: usize, h: usize, marks: bool) -> GreyFrame {
+    let mut pixels = if marks {
+        two_marks(w, h).data().to_vec()
+    } else {
+        vec![60u8; w * h]
+    };
+    // Column scaled back to the bottom row, where the stripes start every 30 px from 185.
+    let on_stripe = |x: f64, y: f64| {
+        let x_bottom = 160.0 + (x - 160.0) * 139.0 / (y - 100.0);
+        let k = ((x_bottom - 185.0) / 30.0).floor();
+        (0.0..5.0).contains(&k) && x_bottom - (185.0 + 30.0 * k) < 14.0
+    };
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if !(165.0..225.0).contains(&y) {
+            continue;
+        }
+        // Anti-aliased as a lens and sensor blur an edge: the pixel's cover on a 4×4 grid.
+        let cover = (0..16)
+            .filter(|s| {
+                on_stripe(
+                    x - 0.375 + 0.25 * f64::from(s % 4),
+                    y - 0.375 + 0.25 * f64::from(s / 4),
+                )
+            })
+            .count() as f64
+            / 16.0;
+        *p = (f64::from(*p) + cover * (220.0 - f64::from(*p))).round() as u8;
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn a_crosswalk_is_not_reported_as_a_lane_and_marks_across_it_are() {
+    let marks = [
+        |y: f64| 100.0 - 0.45 * (y - 239.0),
+        |y: f64| 220.0 + 0.45 * (y - 239.0),
+    ];
+    // Largest distance of each reported lane from its mark over the ROI rows (`None`: no lane).
+    let errors = |cfg: &TrackerConfig, frame: &GreyFrame| {
+        let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let report = tracker.track(frame).expect("a frame");
+        let (top, bottom) = tracker.roi;
+        [0, 1].map(|k| {
+            report.lanes[k].coeffs.map(|c| {
+                (top..bottom)
+                    .map(|y| {
+                        let y = y as f64;
+                        (Parabola::from_coeffs(c).col_at_row(y) - marks[k](y)).abs()
+                    })
+                    .fold(0.0, f64::max)
+            })
+        })
+    };
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(cfg.gradient.periodic_min_stripes > 0);
+    let mut off = cfg;
+    off.gradient.periodic_min_stripes = 0;
+    // The crosswalk alone: no lane; without the rule its stripes are taken for lanes.
+    let alone = crosswalk(320, 240, false);
+    assert_eq!(errors(&cfg, &alone), [None, None], "with the rule");
+    let found = errors(&off, &alone);
+    assert!(
+        found.iter().any(Option::is_some),
+        "without the rule: {found:?}"
+    );
+    // Marks running through the crosswalk are still found, within 5 px over the ROI.
+    let on = errors(&cfg, &crosswalk(320, 240, true));
+    assert!(
+        on.iter().all(|e| e.is_some_and(|e| e < 5.0)),
+        "marks through the crosswalk: {on:?} px"
+    );
+}
