@@ -155,16 +155,16 @@ mod image;
 mod kernel;
 mod normal;
 mod params;
+mod periodic;
 mod ridge;
-mod zebra;
 
 pub use edges::{EdgeBuffer, EdgeClass, EdgePixel, EdgeStats};
 pub use error::GradientError;
 pub use image::{GreyImage, MAX_SIDE_PX};
 pub use normal::gradient_normal_deg;
 pub use params::{GradientParams, Threshold};
+pub use periodic::{PeriodicStripeParams, drop_periodic_stripes};
 pub use ridge::{keep_bright_stripes, split_stripes};
-pub use zebra::{PeriodicStripeParams, drop_periodic_stripes};
 
 use kernel::{Band, CheckedRegion, HIST_BINS, Sink};
 

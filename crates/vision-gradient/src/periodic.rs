@@ -1,5 +1,5 @@
 //! Periodic stripes along a row (an addition beyond the paper): the edge pixels of a crosswalk
-//! ("zebra"), of road text and of railings are dropped before the Hough vote.
+//! (a "zebra"), of road text and of railings are dropped before the Hough vote.
 //!
 //! A lane mark crosses a row once: a rising edge (dark → bright to the right) and, a mark width
 //! later, a falling one. Two marks of one lane (a double line) cross it twice, close together;
