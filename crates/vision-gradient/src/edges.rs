@@ -48,6 +48,18 @@ impl EdgePixel {
     }
 }
 
+/// One past the last index of the row that starts at `start` in `pixels` (rows are stored
+/// contiguously, [`EdgeBuffer`]); `start` must be `< pixels.len()`.
+pub(crate) fn row_end(pixels: &[EdgePixel], start: usize) -> usize {
+    let row = pixels[start].row_px;
+    start
+        + 1
+        + pixels[start + 1..]
+            .iter()
+            .take_while(|p| p.row_px == row)
+            .count()
+}
+
 impl grey_frame::PixelPoint for EdgePixel {
     #[inline]
     fn col_px(&self) -> f64 {

@@ -88,9 +88,10 @@ impl Edge {
 }
 
 /// Drops the edge pixels of periodic stripe chains confirmed by an adjacent row, on their row
-/// and the two adjacent ones (module docs); returns the number dropped. `edges` must come from [`crate::GradientDetector::detect`] (rows contiguous,
-/// columns increasing within a row, polarity from [`crate::EdgePixel::gx`]). Pixels of both
-/// classes form the edges. `min_stripes = 0` drops nothing. No allocation.
+/// and the two adjacent ones (module docs); returns the number dropped. `edges` must come from
+/// [`crate::GradientDetector::detect`] (rows contiguous, columns increasing within a row,
+/// polarity from [`crate::EdgePixel::gx`]). Pixels of both classes form the edges.
+/// `min_stripes = 0` drops nothing. No allocation.
 pub fn drop_periodic_stripes(edges: &mut EdgeBuffer, params: &PeriodicStripeParams) -> usize {
     if params.min_stripes == 0 {
         return 0;
@@ -104,11 +105,7 @@ pub fn drop_periodic_stripes(edges: &mut EdgeBuffer, params: &PeriodicStripePara
     let mut start = 0;
     let mut t = 0usize;
     while start < n {
-        let row = px[start].row_px;
-        let mut end = start + 1;
-        while end < n && px[end].row_px == row {
-            end += 1;
-        }
+        let end = crate::edges::row_end(px, start);
         // The row's edges.
         let mut m = 0;
         for p in &px[start..end] {
@@ -132,7 +129,7 @@ pub fn drop_periodic_stripes(edges: &mut EdgeBuffer, params: &PeriodicStripePara
         }
         let cur = &mut ring[t % 4];
         *cur = RowChains {
-            row_px: row,
+            row_px: px[start].row_px,
             start,
             end,
             ..RowChains::default()

@@ -99,11 +99,7 @@ fn mark(edges: &mut EdgeBuffer, max_width_px: u16, outward_steps_from_col_px: Op
     let n = px.len();
     let mut start = 0;
     while start < n {
-        let row = px[start].row_px;
-        let mut end = start + 1;
-        while end < n && px[end].row_px == row {
-            end += 1;
-        }
+        let end = crate::edges::row_end(px, start);
         // Indexed by `EdgeClass as usize` (1, 2).
         let (mut next_rise, mut next_fall) = ([None::<u16>; 3], [None::<u16>; 3]);
         for p in px[start..end].iter_mut().rev() {
