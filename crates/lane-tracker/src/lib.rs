@@ -191,8 +191,8 @@
 //! the taller rows': 67.7 → 68.5 % dev, 68.2 → 69.3 % hold-out; the unpaired pixels' cap in the
 //! row coverage: 68.5 → 68.8 % dev, 69.3 → 69.6 % hold-out; vertical marks (edges to 90°, a
 //! vertical line not reported alone, stripes to 16 px): 68.8 → 69.5 % dev, 69.6 → 70.0 %
-//! hold-out; periodic stripes: 69.5 → 70.2 % dev, 70.0 → 69.9 % hold-out); `init.ego_pair.min_support_frac =
-//! 0.1` keeps a dashed ego mark beside a solid one (the real udacity clip: both lanes on 220 of 221 stills initialised alone, 163 with
+//! hold-out; periodic stripes: 69.5 → 70.2 % dev, 70.0 → 69.9 % hold-out);
+//! `init.ego_pair.min_support_frac = 0.1` keeps a dashed ego mark beside a solid one (the real udacity clip: both lanes on 220 of 221 stills initialised alone, 163 with
 //! 0.2). The presets (`indoor`, `outdoor`, used by the rendered regression sequences) keep the
 //! paper's initialisation.
 //!
