@@ -21,7 +21,7 @@ mod tests;
 mod update;
 mod windows;
 
-use points::Candidate;
+use points::{BANDS, Candidate, MAX_WINDOW_HALF_WIDTH};
 
 /// Which lane.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -292,6 +292,9 @@ pub struct LaneTracker {
     /// buffer's, plus one).
     of_class: Vec<u32>,
     scratch: Vec<Candidate>,
+    /// Point selection's residual histograms, one per third of the ROI rows
+    /// (`points::BANDS`), bins `0..=2w` of a window `±w` px.
+    residual_hist: Box<[[u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]>,
     /// The rows' kerb feet `(row, offset)` read by `onto_kerb_foot` and `recheck_kerb_foot`
     /// (capacity: the height).
     kerb_rows: Vec<(f64, f64)>,
@@ -399,6 +402,7 @@ impl LaneTracker {
             row_next: Vec::with_capacity(height),
             of_class: Vec::with_capacity(capacity + 1),
             scratch: Vec::with_capacity(capacity),
+            residual_hist: Box::new([[0; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]),
             kerb_rows: Vec::with_capacity(height),
             row_norm,
             q,

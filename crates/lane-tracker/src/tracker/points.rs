@@ -218,6 +218,9 @@ impl Decimation {
     }
 }
 
+/// Row bands of point selection's outlier rejection (thirds of the ROI rows).
+pub(super) const BANDS: usize = 3;
+
 /// Largest window half-width accepted by the configuration, px.
 pub(crate) const MAX_WINDOW_HALF_WIDTH: usize = 200;
 
@@ -237,12 +240,17 @@ impl LaneTracker {
         // Outlier rejection: the residuals r = x − x̂(y) of the window pixels are histogrammed
         // in three row bands; pixels farther than `inlier_half_width_px` from their band's
         // midhinge residual (mean of the quartiles) are dropped (clutter, noise, the edges of a shadow).
-        const BANDS: usize = 3;
         let band_rows = [top + (bottom - top) / 3, top + 2 * (bottom - top) / 3];
         let w_us = w as usize;
         // One pass over the window pixels of the lane's class: residual bin (r + w, rounded;
         // window pixels are within ±w of the prediction) and row band, histogrammed per band.
-        let mut hist = [[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS];
+        // (The tracker's buffer, cleared over the bins this window uses.)
+        let hist = &mut *self.residual_hist;
+        for h in hist.iter_mut() {
+            if let Some(bins) = h.get_mut(..=2 * w_us) {
+                bins.fill(0);
+            }
+        }
         self.scratch.clear();
         // Joint initialisation (lanes sided by position, not lean): per row, the edge class of
         // the predicted slope (`/`: dx/dy < 0), either class where the mark is near vertical.
@@ -256,44 +264,56 @@ impl LaneTracker {
         let gate = tolerance_deg > 0.0;
         let tan_tolerance = tolerance_deg.to_radians().tan() as f32;
         let predicted = Parabola::from_coeffs(coeffs);
-        for p in self.edges.pixels() {
-            let y = f64::from(p.row_px);
-            let slope = predicted.slope_at_row(y);
-            let class_ok = if joint {
-                slope.abs() < NEAR_VERTICAL_SLOPE
-                    || p.class
-                        == if slope < 0.0 {
-                            EdgeClass::LeftLane
-                        } else {
-                            EdgeClass::RightLane
-                        }
-            } else {
-                p.class == lane.class
-            };
-            if !class_ok {
+        // The detector stores its pixels row by row: the prediction, its slope and the class
+        // test are evaluated once per row, not once per pixel.
+        for row_pixels in self.edges.pixels().chunk_by(|a, b| a.row_px == b.row_px) {
+            let Some(first) = row_pixels.first() else {
                 continue;
-            }
-            if gate {
-                let (gx, gy) = p.gradient();
-                let (gx, gy) = (f32::from(gx), f32::from(gy));
-                let slope = slope as f32;
-                if (gx * slope + gy).abs() > tan_tolerance * (gx - gy * slope).abs() {
+            };
+            let row = usize::from(first.row_px);
+            let y = f64::from(first.row_px);
+            let slope = predicted.slope_at_row(y);
+            let col_pred = predicted.col_at_row(y);
+            // The class this row's pixels must have; `None`: either (a near-vertical mark).
+            let class = if !joint {
+                Some(lane.class)
+            } else if slope.abs() < NEAR_VERTICAL_SLOPE {
+                None
+            } else if slope < 0.0 {
+                Some(EdgeClass::LeftLane)
+            } else {
+                Some(EdgeClass::RightLane)
+            };
+            let slope_f32 = slope as f32;
+            let band = usize::from(row >= band_rows[0]) + usize::from(row >= band_rows[1]);
+            let Some(hist) = hist.get_mut(band) else {
+                continue;
+            };
+            for p in row_pixels {
+                if class.is_some_and(|c| p.class != c) {
                     continue;
                 }
-            }
-            let v = f64::from(p.col_px) - predicted.col_at_row(y);
-            // Truncation of a non-negative value is floor: this rounds v to the nearest bin.
-            let bin = ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w_us);
-            let row = usize::from(p.row_px);
-            let band = usize::from(row >= band_rows[0]) + usize::from(row >= band_rows[1]);
-            hist[band][bin] += 1;
-            if self.scratch.len() < self.scratch.capacity() {
-                self.scratch.push(Candidate {
-                    col_px: p.col_px,
-                    row_px: p.row_px,
-                    bin: bin as u16,
-                    band: band as u8,
-                });
+                if gate {
+                    let (gx, gy) = p.gradient();
+                    let (gx, gy) = (f32::from(gx), f32::from(gy));
+                    if (gx * slope_f32 + gy).abs() > tan_tolerance * (gx - gy * slope_f32).abs() {
+                        continue;
+                    }
+                }
+                let v = f64::from(p.col_px) - col_pred;
+                // Truncation of a non-negative value is floor: this rounds v to the nearest bin.
+                let bin = ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w_us);
+                if let Some(count) = hist.get_mut(bin) {
+                    *count += 1;
+                }
+                if self.scratch.len() < self.scratch.capacity() {
+                    self.scratch.push(Candidate {
+                        col_px: p.col_px,
+                        row_px: p.row_px,
+                        bin: bin as u16,
+                        band: band as u8,
+                    });
+                }
             }
         }
         // Band centre = midhinge (mean of the quartiles): with the two edges of a mark it
@@ -320,9 +340,11 @@ impl LaneTracker {
                 centre[b] = (a + c).div_euclid(2);
             }
         }
-        let inlier = self.cfg.track.inlier_half_width_px;
+        // |bin − centre| ≤ inlier_half_width_px for an integer difference: ≤ its floor (the
+        // configuration keeps it finite and > 0).
+        let inlier = self.cfg.track.inlier_half_width_px.floor() as i64;
         let is_inlier =
-            |c: &Candidate| (i64::from(c.bin) - centre[usize::from(c.band)]).abs() as f64 <= inlier;
+            |c: &Candidate| (i64::from(c.bin) - centre[usize::from(c.band)]).abs() <= inlier;
         // With `track.mark_centres`, one sub-pixel point per row (crate docs, "Mark centres"):
         // the inlier edge pixels of a row (both edges of the mark; the detector emits them row
         // by row) bracket the mark, and the centroid of its grey level above the local
