@@ -124,8 +124,12 @@
 //!   side of the centre, among those leaning at least `init.ego_pair.lone_min_lean_deg` from
 //!   the vertical (a vertical line alone may be a door frame or a pole: one still gives no
 //!   ground plane; a mark straight ahead is found with its partner). A lane still tracked stays
-//!   in the pair. While tracking, each row takes
-//!   the edge class of the predicted slope (either class where the mark is near vertical);
+//!   in the pair. Each band's vote, support and least squares take the pixels of its edge
+//!   class **and every pixel whose edge runs within 10° of the vertical** (`|gy| ≤ tan 10°·|gx|`,
+//!   `tracker::init::counts_as`): along a mark straight ahead `gy` is the floor's noise, its
+//!   sign — the class — falls either way, and each band saw about half of the mark. While
+//!   tracking, each row takes the edge class of the predicted slope (either class where the
+//!   mark is within the same 10° of the vertical);
 //! - refines a fresh initialisation `track.refine_passes` times on the same frame in a wider
 //!   window (`track.refine_window_half_width_px`): the Hough line of a thick or curved mark can
 //!   sit several pixels off it;

@@ -14,7 +14,7 @@ use vision_gradient::{
     keep_bright_stripes, split_stripes,
 };
 
-use super::points::fit_profile;
+use super::points::{NEAR_VERTICAL_SLOPE, fit_profile};
 use super::{
     Estimator, InitCandidate, Lane, LaneFilter, LaneState, LaneTracker, MAX_CANDIDATE_LINES,
 };
@@ -31,13 +31,33 @@ const BACKGROUND_SHIFT_BANDS: f64 = 3.0;
 /// noise.
 const UNPAIRED_PER_ROW: usize = 2;
 
-/// Appends `item(index, pixel)` for the pixels of `class` among `pixels`, in their order, without
-/// a branch on the class (the classes alternate along a row: such a branch is mispredicted
-/// often). Needs room for `pixels.len() + 1` more in `out`'s capacity not to allocate.
+/// Fixed-point scale of [`counts_as`]'s lean bound (2^14).
+const LEAN_SCALE: f64 = 16384.0;
+
+/// Whether edge pixel `p` counts as an edge of `class`: its own class, or either class when its
+/// edge runs within `atan(t)` of the vertical, `t = near_vertical_q14 / 2^14`
+/// (`|gy| ≤ t·|gx|`, in integers: `|gy| = magnitude − |gx|`, [`EdgePixel::gradient`]). The
+/// class is the sign of `gx·gy` (the edge's lean, `/` or `\\`); along a mark straight ahead the
+/// edge has almost no lean, `gy` is a few grey levels of noise, and its pixels fall into both
+/// classes at random — each band would see about half of the mark. `near_vertical_q14 = 0` is
+/// the class alone (the detector emits no pixel with `gy = 0`).
+#[inline(always)]
+pub(super) fn counts_as(p: &EdgePixel, class: EdgeClass, near_vertical_q14: i32) -> bool {
+    let gx_abs = i32::from(p.gx).abs();
+    let gy_abs = i32::from(p.magnitude) - gx_abs;
+    // Products ≤ 2040 · 2^14 < 2^31 (magnitudes ≤ 2040, bounds < 2^14 for angles < 45°).
+    (p.class == class) | (gy_abs * LEAN_SCALE as i32 <= near_vertical_q14 * gx_abs)
+}
+
+/// Appends `item(index, pixel)` for the pixels among `pixels` that count as `class`
+/// ([`counts_as`] with `near_vertical_q14`), in their order, without a branch on the class (the
+/// classes alternate along a row: such a branch is mispredicted often). Needs room for
+/// `pixels.len() + 1` more in `out`'s capacity not to allocate.
 fn extend_with_class_by<T: Copy + Default>(
     out: &mut Vec<T>,
     pixels: &[EdgePixel],
     class: EdgeClass,
+    near_vertical_q14: i32,
     item: impl Fn(usize, &EdgePixel) -> T,
 ) {
     let mut n = out.len();
@@ -46,19 +66,20 @@ fn extend_with_class_by<T: Copy + Default>(
         if let Some(slot) = out.get_mut(n) {
             *slot = item(i, p);
         }
-        n += usize::from(p.class == class);
+        n += usize::from(counts_as(p, class, near_vertical_q14));
     }
     out.truncate(n);
 }
 
-/// The `(column, row)` of the pixels of `class` among `pixels` appended to `points`
+/// The `(column, row)` of the pixels among `pixels` that count as `class` appended to `points`
 /// ([`extend_with_class_by`]).
 pub(super) fn extend_with_class(
     points: &mut Vec<(f32, f32)>,
     pixels: &[EdgePixel],
     class: EdgeClass,
+    near_vertical_q14: i32,
 ) {
-    extend_with_class_by(points, pixels, class, |_, p| {
+    extend_with_class_by(points, pixels, class, near_vertical_q14, |_, p| {
         (f32::from(p.col_px), f32::from(p.row_px))
     });
 }
@@ -148,29 +169,60 @@ impl LaneTracker {
             .then(|| u16::try_from(self.width / 2).unwrap_or(u16::MAX))
     }
 
+    /// The lean bound below which an edge pixel counts in both classes in the initialisation
+    /// ([`counts_as`], 2^14 fixed point): the joint initialisation's, `tan 10°` (as the
+    /// tracking windows take either class where the lane is within 10° of the vertical,
+    /// `points::NEAR_VERTICAL_SLOPE`); none for the paper's line per band
+    /// (`init.candidate_lines = 0`).
+    pub(super) fn near_vertical_either_class(&self) -> i32 {
+        if self.cfg.init.candidate_lines > 0 {
+            (NEAR_VERTICAL_SLOPE * LEAN_SCALE).round() as i32
+        } else {
+            0
+        }
+    }
+
     /// `self.candidates` = the edge pixels of `class` (from the last full-ROI gradient).
     fn fill_candidates(&mut self, class: EdgeClass) {
         self.candidates.clear();
-        extend_with_class(&mut self.candidates, self.edges.pixels(), class);
+        let near_vertical = self.near_vertical_either_class();
+        extend_with_class(
+            &mut self.candidates,
+            self.edges.pixels(),
+            class,
+            near_vertical,
+        );
         // Weighted stripe pairing: the sides of bright stripes count `stripe_paired_votes`
         // times in all, the other edge pixels once.
         if self.cfg.gradient.stripe_paired_votes > 0 {
             for _ in 1..self.cfg.gradient.stripe_paired_votes {
-                extend_with_class(&mut self.candidates, self.paired.pixels(), class);
+                extend_with_class(
+                    &mut self.candidates,
+                    self.paired.pixels(),
+                    class,
+                    near_vertical,
+                );
             }
         }
     }
 
-    /// The number of pixels [`Self::fill_candidates`] would put in `self.candidates` for
-    /// `class`, without filling it.
-    fn candidate_count(&self, class: EdgeClass) -> usize {
+    /// Whether [`Self::fill_candidates`] would put at least `min` pixels in `self.candidates`
+    /// for `class`, counted without filling it and only until `min` is reached.
+    fn has_candidates(&self, class: EdgeClass, min: usize) -> bool {
         let votes = usize::from(self.cfg.gradient.stripe_paired_votes);
-        let paired = if votes > 1 {
-            (votes - 1) * self.paired.iter_class(class).count()
-        } else {
-            0
+        let near_vertical = self.near_vertical_either_class();
+        // At most `min` of `pixels` that count as `class`.
+        let count = |pixels: &[EdgePixel]| {
+            pixels
+                .iter()
+                .filter(|p| counts_as(p, class, near_vertical))
+                .take(min)
+                .count()
         };
-        self.edges.iter_class(class).count() + paired
+        let edges = count(self.edges.pixels());
+        // With fewer than `min` edge pixels, the paired ones are counted `votes − 1` times more:
+        // `min` of them (capped) already make `min` when `votes > 1`.
+        edges >= min || (votes > 1 && edges + (votes - 1) * count(self.paired.pixels()) >= min)
     }
 
     /// Joint initialisation (`init.candidate_lines > 0`, crate docs): the strongest
@@ -201,7 +253,7 @@ impl LaneTracker {
         let first = self.init_candidates.len();
         for (k, _) in vote.into_iter().enumerate().filter(|&(_, votes)| votes) {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
-            if self.candidate_count(class) < self.init_params.min_points {
+            if !self.has_candidates(class, self.init_params.min_points) {
                 continue;
             }
             if self.cfg.init.candidate_coverage || self.cfg.init.orientation_tolerance_deg > 0.0 {
@@ -324,9 +376,10 @@ impl LaneTracker {
         let paired_votes = self.cfg.gradient.stripe_paired_votes;
         let bit =
             |p: &vision_gradient::EdgePixel| usize::from(p.row_px) * w + usize::from(p.col_px);
+        let near_vertical = self.near_vertical_either_class();
         let mask = &mut self.paired_mask;
         if paired_votes > 0 {
-            for p in self.paired.iter_class(class) {
+            for p in (self.paired.pixels().iter()).filter(|p| counts_as(p, class, near_vertical)) {
                 if let Some(word) = mask.get_mut(bit(p) / 64) {
                     *word |= 1 << (bit(p) % 64);
                 }
@@ -340,7 +393,7 @@ impl LaneTracker {
         let of_class = &mut self.of_class;
         of_class.clear();
         // i < the buffer's capacity ≤ width·height < 2³².
-        extend_with_class_by(of_class, pixels, class, |i, _| i as u32);
+        extend_with_class_by(of_class, pixels, class, near_vertical, |i, _| i as u32);
         let of_class = &*of_class;
         let in_class = || of_class.iter().filter_map(|&i| pixels.get(i as usize));
         for e in in_class() {
@@ -384,7 +437,7 @@ impl LaneTracker {
             }
         }
         // Leave the mask clear for the next call.
-        for p in self.paired.iter_class(class) {
+        for p in (self.paired.pixels().iter()).filter(|p| counts_as(p, class, near_vertical)) {
             if let Some(word) = mask.get_mut(bit(p) / 64) {
                 *word = 0;
             }

@@ -182,7 +182,7 @@ fn step_edge(pixels: &[u8], step: f64) -> Option<(f64, f64)> {
 /// `|dx/dy|` below which a tracked mark is near vertical and both edge classes are taken
 /// (joint initialisation): tan 10°, within 10° of the vertical (the edge band of the default
 /// reaches 90°, the presets' 80°).
-const NEAR_VERTICAL_SLOPE: f64 = 0.176;
+pub(super) const NEAR_VERTICAL_SLOPE: f64 = 0.176;
 
 /// Uniform decimation of `total` items in order down to `max` (all of them when
 /// `total ≤ max`): item `j` is kept iff `⌊(j+1)·max/total⌋ > ⌊j·max/total⌋`, i.e. iff a

@@ -3,9 +3,10 @@
 
 use alloc_counter::{CountingAllocator, allocations_in};
 use info_filter::KifError;
-use vision_gradient::GreyImage;
+use vision_gradient::{EdgeClass, EdgePixel, GreyImage};
 use wrls::WrlsError;
 
+use super::init::counts_as;
 use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, Side};
 use crate::{FilterFailure, GreyFrame, TrackerConfig};
 use hough_init::Parabola;
@@ -593,7 +594,7 @@ fn the_branch_free_append_keeps_one_class_in_order_without_allocating() {
         let mut points = Vec::with_capacity(1 + pixels.len() + 1);
         points.push((-1.0, -1.0));
         let (_, allocations) =
-            allocations_in(|| super::init::extend_with_class(&mut points, &pixels, class));
+            allocations_in(|| super::init::extend_with_class(&mut points, &pixels, class, 0));
         assert_eq!(allocations, 0);
         assert_eq!(points, want);
     }
@@ -734,4 +735,116 @@ fn a_crosswalk_is_not_reported_as_a_lane_and_marks_across_it_are() {
         on.iter().all(|e| e.is_some_and(|e| e < 5.0)),
         "marks through the crosswalk: {on:?} px"
     );
+}
+
+/// A mark straight ahead of the camera (vertical, columns 141..147) and a `\` mark on the right
+/// (centre `220 + 0.45·(y − 239)`), both 6 px wide and grey 200, anti-aliased, on a floor of
+/// grey 60 with a deterministic texture of ±3 grey levels: along the vertical mark's edges
+/// `gy` is that texture, so its sign — the pixel's class — is random.
+fn mark_straight_ahead(w: usize, h: usize) -> GreyFrame {
+    let on_mark = |x: f64, y: f64| {
+        (141.0..147.0).contains(&x) || (x - (220.0 + 0.45 * (y - 239.0))).abs() < 3.0
+    };
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f64, (i / w) as f64);
+            // A splitmix64 finaliser of the pixel index: no pattern along rows or columns.
+            let mut hash = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+            hash = (hash ^ (hash >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            hash = (hash ^ (hash >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            hash = (hash ^ (hash >> 31)) % 7;
+            let floor = 60.0 + hash as f64 - 3.0;
+            let cover = (0..16)
+                .filter(|s| {
+                    on_mark(
+                        x - 0.375 + 0.25 * f64::from(s % 4),
+                        y - 0.375 + 0.25 * f64::from(s / 4),
+                    )
+                })
+                .count() as f64
+                / 16.0;
+            (floor + cover * (200.0 - floor)).round() as u8
+        })
+        .collect();
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn a_mark_straight_ahead_votes_with_all_its_edges_in_the_initialisation() {
+    // A near-vertical edge pixel counts in both classes; a leaning one, or any with the rule
+    // off, in its own.
+    let pixel = |gx: i16, gy: i16| {
+        let magnitude = (gx.abs() + gy.abs()) as u16;
+        let class = if (gx ^ gy) < 0 {
+            EdgeClass::RightLane
+        } else {
+            EdgeClass::LeftLane
+        };
+        EdgePixel {
+            col_px: 10,
+            row_px: 10,
+            magnitude,
+            class,
+            gx,
+        }
+    };
+    // The tracking windows' near-vertical slope (≈ tan 10°) in 2^14 fixed point, as the
+    // default's joint initialisation uses it.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let tan_10 = LaneTracker::new(&cfg, Estimator::Kif, 320, 240)
+        .expect("a tracker")
+        .near_vertical_either_class();
+    assert_eq!(
+        tan_10,
+        (super::points::NEAR_VERTICAL_SLOPE * 16384.0).round() as i32
+    );
+    for (gx, gy, both) in [
+        (200, 3, true),
+        (-200, 3, true),
+        (200, -35, true),
+        (200, 36, false),
+    ] {
+        let p = pixel(gx, gy);
+        let other = if p.class == EdgeClass::LeftLane {
+            EdgeClass::RightLane
+        } else {
+            EdgeClass::LeftLane
+        };
+        assert!(counts_as(&p, p.class, tan_10) && counts_as(&p, p.class, 0));
+        assert_eq!(counts_as(&p, other, tan_10), both, "gx {gx}, gy {gy}");
+        assert!(!counts_as(&p, other, 0), "gx {gx}, gy {gy}: the rule off");
+    }
+    // The mark straight ahead is a candidate (within 4 px: on either edge of the 6 px mark, or
+    // between them) with most of the support of the leaning mark (same width, contrast and
+    // rows): 77 % of it (the detector keeps no pixel where the texture leaves `gy = 0`), against
+    // 43 % when each pixel counts in its own class only. The pair is reported on both marks.
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let report = tracker
+        .track(&mark_straight_ahead(320, 240))
+        .expect("a frame");
+    let marks = [|_: f64| 143.5, |y: f64| 220.0 + 0.45 * (y - 239.0)];
+    let col = |c: [f64; 3], y: f64| Parabola::from_coeffs(c).col_at_row(y);
+    let worst = |c: [f64; 3], k: usize| {
+        (top..bottom)
+            .map(|y| (col(c, y as f64) - marks[k](y as f64)).abs())
+            .fold(0.0, f64::max)
+    };
+    let best_support = |k: usize| {
+        tracker
+            .init_candidates()
+            .iter()
+            .filter(|c| worst(c.coeffs, k) < 4.0)
+            .map(|c| c.support)
+            .fold(0.0, f64::max)
+    };
+    let (straight, leaning) = (best_support(0), best_support(1));
+    assert!(
+        straight >= 0.7 * leaning && leaning > 0.0,
+        "support: straight ahead {straight}, leaning {leaning}"
+    );
+    for k in 0..2 {
+        let c = report.lanes[k].coeffs.expect("a lane on each mark");
+        assert!(worst(c, k) < 1.5, "lane {k}: {} px", worst(c, k));
+    }
 }
