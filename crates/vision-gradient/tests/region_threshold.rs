@@ -122,6 +122,48 @@ fn regions_select_exactly_their_pixels() {
     }
 }
 
+/// Row segments of every length from 1 to 200 px: each gives exactly the full frame's pixels
+/// inside it, and the full frame's list holds exactly its class image's pixels. The kernel
+/// works in blocks of 16 px, the last one of a segment overlapping the one before it, and
+/// segments shorter than a block pixel by pixel: every remainder, every count of blocks.
+#[test]
+fn segments_of_every_length_emit_exactly_their_pixels() {
+    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    let (w, h) = (260, 203);
+    let data = random_image(&mut rng, w, h);
+    let det = fixed(300);
+    let (full, _, full_cls) = detect(&det, &data, w, h, Region::Full);
+    let from_class_image: Vec<(u16, u16)> = (0..h)
+        .rev()
+        .flat_map(|r| (0..w).map(move |c| (r, c)))
+        .filter(|&(r, c)| full_cls[r * w + c] != 0)
+        .map(|(r, c)| (r as u16, c as u16))
+        .collect();
+    let listed: Vec<(u16, u16)> = full.iter().map(|p| (p.row_px, p.col_px)).collect();
+    assert_eq!(listed, from_class_image);
+    // Row r (1..=200) holds a segment r px long, its start spread over the row.
+    let spans: Vec<ColSpan> = (0..h)
+        .map(|r| {
+            if r == 0 || r > 200 {
+                return ColSpan::EMPTY;
+            }
+            let start = 1 + (r * 37) % (w - 2 - r);
+            ColSpan::clamped(start as i64, (start + r) as i64, w)
+        })
+        .collect();
+    let (got, _, _) = detect(&det, &data, w, h, Region::Spans(&spans));
+    let want: Vec<EdgePixel> = full
+        .iter()
+        .copied()
+        .filter(|p| {
+            let span = spans[usize::from(p.row_px)];
+            (span.col_start_px..span.col_end_px).contains(&p.col_px)
+        })
+        .collect();
+    assert!(want.len() > 1000, "test geometry: {} pixels", want.len());
+    assert_eq!(got, want);
+}
+
 /// The adaptive threshold is the (1 - f) quantile of the in-band magnitudes, checked against a
 /// sort of the f64 reference magnitudes (band disabled, so the population is every interior
 /// pixel with gx != 0 and gy != 0).
