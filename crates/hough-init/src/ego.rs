@@ -52,6 +52,11 @@ pub struct EgoPairParams {
     /// corner) is as likely a vertical structure as a mark straight ahead, while a mark straight
     /// ahead is still found with its partner. Default `0.0`.
     pub lone_min_lean_deg: f64,
+    /// The boundaries may meet within this top fraction of the chord's rows, in `[0, 0.5)`:
+    /// the vanishing point lies inside the region of interest when its top rows reach above
+    /// the horizon (a camera pitched up, a region set for another camera). Below that row the
+    /// pair must be in order. `0`: they meet above the region. Default `0.0`.
+    pub meet_top_frac: f64,
 }
 
 impl Default for EgoPairParams {
@@ -65,6 +70,7 @@ impl Default for EgoPairParams {
             min_support_frac: 0.2,
             width_weight: 0.0,
             lone_min_lean_deg: 0.0,
+            meet_top_frac: 0.0,
         }
     }
 }
@@ -135,6 +141,9 @@ impl EgoPairParams {
                 "must be in [0, 90)",
             );
         }
+        if !(0.0..0.5).contains(&self.meet_top_frac) {
+            return bad("meet_top_frac", self.meet_top_frac, "must be in [0, 0.5)");
+        }
         Ok(())
     }
 }
@@ -152,7 +161,9 @@ pub struct EgoChoice {
 /// boundaries can lean the same way). A pair `(L, R)` is plausible when
 ///
 /// * `w_b = R.bottom − L.bottom` lies in `[min_width_frac, max_width_frac]·W`;
-/// * the boundaries meet above the ROI: `0 ≤ R.top − L.top ≤ max_top_width_ratio·w_b`;
+/// * the boundaries converge upwards, `w_t = R.top − L.top ≤ max_top_width_ratio·w_b`, and
+///   meet above the ROI or within its top `f = meet_top_frac` of the rows: the chords are in
+///   order at that row, `w_t + f·(w_b − w_t) ≥ 0` (`w_t ≥ 0` for `f = 0`);
 /// * the camera is inside the lane: `L.bottom ≤ W/2 + m` and `R.bottom ≥ W/2 − m`,
 ///   `m = centre_margin_frac·W`;
 ///
@@ -206,7 +217,7 @@ pub fn choose_ego_pair(
             let wt = cr.col_top_px - cl.col_top_px;
             let ok = wb >= params.min_width_frac * w
                 && wb <= params.max_width_frac * w
-                && wt >= 0.0
+                && wt + params.meet_top_frac * (wb - wt) >= 0.0
                 && wt <= params.max_top_width_ratio * wb
                 && cl.col_bottom_px <= c + m
                 && cr.col_bottom_px >= c - m;
@@ -305,6 +316,37 @@ mod tests {
                 right: Some(1)
             }
         );
+    }
+
+    #[test]
+    fn boundaries_may_meet_within_the_top_fraction_and_nowhere_lower() {
+        // 100 chord rows; ego boundaries 200 px apart at the bottom that cross 10 rows below
+        // the top (the vanishing point inside the region): 22.2 px crossed at the top.
+        let (l_bottom, r_bottom, meet_row) = (60.0, 260.0, 10.0);
+        let top = |bottom: f64| 160.0 + (bottom - 160.0) * (-meet_row) / (100.0 - meet_row);
+        let chords = [
+            ch(top(l_bottom), l_bottom, 50.0),
+            ch(top(r_bottom), r_bottom, 50.0),
+        ];
+        assert!(
+            chords[0].col_top_px > chords[1].col_top_px,
+            "crossed at the top"
+        );
+        let pair = EgoChoice {
+            left: Some(0),
+            right: Some(1),
+        };
+        let with = |f: f64| EgoPairParams {
+            meet_top_frac: f,
+            ..EgoPairParams::default()
+        };
+        // They meet at 0.1 of the rows: a pair for f above it, not below.
+        for (f, is_pair) in [(0.0, false), (0.09, false), (0.11, true), (0.25, true)] {
+            let got = choose_ego_pair(&chords, 320.0, 100.0, &with(f), None);
+            assert_eq!(got == pair, is_pair, "meet_top_frac {f}: {got:?}");
+        }
+        assert!(with(0.5).validate().is_err() && with(-0.1).validate().is_err());
+        assert!(with(0.49).validate().is_ok());
     }
 
     #[test]

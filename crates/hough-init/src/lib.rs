@@ -102,7 +102,8 @@
 //! [`HoughWorkspace::find_lines`] returns the strongest few lines of a band (non-maximum
 //! suppression in θ and ρ) instead of the single best; [`choose_ego_pair`] picks the ego lane's
 //! two boundaries among the candidates of both bands jointly — a plausible lane width at the
-//! bottom ROI row, boundaries that converge towards a vanishing point above the ROI, the camera
+//! bottom ROI row, boundaries that converge towards a vanishing point above the ROI (or within
+//! its top rows, `EgoPairParams::meet_top_frac`), the camera
 //! inside the lane, the pair nearest the image centre — so a neighbour lane's stronger line, a
 //! crosswalk stripe or a car edge leaning the wrong way no longer wins on votes alone, and on a
 //! curve the two boundaries may lean the same way. Without a plausible pair a single line is

@@ -87,9 +87,10 @@
 //!    ROI rows; then refined by one windowed update on the same frame.
 //!    With `init.candidate_lines > 0` (the default configuration) the initialisation is
 //!    *joint* instead, see *Joint initialisation* below.
-//! 3. *Crossing gate*: the lanes may not cross at the top ROI row nor come closer than
-//!    `track.min_lane_separation_px` at the middle and bottom rows; the estimate just
-//!    initialised, else the one with fewer points, is undone.
+//! 3. *Crossing gate*: the lanes may not cross at the top ROI row (with
+//!    `init.ego_pair.meet_top_frac`, below the top fraction of the ROI rows where the vanishing
+//!    point may lie) nor come closer than `track.min_lane_separation_px` at the middle and
+//!    bottom rows; the estimate just initialised, else the one with fewer points, is undone.
 //!
 //! No allocation in [`LaneTracker::track`] (tested with a counting allocator).
 //!
@@ -112,7 +113,10 @@
 //! - takes the **`init.candidate_lines` strongest lines** of each band
 //!   (`hough_init::HoughWorkspace::find_lines`, non-maximum suppression) and **chooses the ego
 //!   pair jointly** (`hough_init::choose_ego_pair`, `[init.ego_pair]`): a lane width at the
-//!   bottom ROI row within `[0.2, 1.5]·W`, boundaries converging above the ROI, the camera
+//!   bottom ROI row within `[0.2, 1.5]·W`, boundaries converging upwards and meeting above the
+//!   ROI or within its top quarter of rows (`init.ego_pair.meet_top_frac = 0.25`: with the
+//!   camera pitched up, or the ROI's top fraction set for another camera, its top rows reach
+//!   above the vanishing point), the camera
 //!   inside the lane, then support minus the pair's offset from the image centre and its width
 //!   (`init.ego_pair.width_weight`: the nearest boundary on each side). With
 //!   `init.candidate_coverage` a candidate is seen as the least-squares parabola it would be

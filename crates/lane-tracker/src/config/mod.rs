@@ -527,6 +527,7 @@ impl TrackerConfig {
                     "centre_weight" => "init.ego_pair.centre_weight",
                     "width_weight" => "init.ego_pair.width_weight",
                     "lone_min_lean_deg" => "init.ego_pair.lone_min_lean_deg",
+                    "meet_top_frac" => "init.ego_pair.meet_top_frac",
                     _ => "init.ego_pair.min_support_frac",
                 },
                 value,

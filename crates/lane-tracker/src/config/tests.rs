@@ -143,6 +143,9 @@ fn each_out_of_range_field_is_named() {
         ("init.ego_pair.lone_min_lean_deg", |c| {
             c.init.ego_pair.lone_min_lean_deg = 90.0
         }),
+        ("init.ego_pair.meet_top_frac", |c| {
+            c.init.ego_pair.meet_top_frac = 0.5
+        }),
         ("init.kerb_foot", |c| {
             c.init.kerb_foot = true;
             c.gradient.stripe_max_width_px = 3;

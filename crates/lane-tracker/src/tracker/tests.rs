@@ -848,3 +848,67 @@ fn a_mark_straight_ahead_votes_with_all_its_edges_in_the_initialisation() {
         assert!(worst(c, k) < 1.5, "lane {k}: {} px", worst(c, k));
     }
 }
+
+/// Two marks 5 px wide on a dark floor meeting at the vanishing point `(160, meet_row)`, from
+/// columns 60 and 260 at the bottom row; nothing is painted above that row.
+fn marks_meeting_at(w: usize, h: usize, meet_row: f64) -> GreyFrame {
+    let mark = |bottom_col: f64, y: f64| {
+        160.0 + (bottom_col - 160.0) * (y - meet_row) / (239.0 - meet_row)
+    };
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if y > meet_row && ((x - mark(60.0, y)).abs() < 2.5 || (x - mark(260.0, y)).abs() < 2.5) {
+            *p = 200;
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn a_vanishing_point_inside_the_roi_still_gives_the_pair_and_keeps_it() {
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    // The marks meet a tenth of the ROI's rows below its top: crossed at the top row.
+    let meet_row = top as f64 + 0.1 * (bottom - 1 - top) as f64;
+    let frame = marks_meeting_at(320, 240, meet_row);
+    let marks = [60.0, 260.0]
+        .map(|b: f64| move |y: f64| 160.0 + (b - 160.0) * (y - meet_row) / (239.0 - meet_row));
+    // Largest distance of each reported lane from its mark over the rows 10 below the meeting
+    // row to the bottom (`None`: no lane), on each of `frames` frames.
+    let errors = |cfg: &TrackerConfig, frames: usize| {
+        let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        (0..frames)
+            .map(|_| {
+                let report = tracker.track(&frame).expect("a frame");
+                [0, 1].map(|k| {
+                    report.lanes[k].coeffs.map(|c| {
+                        ((meet_row as usize + 10)..bottom)
+                            .map(|y| {
+                                let y = y as f64;
+                                (Parabola::from_coeffs(c).col_at_row(y) - marks[k](y)).abs()
+                            })
+                            .fold(0.0, f64::max)
+                    })
+                })
+            })
+            .collect::<Vec<_>>()
+    };
+    assert!(cfg.init.ego_pair.meet_top_frac >= 0.1);
+    // The pair on the first frame, kept by the crossing gate on the next ones.
+    for (n, frame_errors) in errors(&cfg, 5).iter().enumerate() {
+        assert!(
+            frame_errors.iter().all(|e| e.is_some_and(|e| e < 2.0)),
+            "frame {n}: {frame_errors:?} px"
+        );
+    }
+    // Meeting only above the ROI: no pair.
+    let mut above = cfg;
+    above.init.ego_pair.meet_top_frac = 0.0;
+    let first = errors(&above, 1)[0];
+    assert!(
+        !first.iter().all(|e| e.is_some_and(|e| e < 2.0)),
+        "without the rule: {first:?}"
+    );
+}

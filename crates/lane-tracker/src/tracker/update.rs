@@ -122,8 +122,10 @@ impl LaneTracker {
         };
     }
 
-    /// Left and right lanes may not cross at the top ROI row, nor come closer than
-    /// `min_lane_separation_px` at the middle and bottom ROI rows. The offending estimate is the one that changed on this
+    /// Left and right lanes may not cross below the top `init.ego_pair.meet_top_frac` of the ROI
+    /// rows (at the top row when it is 0: where the vanishing point may lie, as for the ego
+    /// pair's choice), nor come closer than `min_lane_separation_px` at the middle and bottom
+    /// ROI rows. The offending estimate is the one that changed on this
     /// frame by initialisation, else the one backed by fewer points; it is undone. The gate
     /// compares the edges the filters track: a kerb's offset (`init.kerb_foot`, at most
     /// `gradient.stripe_max_width_px + 1` px towards the road) is not part of it.
@@ -137,10 +139,11 @@ impl LaneTracker {
         }
         let (top, bottom) = self.search_rows;
         let sep = self.cfg.track.min_lane_separation_px;
-        // Lanes converge towards the horizon: at the top ROI row they need only be in order,
-        // at the middle and bottom rows `sep` apart.
+        // Lanes converge towards the horizon: at the row `meet_top_frac` of the ROI down (the top
+        // row for 0) they need only be in order, at the middle and bottom rows `sep` apart.
+        let meet = self.cfg.init.ego_pair.meet_top_frac;
         let rows = [
-            (top as f64, 0.0),
+            (top as f64 + meet * (bottom - 1 - top) as f64, 0.0),
             (0.5 * (top + bottom - 1) as f64, sep),
             ((bottom - 1) as f64, sep),
         ];
