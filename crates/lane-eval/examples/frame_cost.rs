@@ -1,0 +1,60 @@
+//! A deterministic work count for the tracker's frames, beside the criterion bench
+//! (`cargo bench -p lane-eval --bench track`), whose wall times swing with a shared VM's load:
+//! runs `N` frames of one kind on the udacity clip's 10th frame (the bench's frame) with the
+//! default configuration and prints the wall time per frame. Run under
+//! `valgrind --tool=callgrind --callgrind-out-file=/dev/null` with `N` and with `0` frames; the
+//! difference of the two "Collected" counts over `N` is the instructions per frame.
+//!
+//! `frame_cost KIND N`, `KIND` one of `init` (an initialisation frame), `right` (the ROI's right
+//! half blanked: the second search runs for the right side), `both` (the whole ROI blanked: both
+//! sides searched for over the taller rows), `track` (a tracked frame).
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+use lane_io::FrameSource;
+use lane_io::y4m::Y4mSource;
+use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let kind = args.next().unwrap_or_else(|| "init".into());
+    let n: usize = args
+        .next()
+        .map_or(100, |s| s.parse().expect("a frame count"));
+    let path = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).expect("the udacity clip");
+    let file = std::fs::File::open(&path).expect("the udacity clip opens");
+    let mut src = Y4mSource::new(std::io::BufReader::new(file), path.display().to_string())
+        .expect("a y4m stream");
+    let mut frame = GreyFrame::default();
+    for _ in 0..10 {
+        src.next_frame(&mut frame).unwrap().expect("10 frames");
+    }
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let mut tracker =
+        LaneTracker::new(&cfg, Estimator::Kif, frame.width(), frame.height()).unwrap();
+    for _ in 0..5 {
+        tracker.track(&frame).unwrap();
+    }
+    let (top, bottom) = tracker.roi_rows();
+    let w = frame.width();
+    let blank_from = match kind.as_str() {
+        "init" | "track" => None,
+        "right" => Some(w / 2),
+        "both" => Some(0),
+        other => panic!("unknown kind {other}: init, right, both or track"),
+    };
+    let mut input = frame.clone();
+    if let Some(from_col) = blank_from {
+        let fill = frame.data()[top * w];
+        for row in input.data_mut()[top * w..bottom * w].chunks_mut(w) {
+            row[from_col..].fill(fill);
+        }
+    }
+    let start = std::time::Instant::now();
+    for _ in 0..n {
+        if kind != "track" {
+            tracker.reset();
+        }
+        std::hint::black_box(tracker.track(std::hint::black_box(&input)).unwrap());
+    }
+    let per_frame_us = start.elapsed().as_secs_f64() * 1e6 / n.max(1) as f64;
+    println!("{kind}: {n} frames, {per_frame_us:.1} µs a frame (wall)");
+}
