@@ -657,6 +657,20 @@ fn unpaired_pixels_count_one_steps_worth_a_row_in_the_row_coverage() {
     assert_eq!(coverage(&beside), 4.0 * rows);
 }
 
+/// The fraction of pixel `(x, y)` that `inside` covers, sampled on a 4×4 grid: a painted shape
+/// anti-aliased as a lens and sensor blur its edges.
+fn cover(inside: &dyn Fn(f64, f64) -> bool, x: f64, y: f64) -> f64 {
+    (0..16)
+        .filter(|s| {
+            inside(
+                x - 0.375 + 0.25 * f64::from(s % 4),
+                y - 0.375 + 0.25 * f64::from(s / 4),
+            )
+        })
+        .count() as f64
+        / 16.0
+}
+
 /// A crosswalk across the near rows (165..225) of a dark floor, right of the camera: five
 /// bright stripes along the road (towards a vanishing point at (160, 100)), 14 px wide and 16 px
 /// apart at the bottom row from column 185, narrowing with distance, anti-aliased; with `marks`,
@@ -680,16 +694,7 @@ fn crosswalk(w: usize, h: usize, marks: bool) -> GreyFrame {
         if !(165.0..225.0).contains(&y) {
             continue;
         }
-        // Anti-aliased as a lens and sensor blur an edge: the pixel's cover on a 4×4 grid.
-        let cover = (0..16)
-            .filter(|s| {
-                on_stripe(
-                    x - 0.375 + 0.25 * f64::from(s % 4),
-                    y - 0.375 + 0.25 * f64::from(s / 4),
-                )
-            })
-            .count() as f64
-            / 16.0;
+        let cover = cover(&on_stripe, x, y);
         *p = (f64::from(*p) + cover * (220.0 - f64::from(*p))).round() as u8;
     }
     GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
@@ -754,16 +759,7 @@ fn mark_straight_ahead(w: usize, h: usize) -> GreyFrame {
             hash = (hash ^ (hash >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
             hash = (hash ^ (hash >> 31)) % 7;
             let floor = 60.0 + hash as f64 - 3.0;
-            let cover = (0..16)
-                .filter(|s| {
-                    on_mark(
-                        x - 0.375 + 0.25 * f64::from(s % 4),
-                        y - 0.375 + 0.25 * f64::from(s / 4),
-                    )
-                })
-                .count() as f64
-                / 16.0;
-            (floor + cover * (200.0 - floor)).round() as u8
+            (floor + cover(&on_mark, x, y) * (200.0 - floor)).round() as u8
         })
         .collect();
     GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
