@@ -182,7 +182,9 @@ impl LaneTracker {
         }
     }
 
-    /// `self.candidates` = the edge pixels of `class` (from the last full-ROI gradient).
+    /// `self.candidates` = the edge pixels that count as `class` ([`counts_as`]: those of the
+    /// class and the near-vertical ones of either), from the last full-ROI gradient, the
+    /// paired ones `gradient.stripe_paired_votes` times.
     fn fill_candidates(&mut self, class: EdgeClass) {
         self.candidates.clear();
         let near_vertical = self.near_vertical_either_class();
@@ -436,10 +438,12 @@ impl LaneTracker {
                 *k += 1;
             }
         }
-        // Leave the mask clear for the next call.
-        for p in (self.paired.pixels().iter()).filter(|p| counts_as(p, class, near_vertical)) {
-            if let Some(word) = mask.get_mut(bit(p) / 64) {
-                *word = 0;
+        // Leave the mask clear for the next call: every word a paired pixel may have set.
+        if paired_votes > 0 {
+            for p in self.paired.pixels() {
+                if let Some(word) = mask.get_mut(bit(p) / 64) {
+                    *word = 0;
+                }
             }
         }
         for r in 0..h {

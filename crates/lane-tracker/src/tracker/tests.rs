@@ -657,6 +657,53 @@ fn unpaired_pixels_count_one_steps_worth_a_row_in_the_row_coverage() {
     assert_eq!(coverage(&beside), 4.0 * rows);
 }
 
+/// A bright road between the outer edges of `two_marks`' marks on a dark floor: the same
+/// rising and falling edge pixels as those marks' outer sides, but each the side of a region
+/// far wider than a mark (no stripe pairs them).
+fn road_between_marks(w: usize, h: usize) -> GreyFrame {
+    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if x > left(y) - 2.5 && x < right(y) + 2.5 {
+            *p = 200;
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn one_frames_stripe_pairs_do_not_weigh_the_next_frames_pixels() {
+    // The paired pixels of a frame are marked in a bit mask for the initialisation's weights
+    // and the mask is cleared after use; a bit left set would count an unpaired pixel at the
+    // same place on a later frame as paired (3 votes, not a step's share) and change its
+    // candidates' support.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(cfg.gradient.stripe_paired_votes > 1);
+    let (marks, road) = (two_marks(320, 240), road_between_marks(320, 240));
+    let candidates_on_road = |tracker: &mut LaneTracker| {
+        tracker.reset();
+        tracker.track(&road).expect("a frame");
+        tracker.init_candidates().to_vec()
+    };
+    let mut fresh = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let alone = candidates_on_road(&mut fresh);
+    assert!(!alone.is_empty(), "the road's edges give candidates");
+    let mut used = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    used.track(&marks).expect("a frame");
+    assert!(
+        used.init_candidates().iter().any(|c| c.chosen.is_some()),
+        "the marks were initialised (their sides paired)"
+    );
+    let after_marks = candidates_on_road(&mut used);
+    assert_eq!(after_marks, alone);
+    // And again, with the marks' frame in between.
+    used.reset();
+    used.track(&marks).expect("a frame");
+    assert_eq!(candidates_on_road(&mut used), alone);
+}
+
 /// The fraction of pixel `(x, y)` that `inside` covers, sampled on a 4×4 grid: a painted shape
 /// anti-aliased as a lens and sensor blur its edges.
 fn cover(inside: &dyn Fn(f64, f64) -> bool, x: f64, y: f64) -> f64 {
