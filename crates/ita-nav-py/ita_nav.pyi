@@ -47,6 +47,7 @@ class Counters(TypedDict):
     initialisations: Tuple[int, int]
     gated_jumps: Tuple[int, int]
     gated_crossings: Tuple[int, int]
+    gated_pairs: int
 
 class LaneTracker:
     """One tracker per video stream; every frame must have the size of the first one."""

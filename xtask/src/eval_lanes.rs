@@ -60,6 +60,12 @@ pub struct EvalLanesArgs {
     /// refinement).
     #[arg(long)]
     census: bool,
+    /// Track each set's frames as one sequence, in set order, never reset between clips: a
+    /// stress test of the tracking path (the labelled frames are stills seconds apart, so every
+    /// frame is an abrupt change of scene the tracker has to notice), not an accuracy figure
+    /// for video. Not with `--check` or `--record` (the floors are for the stills).
+    #[arg(long)]
+    one_sequence: bool,
 }
 
 /// Format version of `summary.json`.
@@ -300,7 +306,18 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
     }
     let out = resolve(&root, &args.out);
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
-    let sets = find_sets(&sets_dir)?;
+    if args.one_sequence && (args.check || args.record) {
+        bail!("--one-sequence is a stress test: the floors (--check, --record) are for the stills");
+    }
+    let mut sets = find_sets(&sets_dir)?;
+    if args.one_sequence {
+        for (_, set) in &mut sets {
+            let one = format!("{}-one-sequence", set.set);
+            for f in &mut set.frames {
+                f.clip.clone_from(&one);
+            }
+        }
+    }
     let rules = ScoringRules::default();
 
     let mut configs: Vec<(String, TrackerConfig)> =

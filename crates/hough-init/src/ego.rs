@@ -157,6 +157,28 @@ pub struct EgoChoice {
     pub right: Option<usize>,
 }
 
+/// Whether `(left, right)` has the shape of an ego lane, the first two rules of
+/// [`choose_ego_pair`]: with `w_b = right.bottom − left.bottom` and `w_t = right.top −
+/// left.top`, `w_b ∈ [min_width_frac, max_width_frac]·W`, `w_t ≤ max_top_width_ratio·w_b` and
+/// `w_t + meet_top_frac·(w_b − w_t) ≥ 0` (converging upwards, meeting above the region or
+/// within its top fraction of rows). The camera-inside rule is not part of it (a tracked pair
+/// may leave it in a lane change). Non-finite columns are not plausible.
+pub fn pair_shape_is_plausible(
+    left: &Chord,
+    right: &Chord,
+    image_width_px: f64,
+    params: &EgoPairParams,
+) -> bool {
+    let w = image_width_px;
+    let wb = right.col_bottom_px - left.col_bottom_px;
+    let wt = right.col_top_px - left.col_top_px;
+    // `false` for NaN: every comparison with it is.
+    wb >= params.min_width_frac * w
+        && wb <= params.max_width_frac * w
+        && wt + params.meet_top_frac * (wb - wt) >= 0.0
+        && wt <= params.max_top_width_ratio * wb
+}
+
 /// Chooses the ego lane's two boundaries jointly among `chords` (any lean: on a curve both
 /// boundaries can lean the same way). A pair `(L, R)` is plausible when
 ///
@@ -214,11 +236,7 @@ pub fn choose_ego_pair(
             }
             let (cl, cr) = (&chords[l], &chords[r]);
             let wb = cr.col_bottom_px - cl.col_bottom_px;
-            let wt = cr.col_top_px - cl.col_top_px;
-            let ok = wb >= params.min_width_frac * w
-                && wb <= params.max_width_frac * w
-                && wt + params.meet_top_frac * (wb - wt) >= 0.0
-                && wt <= params.max_top_width_ratio * wb
+            let ok = pair_shape_is_plausible(cl, cr, w, params)
                 && cl.col_bottom_px <= c + m
                 && cr.col_bottom_px >= c - m;
             if !ok {
@@ -347,6 +365,46 @@ mod tests {
         }
         assert!(with(0.5).validate().is_err() && with(-0.1).validate().is_err());
         assert!(with(0.49).validate().is_ok());
+    }
+
+    #[test]
+    fn a_pairs_shape_is_its_width_and_its_convergence_not_where_the_camera_is() {
+        let p = EgoPairParams::default(); // width 0.2–1.5 W, top ≤ 0.9 × bottom
+        let shape = |l: (f64, f64), r: (f64, f64)| {
+            pair_shape_is_plausible(&ch(l.0, l.1, 1.0), &ch(r.0, r.1, 1.0), 320.0, &p)
+        };
+        // (top, bottom) columns; bottom width 200 px.
+        assert!(shape((120.0, 60.0), (200.0, 260.0)), "converging");
+        assert!(
+            shape((70.0, 60.0), (250.0, 260.0)),
+            "top 0.9 × bottom: at the bound"
+        );
+        assert!(!shape((69.0, 60.0), (251.0, 260.0)), "top 0.91 × bottom");
+        assert!(!shape((40.0, 60.0), (280.0, 260.0)), "diverging upwards");
+        assert!(
+            !shape((150.0, 140.0), (170.0, 180.0)),
+            "40 px: narrower than 0.2 W"
+        );
+        assert!(
+            !shape((0.0, -300.0), (400.0, 300.0)),
+            "600 px: wider than 1.5 W"
+        );
+        // Both boundaries right of the centre and its margin (a lane change): still an ego
+        // lane's shape, which the choice refuses (the camera is not inside it).
+        assert!(shape((230.0, 200.0), (270.0, 330.0)));
+        let got = choose_ego_pair(
+            &[ch(230.0, 200.0, 1.0), ch(270.0, 330.0, 1.0)],
+            320.0,
+            100.0,
+            &p,
+            None,
+        );
+        assert_ne!(
+            (got.left, got.right),
+            (Some(0), Some(1)),
+            "the choice keeps the camera inside"
+        );
+        assert!(!shape((f64::NAN, 60.0), (200.0, 260.0)), "not a number");
     }
 
     #[test]

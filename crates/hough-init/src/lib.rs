@@ -161,7 +161,7 @@ mod parabola;
 mod params;
 mod point;
 
-pub use ego::{Chord, EgoChoice, EgoPairParams, choose_ego_pair};
+pub use ego::{Chord, EgoChoice, EgoPairParams, choose_ego_pair, pair_shape_is_plausible};
 pub use error::{HoughError, PointSet};
 /// The workspace's one pixel point type (crate `grey-frame`), re-exported.
 pub use grey_frame::PixelPoint;

@@ -314,6 +314,7 @@ impl LaneTracker {
             "gated_crossings",
             (c.gated_crossings[0], c.gated_crossings[1]),
         )?;
+        d.set_item("gated_pairs", c.gated_pairs)?;
         Ok(d)
     }
 

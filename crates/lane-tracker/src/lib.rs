@@ -81,13 +81,23 @@
 //!    lane by more than `track.max_jump_px` at the top or bottom ROI row (the *jump gate*) is a miss: the lane
 //!    coasts on its prediction; after `track.lost_after_frames` misses in a row it is
 //!    [`LaneState::Lost`] and reported without coefficients.
-//! 2. *(Re-)initialisation* (first frame, and every frame a lane is lost): gradient over the
+//! 2. *Pair gate* (joint initialisation only, an addition beyond the paper): two tracked lanes
+//!    whose chords over the ROI rows no longer have an ego lane's shape — the width at the bottom
+//!    row within `[init.ego_pair.min_width_frac, max_width_frac]·W`, not wider at the top than at
+//!    the bottom, in order below the top `init.ego_pair.meet_top_frac` of the rows
+//!    (`hough_init::pair_shape_is_plausible`, the rules the pair was chosen by, with the
+//!    choice's 0.9 top/bottom margin relaxed to 1) — have lost a boundary to something else,
+//!    and the pair cannot tell which: both are dropped and initialised again on the same frame
+//!    ([`TrackerCounters::gated_pairs`]). Without it a lane that had slid onto a kerb, a pole or
+//!    a car kept its points and was never lost (a lane is lost only when its windows run out
+//!    of points).
+//! 3. *(Re-)initialisation* (first frame, and every frame a lane is lost): gradient over the
 //!    whole ROI, Hough over the lane's angle band and LS parabola on the band around the line
 //!    (`hough-init`, with `init.refit_iterations` refits); accepted if it spans ≥ 25 % of the
 //!    ROI rows; then refined by one windowed update on the same frame.
 //!    With `init.candidate_lines > 0` (the default configuration) the initialisation is
 //!    *joint* instead, see *Joint initialisation* below.
-//! 3. *Crossing gate*: the lanes may not cross at the top ROI row (with
+//! 4. *Crossing gate*: the lanes may not cross at the top ROI row (with
 //!    `init.ego_pair.meet_top_frac`, below the top fraction of the ROI rows where the vanishing
 //!    point may lie) nor come closer than `track.min_lane_separation_px` at the middle and
 //!    bottom rows; the estimate just initialised, else the one with fewer points, is undone.

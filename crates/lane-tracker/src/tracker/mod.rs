@@ -120,6 +120,9 @@ pub struct TrackerCounters {
     pub gated_jumps: [u64; 2],
     /// Estimates rejected because the lanes crossed, per lane.
     pub gated_crossings: [u64; 2],
+    /// Frames on which the tracked pair had lost an ego lane's shape and both lanes were
+    /// initialised again (the pair gate; joint initialisation only).
+    pub gated_pairs: u64,
     /// Filter failures (numerical: a non-positive-definite matrix), per lane.
     pub filter_failures: [u64; 2],
 }
@@ -561,6 +564,7 @@ impl LaneTracker {
                 lane.points.clear();
             }
         }
+        self.pair_gate();
         let need_init = self.lanes.iter().any(|l| !l.has_estimate());
         if need_init {
             self.initialise(&image)?;

@@ -1,6 +1,7 @@
 //! Stage III, measurement update and gates: the filter update (KIF eqs. 6, 12 or WRLS eqs.
 //! 25–27), the jump gate, misses, and the crossing gate between the two lanes.
 
+use hough_init::{Chord, EgoPairParams, pair_shape_is_plausible};
 use vision_gradient::{GreyImage, Region, keep_bright_stripes};
 
 use super::points::{fit_profile, weighted_scatter};
@@ -120,6 +121,50 @@ impl LaneTracker {
         } else {
             LaneState::Coasting
         };
+    }
+
+    /// The pair gate (joint initialisation only, `init.candidate_lines > 0`): two tracked lanes
+    /// whose chords over the ROI rows no longer have the shape of an ego lane have lost at
+    /// least one boundary to something else — and which one cannot be told from the pair
+    /// alone. Both are dropped, and the joint initialisation that follows on the same frame
+    /// chooses the pair again among all candidates. The shape is
+    /// `hough_init::pair_shape_is_plausible` with `[init.ego_pair]` (the width at the bottom ROI
+    /// row, meeting above the ROI or within its top `meet_top_frac`), except that a tracked pair
+    /// need only not diverge upwards (top width ≤ bottom width): `max_top_width_ratio` is a
+    /// margin for choosing among candidates, and labelled ego pairs on a camera looking down
+    /// reach a ratio of 0.92 (`seame`). Returns whether the pair was dropped.
+    pub(super) fn pair_gate(&mut self) -> bool {
+        if self.cfg.init.candidate_lines == 0 {
+            return false;
+        }
+        let [l, r] = &self.lanes;
+        let (Some(lf), Some(rf)) = (l.filter.as_ref(), r.filter.as_ref()) else {
+            return false;
+        };
+        if !(l.has_estimate() && r.has_estimate()) {
+            return false;
+        }
+        let (top, bottom) = self.search_rows;
+        let (yt, yb) = (top as f64, (bottom - 1) as f64);
+        let chord = |f: &LaneFilter| Chord {
+            col_top_px: f.col_at_row(yt),
+            col_bottom_px: f.col_at_row(yb),
+            support: 0.0,
+        };
+        let shape = EgoPairParams {
+            max_top_width_ratio: 1.0,
+            ..self.cfg.init.ego_pair
+        };
+        if pair_shape_is_plausible(&chord(lf), &chord(rf), self.width as f64, &shape) {
+            return false;
+        }
+        self.counters.gated_pairs += 1;
+        for lane in &mut self.lanes {
+            lane.filter = None;
+            lane.points_now = 0;
+            lane.state = LaneState::Lost;
+        }
+        true
     }
 
     /// Left and right lanes may not cross below the top `init.ego_pair.meet_top_frac` of the ROI

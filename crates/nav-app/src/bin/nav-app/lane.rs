@@ -475,8 +475,13 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         if let Some(t) = lanes.tracker() {
             let c = t.counters();
             eprintln!(
-                "nav-app: initialisations left {} right {}; gated jumps {:?}; gated crossings {:?}",
-                c.initialisations[0], c.initialisations[1], c.gated_jumps, c.gated_crossings
+                "nav-app: initialisations left {} right {}; gated jumps {:?}; gated crossings {:?}; \
+                 pairs initialised again {}",
+                c.initialisations[0],
+                c.initialisations[1],
+                c.gated_jumps,
+                c.gated_crossings,
+                c.gated_pairs
             );
         }
     } else if lost > 0 {
