@@ -48,6 +48,8 @@ class Counters(TypedDict):
     gated_jumps: Tuple[int, int]
     gated_crossings: Tuple[int, int]
     gated_pairs: int
+    revalidations: int
+    revalidation_switches: Tuple[int, int]
 
 class LaneTracker:
     """One tracker per video stream; every frame must have the size of the first one."""

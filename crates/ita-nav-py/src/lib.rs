@@ -315,6 +315,11 @@ impl LaneTracker {
             (c.gated_crossings[0], c.gated_crossings[1]),
         )?;
         d.set_item("gated_pairs", c.gated_pairs)?;
+        d.set_item("revalidations", c.revalidations)?;
+        d.set_item(
+            "revalidation_switches",
+            (c.revalidation_switches[0], c.revalidation_switches[1]),
+        )?;
         Ok(d)
     }
 

@@ -85,17 +85,37 @@ fn tracking_frame(c: &mut Criterion) {
         // The default configuration (joint initialisation, stripe pairing): a tracking frame and
         // an initialisation frame (several Hough candidates per band, ego-pair choice, two
         // refinements in the wider window).
+        // The tracked frame alone: the default re-validates every
+        // `track.revalidate_every_frames`-th frame (an initialisation's work, measured apart
+        // below), so the tracked frame is measured with re-validation off.
         let default = TrackerConfig::default_preset().unwrap();
-        let mut tracker =
-            LaneTracker::new(&default, Estimator::Kif, frame.width(), frame.height()).unwrap();
+        let mut tracked_only = default;
+        tracked_only.track.revalidate_every_frames = 0;
+        let mut tracking =
+            LaneTracker::new(&tracked_only, Estimator::Kif, frame.width(), frame.height()).unwrap();
         for _ in 0..5 {
-            tracker.track(frame).unwrap();
+            tracking.track(frame).unwrap();
         }
-        if !tracker.track(frame).unwrap().full_gradient {
+        if !tracking.track(frame).unwrap().full_gradient {
             group.bench_function(BenchmarkId::new("kif_default", name), |b| {
-                b.iter(|| black_box(tracker.track(black_box(frame)).unwrap()));
+                b.iter(|| black_box(tracking.track(black_box(frame)).unwrap()));
             });
         }
+        // A re-validation frame: both lanes tracked, the joint initialisation run over the ROI
+        // and the tracked lanes weighed against its candidates (here on every frame).
+        let mut every_frame = default;
+        every_frame.track.revalidate_every_frames = 1;
+        let mut revalidating =
+            LaneTracker::new(&every_frame, Estimator::Kif, frame.width(), frame.height()).unwrap();
+        for _ in 0..5 {
+            revalidating.track(frame).unwrap();
+        }
+        group.bench_function(BenchmarkId::new("revalidation_frame_default", name), |b| {
+            b.iter(|| black_box(revalidating.track(black_box(frame)).unwrap()));
+        });
+        let mut tracker =
+            LaneTracker::new(&default, Estimator::Kif, frame.width(), frame.height()).unwrap();
+        tracker.track(frame).unwrap();
         group.bench_function(BenchmarkId::new("init_frame_default", name), |b| {
             b.iter(|| {
                 tracker.reset();

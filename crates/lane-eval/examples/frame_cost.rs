@@ -7,7 +7,9 @@
 //!
 //! `frame_cost KIND N`, `KIND` one of `init` (an initialisation frame), `right` (the ROI's right
 //! half blanked: the second search runs for the right side), `both` (the whole ROI blanked: both
-//! sides searched for over the taller rows), `track` (a tracked frame).
+//! sides searched for over the taller rows), `track` (a tracked frame; re-validation off),
+//! `revalidate` (a re-validation frame: both lanes tracked, the joint initialisation run over
+//! the ROI on every frame).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 use lane_io::FrameSource;
 use lane_io::y4m::Y4mSource;
@@ -27,7 +29,12 @@ fn main() {
     for _ in 0..10 {
         src.next_frame(&mut frame).unwrap().expect("10 frames");
     }
-    let cfg = TrackerConfig::default_preset().unwrap();
+    let mut cfg = TrackerConfig::default_preset().unwrap();
+    cfg.track.revalidate_every_frames = match kind.as_str() {
+        "track" => 0,
+        "revalidate" => 1,
+        _ => cfg.track.revalidate_every_frames,
+    };
     let mut tracker =
         LaneTracker::new(&cfg, Estimator::Kif, frame.width(), frame.height()).unwrap();
     for _ in 0..5 {
@@ -36,10 +43,10 @@ fn main() {
     let (top, bottom) = tracker.roi_rows();
     let w = frame.width();
     let blank_from = match kind.as_str() {
-        "init" | "track" => None,
+        "init" | "track" | "revalidate" => None,
         "right" => Some(w / 2),
         "both" => Some(0),
-        other => panic!("unknown kind {other}: init, right, both or track"),
+        other => panic!("unknown kind {other}: init, right, both, track or revalidate"),
     };
     let mut input = frame.clone();
     if let Some(from_col) = blank_from {
@@ -50,7 +57,7 @@ fn main() {
     }
     let start = std::time::Instant::now();
     for _ in 0..n {
-        if kind != "track" {
+        if kind != "track" && kind != "revalidate" {
             tracker.reset();
         }
         std::hint::black_box(tracker.track(std::hint::black_box(&input)).unwrap());

@@ -52,9 +52,11 @@ fn kif_tracking_and_reinitialisation_frames_do_not_allocate() {
 #[test]
 fn the_default_configuration_does_not_allocate() {
     // Joint initialisation (several Hough candidates, ego-pair choice) and stripe splitting,
-    // on every frame of sequences with re-initialisation.
+    // on every frame of sequences with re-initialisation, and a re-validation every
+    // `track.revalidate_every_frames` frames (> 20 frames: at least two).
     let cfg = TrackerConfig::default_preset().unwrap();
     assert!(cfg.init.candidate_lines > 0 && cfg.gradient.stripe_paired_votes > 0);
+    assert!((1..=10).contains(&cfg.track.revalidate_every_frames));
     for scene in ["wall_recovery", "noise"] {
         let (allocs, frames) = allocations_with(Estimator::Kif, scene, &cfg);
         assert!(frames > 20);

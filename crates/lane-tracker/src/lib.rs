@@ -91,7 +91,12 @@
 //!    ([`TrackerCounters::gated_pairs`]). Without it a lane that had slid onto a kerb, a pole or
 //!    a car kept its points and was never lost (a lane is lost only when its windows run out
 //!    of points).
-//! 3. *(Re-)initialisation* (first frame, and every frame a lane is lost): gradient over the
+//! 3. *(Re-)initialisation* (first frame, every frame a lane is lost, and — the *re-validation*,
+//!    an addition beyond the paper, joint initialisation only — every
+//!    `track.revalidate_every_frames`-th frame while both lanes are tracked, where the tracked
+//!    lanes compete with the candidates, each weighed by its own row coverage ×
+//!    `track.revalidate_keep_factor`, and a lane is replaced only by a candidate off its mark,
+//!    [`TrackerCounters::revalidations`]): gradient over the
 //!    whole ROI, Hough over the lane's angle band and LS parabola on the band around the line
 //!    (`hough-init`, with `init.refit_iterations` refits); accepted if it spans ≥ 25 % of the
 //!    ROI rows; then refined by one windowed update on the same frame.

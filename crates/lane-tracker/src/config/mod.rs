@@ -342,6 +342,23 @@ pub struct TrackConfig {
     /// absent; 0 is read as 1).
     #[serde(default)]
     pub refine_passes: u32,
+    /// Re-validation (an addition beyond the paper; joint initialisation only): while both
+    /// lanes are tracked, every this many frames the whole ROI goes through the joint
+    /// initialisation and the tracked lanes compete with its candidates for the ego pair; a
+    /// lane the choice replaces by a candidate on another mark is initialised there. Frames,
+    /// 0..=100000; 0 (default when absent): never (the paper: a lane is re-initialised only
+    /// when lost).
+    #[serde(default)]
+    pub revalidate_every_frames: u32,
+    /// In a re-validation, a tracked lane's row coverage counts this many times (≥ 1, finite;
+    /// default 3 when absent): a candidate replaces it only when clearly stronger, not on the
+    /// frame-to-frame noise of the choice.
+    #[serde(default = "default_revalidate_keep_factor")]
+    pub revalidate_keep_factor: f64,
+}
+
+fn default_revalidate_keep_factor() -> f64 {
+    3.0
 }
 
 impl TrackConfig {
@@ -604,6 +621,18 @@ impl TrackerConfig {
             "track.refine_passes",
             t.refine_passes,
             "must be in 0..=5",
+        )?;
+        check(
+            t.revalidate_every_frames <= 100_000,
+            "track.revalidate_every_frames",
+            t.revalidate_every_frames,
+            "must be in 0..=100000 frames (0: never)",
+        )?;
+        check(
+            t.revalidate_keep_factor >= 1.0 && t.revalidate_keep_factor.is_finite(),
+            "track.revalidate_keep_factor",
+            t.revalidate_keep_factor,
+            "must be finite and >= 1",
         )?;
         check(
             (0.0..=90.0).contains(&t.orientation_tolerance_deg),

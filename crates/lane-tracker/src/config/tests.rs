@@ -126,6 +126,15 @@ fn each_out_of_range_field_is_named() {
             c.track.reinit_min_points = 2000
         }),
         ("track.lost_after_frames", |c| c.track.lost_after_frames = 0),
+        ("track.revalidate_every_frames", |c| {
+            c.track.revalidate_every_frames = 100_001
+        }),
+        ("track.revalidate_keep_factor", |c| {
+            c.track.revalidate_keep_factor = 0.5
+        }),
+        ("track.revalidate_keep_factor", |c| {
+            c.track.revalidate_keep_factor = f64::INFINITY
+        }),
         ("track.max_jump_px", |c| c.track.max_jump_px = -1.0),
         ("track.min_lane_separation_px", |c| {
             c.track.min_lane_separation_px = f64::NAN

@@ -248,11 +248,15 @@ impl LaneTracker {
         let (yt, yb) = (top as f64, (bottom - 1) as f64);
         let mut lines = [none; 2 * MAX_LINES];
         let mut classes = [EdgeClass::LeftLane; 2 * MAX_LINES];
-        let mut chords = [Chord::default(); 2 * MAX_LINES + 1];
+        let mut chords = [Chord::default(); 2 * MAX_LINES + 2];
         let mut found = [none; MAX_LINES];
         let mut m = 0;
         // This search's candidates follow those of an earlier search on the same frame.
         let first = self.init_candidates.len();
+        // Both lanes tracked: a re-validation (`track.revalidate_every_frames`), in which the
+        // tracked lanes compete with the candidates on their own row coverage, none locked.
+        let revalidating = self.lanes.iter().all(Lane::has_estimate);
+        let mut tracked_support = [0.0f64; 2];
         for (k, _) in vote.into_iter().enumerate().filter(|&(_, votes)| votes) {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
             if !self.has_candidates(class, self.init_params.min_points) {
@@ -260,6 +264,16 @@ impl LaneTracker {
             }
             if self.cfg.init.candidate_coverage || self.cfg.init.orientation_tolerance_deg > 0.0 {
                 self.sort_candidates_by_row(class);
+            }
+            if revalidating && self.cfg.init.candidate_coverage {
+                // Each tracked lane's coverage by this band's pixels; the better band counts (on
+                // a bend a boundary leans into the other band).
+                for (i, support) in tracked_support.iter_mut().enumerate() {
+                    if let Some(f) = self.lanes[i].filter.as_ref() {
+                        let p = Parabola::from_coeffs(f.coeffs());
+                        *support = support.max(self.row_coverage(&p));
+                    }
+                }
             }
             if self.cfg.init.orientation_tolerance_deg <= 0.0 {
                 self.fill_candidates(class); // the plain vote's input
@@ -322,16 +336,29 @@ impl LaneTracker {
             }
         }
         let s_max = chords[..m].iter().map(|c| c.support).fold(0.0, f64::max);
+        // Tracked lanes as chords after the candidates: in a re-validation both, unlocked, each
+        // with its row coverage counted `track.revalidate_keep_factor` times; otherwise the
+        // first one with an estimate, locked into the pair, with the strongest support.
         let mut locked = None;
+        let mut tracked_at = [None; 2];
         for (i, lane) in self.lanes.iter().enumerate() {
-            if let (true, Some(f)) = (lane.has_estimate(), lane.filter.as_ref()) {
-                chords[m] = Chord {
-                    col_top_px: f.col_at_row(yt),
-                    col_bottom_px: f.col_at_row(yb),
-                    support: s_max,
-                };
-                locked = Some((m, i));
-                m += 1;
+            let (true, Some(f)) = (lane.has_estimate(), lane.filter.as_ref()) else {
+                continue;
+            };
+            let support = if revalidating {
+                tracked_support[i] * self.cfg.track.revalidate_keep_factor
+            } else {
+                s_max
+            };
+            chords[m] = Chord {
+                col_top_px: f.col_at_row(yt),
+                col_bottom_px: f.col_at_row(yb),
+                support,
+            };
+            tracked_at[i] = Some(m);
+            m += 1;
+            if !revalidating {
+                locked = Some((m - 1, i));
                 break;
             }
         }
@@ -350,16 +377,40 @@ impl LaneTracker {
         }
         for (i, pick) in [choice.left, choice.right].into_iter().enumerate() {
             let Some(j) = pick else { continue };
-            // `init_candidates[first..]` holds the first `m` chords in order (a tracked lane's
-            // chord, appended after them, is not a candidate).
-            if let Some(c) = self.init_candidates.get_mut(first + j) {
-                c.chosen = Some(self.lanes[i].side);
+            // A tracked lane's chord (appended after the candidates) is not a candidate: the
+            // choice kept a tracked lane (in a re-validation, either one: a lane the choice put
+            // on the other side is left as it is).
+            if tracked_at.contains(&Some(j)) {
+                continue;
             }
-            if locked.is_some_and(|(l, _)| l == j) || self.lanes[i].has_estimate() {
+            // `init_candidates[first..]` holds the first `m` candidates' chords in order.
+            let Some(c) = self.init_candidates.get_mut(first + j) else {
+                continue;
+            };
+            c.chosen = Some(self.lanes[i].side);
+            let coeffs = c.coeffs;
+            if revalidating {
+                // A candidate on the tracked lane's own mark (within the tracking window at
+                // every ROI row) leaves the lane and its filter as they are.
+                let Some(f) = self.lanes[i].filter.as_ref() else {
+                    continue;
+                };
+                let p = Parabola::from_coeffs(coeffs);
+                let w = self.cfg.track.window_half_width_px as f64;
+                let (top, bottom) = self.search_rows;
+                if (top..bottom)
+                    .all(|y| (p.col_at_row(y as f64) - f.col_at_row(y as f64)).abs() <= w)
+                {
+                    continue;
+                }
+            } else if self.lanes[i].has_estimate() {
                 continue;
             }
             self.fill_candidates(classes[j]);
             if let Ok(init) = fit_around_line(&self.candidates, lines[j], &self.init_params) {
+                if revalidating {
+                    self.counters.revalidation_switches[i] += 1;
+                }
                 self.install(i, &init);
             }
         }

@@ -123,6 +123,11 @@ pub struct TrackerCounters {
     /// Frames on which the tracked pair had lost an ego lane's shape and both lanes were
     /// initialised again (the pair gate; joint initialisation only).
     pub gated_pairs: u64,
+    /// Re-validations (`track.revalidate_every_frames`): frames on which the tracked pair was
+    /// weighed against a fresh initialisation's candidates.
+    pub revalidations: u64,
+    /// Lanes a re-validation replaced by another candidate, per lane.
+    pub revalidation_switches: [u64; 2],
     /// Filter failures (numerical: a non-positive-definite matrix), per lane.
     pub filter_failures: [u64; 2],
 }
@@ -311,6 +316,9 @@ pub struct LaneTracker {
     counters: TrackerCounters,
     /// The last filter failure per lane (left, right), kept typed without allocating.
     last_failure: [Option<FilterFailure>; 2],
+    /// Frames since the last one whose whole ROI went through the gradient (an initialisation
+    /// or a re-validation).
+    frames_since_full_gradient: u64,
 }
 
 impl LaneTracker {
@@ -414,6 +422,7 @@ impl LaneTracker {
             init_candidates: Vec::with_capacity(4 * MAX_CANDIDATE_LINES),
             counters: TrackerCounters::default(),
             last_failure: [None; 2],
+            frames_since_full_gradient: 0,
         })
     }
 
@@ -460,6 +469,7 @@ impl LaneTracker {
         self.init_candidates.clear();
         self.counters = TrackerCounters::default();
         self.last_failure = [None; 2];
+        self.frames_since_full_gradient = 0;
     }
 
     /// Why lane `side`'s filter last refused a prediction, an update or an initialisation (the
@@ -566,7 +576,22 @@ impl LaneTracker {
         }
         self.pair_gate();
         let need_init = self.lanes.iter().any(|l| !l.has_estimate());
-        if need_init {
+        // Re-validation (`track.revalidate_every_frames`; joint initialisation weighing its
+        // candidates by row coverage only): both lanes tracked, the joint initialisation runs
+        // over the ROI and the tracked lanes compete with its candidates.
+        let every = u64::from(self.cfg.track.revalidate_every_frames);
+        let revalidate = !need_init
+            && self.cfg.init.candidate_lines > 0
+            && self.cfg.init.candidate_coverage
+            && every > 0
+            && self.frames_since_full_gradient + 1 >= every;
+        if need_init || revalidate {
+            self.frames_since_full_gradient = 0;
+        } else {
+            self.frames_since_full_gradient += 1;
+        }
+        self.counters.revalidations += u64::from(revalidate);
+        if need_init || revalidate {
             self.initialise(&image)?;
             // Refine a fresh initialisation on the same frame: one windowed update around the
             // LS parabola, with the window's outlier rejection (the Hough band keeps clutter).
@@ -612,7 +637,7 @@ impl LaneTracker {
         }
         Ok(TrackReport {
             lanes: [self.lanes[0].report(), self.lanes[1].report()],
-            full_gradient: need_init,
+            full_gradient: need_init || revalidate,
         })
     }
 }

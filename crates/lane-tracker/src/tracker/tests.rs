@@ -1061,3 +1061,62 @@ fn a_tracked_pair_as_wide_at_the_top_as_a_camera_looking_down_sees_it_is_kept() 
     assert_eq!(tracker.counters().gated_pairs, 0);
     assert_eq!(tracker.counters().initialisations, [0, 0]);
 }
+
+/// `two_marks` with a faint dashed line 25 px left of the left mark and parallel to it: 2 px
+/// wide, 30 grey levels above the floor, dashes 6 rows long every 24 rows (a seam, a worn
+/// line): enough edge pixels to hold a tracked lane, a quarter of a mark's row coverage.
+fn two_marks_and_a_faint_dashed_line(w: usize, h: usize) -> GreyFrame {
+    let mut pixels = two_marks(w, h).data().to_vec();
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if (x - faint_line(y)).abs() < 1.0 && (i / w) % 24 < 6 {
+            *p = 90;
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+fn faint_line(y: f64) -> f64 {
+    75.0 - 0.45 * (y - 239.0)
+}
+
+#[test]
+fn a_lane_left_on_a_faint_line_is_moved_to_the_mark_by_the_next_revalidation() {
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let every = cfg.track.revalidate_every_frames;
+    assert!(every > 0 && cfg.track.revalidate_keep_factor < 4.0);
+    let frame = two_marks_and_a_faint_dashed_line(320, 240);
+    let mark = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    // Largest distance of the left lane from `truth` over the ROI rows after `frames` more
+    // frames, the left lane having been put on the faint line first.
+    let left_after = |cfg: &TrackerConfig, frames: u32, truth: &dyn Fn(f64) -> f64| {
+        let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let (top, bottom) = tracker.roi;
+        tracker.track(&frame).expect("a frame");
+        let line = nalgebra::Vector3::new(0.0, -0.45, faint_line(0.0));
+        tracker.lanes[0].filter = Some(tracker.new_filter(&line).expect("a filter"));
+        let mut report = None;
+        for _ in 0..frames {
+            report = Some(tracker.track(&frame).expect("a frame"));
+        }
+        let c = report.and_then(|r| r.lanes[0].coeffs).expect("a left lane");
+        let worst = (top..bottom)
+            .map(|y| (Parabola::from_coeffs(c).col_at_row(y as f64) - truth(y as f64)).abs())
+            .fold(0.0, f64::max);
+        (worst, *tracker.counters())
+    };
+    // The first initialisation found the mark (the faint line is no candidate for the pair).
+    let (on_mark, counters) = left_after(&cfg, every, &mark);
+    assert!(
+        on_mark < 2.0,
+        "after {every} frames: {on_mark} px from the mark"
+    );
+    assert_eq!(counters.revalidation_switches, [1, 0]);
+    assert_eq!(counters.gated_pairs, 0);
+    // Without re-validation the lane stays on the faint line: it keeps enough points.
+    let mut never = cfg;
+    never.track.revalidate_every_frames = 0;
+    let (on_line, counters) = left_after(&never, 3 * every, &faint_line);
+    assert!(on_line < 2.0, "without: {on_line} px from the faint line");
+    assert_eq!(counters.revalidations, 0);
+}

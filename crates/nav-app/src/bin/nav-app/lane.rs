@@ -476,12 +476,14 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
             let c = t.counters();
             eprintln!(
                 "nav-app: initialisations left {} right {}; gated jumps {:?}; gated crossings {:?}; \
-                 pairs initialised again {}",
+                 pairs initialised again {}; re-validations {} (lanes replaced {:?})",
                 c.initialisations[0],
                 c.initialisations[1],
                 c.gated_jumps,
                 c.gated_crossings,
-                c.gated_pairs
+                c.gated_pairs,
+                c.revalidations,
+                c.revalidation_switches
             );
         }
     } else if lost > 0 {
