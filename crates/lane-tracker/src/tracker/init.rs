@@ -369,41 +369,39 @@ impl LaneTracker {
             &self.cfg.init.ego_pair,
             locked.map(|(j, _)| j),
         );
-        // A tracked lane the choice put on the other side: leave both as they are.
-        if let Some((j, i)) = locked
-            && [choice.left, choice.right][i] != Some(j)
-        {
-            return;
-        }
-        for (i, pick) in [choice.left, choice.right].into_iter().enumerate() {
-            let Some(j) = pick else { continue };
-            // A tracked lane's chord (appended after the candidates) is not a candidate: the
-            // choice kept a tracked lane (in a re-validation, either one: a lane the choice put
-            // on the other side is left as it is).
-            if tracked_at.contains(&Some(j)) {
-                continue;
+        let picks = [choice.left, choice.right];
+        // The tracked lane each pick lies on, if any: its own chord, or (in a re-validation) a
+        // candidate within the tracking window of it at every ROI row — its own mark.
+        let w = self.cfg.track.window_half_width_px as f64;
+        let owner = |j: usize| -> Option<usize> {
+            if let Some(k) = tracked_at.iter().position(|&t| t == Some(j)) {
+                return Some(k);
             }
-            // `init_candidates[first..]` holds the first `m` candidates' chords in order.
-            let Some(c) = self.init_candidates.get_mut(first + j) else {
-                continue;
-            };
-            c.chosen = Some(self.lanes[i].side);
-            let coeffs = c.coeffs;
-            if revalidating {
-                // A candidate on the tracked lane's own mark (within the tracking window at
-                // every ROI row) leaves the lane and its filter as they are.
-                let Some(f) = self.lanes[i].filter.as_ref() else {
-                    continue;
-                };
-                let p = Parabola::from_coeffs(coeffs);
-                let w = self.cfg.track.window_half_width_px as f64;
-                let (top, bottom) = self.search_rows;
-                if (top..bottom)
-                    .all(|y| (p.col_at_row(y as f64) - f.col_at_row(y as f64)).abs() <= w)
-                {
-                    continue;
-                }
-            } else if self.lanes[i].has_estimate() {
+            let c = self.init_candidates.get(first + j)?;
+            let p = Parabola::from_coeffs(c.coeffs);
+            (0..2).filter(|_| revalidating).find(|&k| {
+                self.lanes[k].filter.as_ref().is_some_and(|f| {
+                    (top..bottom)
+                        .all(|y| (p.col_at_row(y as f64) - f.col_at_row(y as f64)).abs() <= w)
+                })
+            })
+        };
+        let owners = picks.map(|p| p.and_then(owner));
+        // A tracked lane the choice put on the other side: the camera crossed it (a lane
+        // change), and it is that side's boundary now. It moves over with its filter; the lane
+        // it replaces there is dropped unless the choice gives that side a candidate below.
+        if let Some(i) = (0..2).find(|&i| owners[i] == Some(1 - i)) {
+            self.hand_over(1 - i, i);
+            self.counters.lane_changes += 1;
+        }
+        for (i, pick) in picks.into_iter().enumerate() {
+            let Some(j) = pick else { continue };
+            // `init_candidates[first..]` holds the first candidates' chords in order.
+            if let Some(c) = self.init_candidates.get_mut(first + j) {
+                c.chosen = Some(self.lanes[i].side);
+            }
+            // A tracked lane kept on its side (or just handed over to it).
+            if owners[i].is_some() || (!revalidating && self.lanes[i].has_estimate()) {
                 continue;
             }
             self.fill_candidates(classes[j]);
@@ -414,6 +412,27 @@ impl LaneTracker {
                 self.install(i, &init);
             }
         }
+    }
+
+    /// Lane `from` becomes lane `to` (its filter, state and buffers move; each slot keeps its
+    /// side, edge class and angle band), and the lane that was at `to` is dropped into `from`
+    /// (no estimate: initialised again unless replaced on this frame). No allocation (the
+    /// buffers are swapped).
+    fn hand_over(&mut self, from: usize, to: usize) {
+        if from == to || from > 1 || to > 1 {
+            return;
+        }
+        self.lanes.swap(from, to);
+        let [a, b] = &mut self.lanes;
+        std::mem::swap(&mut a.side, &mut b.side);
+        std::mem::swap(&mut a.class, &mut b.class);
+        std::mem::swap(&mut a.band, &mut b.band);
+        let dropped = &mut self.lanes[from];
+        dropped.filter = None;
+        dropped.predicted = None;
+        dropped.state = LaneState::Lost;
+        dropped.points_now = 0;
+        dropped.initialised_now = false;
     }
 
     /// `self.by_row` = the edge pixels of `class` as `(column, weight)` sorted by row then

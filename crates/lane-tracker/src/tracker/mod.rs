@@ -128,6 +128,9 @@ pub struct TrackerCounters {
     pub revalidations: u64,
     /// Lanes a re-validation replaced by another candidate, per lane.
     pub revalidation_switches: [u64; 2],
+    /// Lane changes: a tracked boundary the joint initialisation or a re-validation put on the
+    /// other side of the pair (the camera crossed it), handed over to that side.
+    pub lane_changes: u64,
     /// Filter failures (numerical: a non-positive-definite matrix), per lane.
     pub filter_failures: [u64; 2],
 }
@@ -240,11 +243,11 @@ pub struct InitCandidate {
     /// Its support in the choice: the row coverage net of the clutter beside it
     /// (`init.candidate_coverage`), else its Hough votes.
     pub support: f64,
-    /// The side the choice gave it, if any. A side without an estimate is then initialised from
-    /// this candidate's line refitted by least squares and refined in the windows
-    /// (`track.refine_passes`), unless the fit or the sanity checks refuse it. `None` on every
-    /// candidate when the choice put a lane still being tracked on the other side (both lanes
-    /// are then left as they were).
+    /// The side the choice gave it, if any. A side without an estimate (or, in a re-validation,
+    /// whose tracked lane lies off this candidate's mark) is then initialised from this
+    /// candidate's line refitted by least squares and refined in the windows
+    /// (`track.refine_passes`), unless the fit or the sanity checks refuse it. A side the choice
+    /// gave a tracked lane's own chord has no chosen candidate.
     pub chosen: Option<Side>,
 }
 

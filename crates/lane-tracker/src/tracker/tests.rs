@@ -1120,3 +1120,68 @@ fn a_lane_left_on_a_faint_line_is_moved_to_the_mark_by_the_next_revalidation() {
     assert!(on_line < 2.0, "without: {on_line} px from the faint line");
     assert_eq!(counters.revalidations, 0);
 }
+
+/// Three marks 5 px wide towards a vanishing point (`mark_towards_vp`), 160 px apart at the
+/// bottom row, at bottom columns 80, 240 and 400 less `shift_px` (the camera moved right).
+/// Anti-aliased (`cover`): a mark near the vertical still has edge pixels that lean.
+fn three_marks_shifted(w: usize, h: usize, shift_px: f64) -> GreyFrame {
+    let on_mark = |x: f64, y: f64| {
+        y > 100.0
+            && [80.0, 240.0, 400.0]
+                .iter()
+                .any(|&b| (x - mark_towards_vp(b - shift_px, y)).abs() < 2.5)
+    };
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        *p = (60.0 + 140.0 * cover(&on_mark, x, y)).round() as u8;
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+/// Column at row `y` of a mark through `bottom_col` at row 239 and the vanishing point (150, 100)
+/// (off the middle column: a mark crossing it is never exactly vertical, which the gradient
+/// does not see).
+fn mark_towards_vp(bottom_col: f64, y: f64) -> f64 {
+    150.0 + (bottom_col - 150.0) * (y - 100.0) / 139.0
+}
+
+#[test]
+fn a_lane_change_hands_the_crossed_boundary_to_the_other_side() {
+    // The camera moves right 4 px a frame over a three-lane road: the right boundary of the
+    // first ego lane crosses the image's middle column at frame 20 and is the new ego lane's
+    // left boundary from then on, the third mark its right one.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let worst = |c: Option<[f64; 3]>, bottom_col: f64| {
+        c.map_or(f64::INFINITY, |c| {
+            (top..bottom)
+                .map(|y| {
+                    let y = y as f64;
+                    (Parabola::from_coeffs(c).col_at_row(y) - mark_towards_vp(bottom_col, y)).abs()
+                })
+                .fold(0.0, f64::max)
+        })
+    };
+    let every = u64::from(cfg.track.revalidate_every_frames);
+    for n in 0..60u64 {
+        let shift = 4.0 * n as f64;
+        let report = tracker
+            .track(&three_marks_shifted(320, 240, shift))
+            .expect("a frame");
+        let [l, r] = [report.lanes[0].coeffs, report.lanes[1].coeffs];
+        if n < 15 {
+            let e = [worst(l, 80.0 - shift), worst(r, 240.0 - shift)];
+            assert!(e.iter().all(|&e| e < 3.0), "frame {n}: first lane {e:?} px");
+        }
+        // Within a re-validation's period of the crossing (with a margin of 5 frames).
+        if n >= 25 + every {
+            let e = [worst(l, 240.0 - shift), worst(r, 400.0 - shift)];
+            assert!(e.iter().all(|&e| e < 3.0), "frame {n}: next lane {e:?} px");
+        }
+    }
+    // The old right boundary was handed over (not found again as a new lane).
+    assert_eq!(tracker.counters().lane_changes, 1);
+    assert_eq!(tracker.counters().initialisations, [1, 2]);
+}

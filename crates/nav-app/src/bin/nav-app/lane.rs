@@ -476,14 +476,15 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
             let c = t.counters();
             eprintln!(
                 "nav-app: initialisations left {} right {}; gated jumps {:?}; gated crossings {:?}; \
-                 pairs initialised again {}; re-validations {} (lanes replaced {:?})",
+                 pairs initialised again {}; re-validations {} (lanes replaced {:?}); lane changes {}",
                 c.initialisations[0],
                 c.initialisations[1],
                 c.gated_jumps,
                 c.gated_crossings,
                 c.gated_pairs,
                 c.revalidations,
-                c.revalidation_switches
+                c.revalidation_switches,
+                c.lane_changes
             );
         }
     } else if lost > 0 {
