@@ -96,7 +96,9 @@
 //!    `track.revalidate_every_frames`-th frame while both lanes are tracked, where the tracked
 //!    lanes compete with the candidates, each weighed by its own row coverage ×
 //!    `track.revalidate_keep_factor`, and a lane is replaced only by a candidate off its mark,
-//!    [`TrackerCounters::revalidations`]; a tracked lane the joint choice puts on the other side
+//!    [`TrackerCounters::revalidations`]; with re-validation on, a lane tracked from earlier
+//!    frames competes so too when the other side is initialised again, instead of being locked
+//!    into the pair; a tracked lane the joint choice puts on the other side
 //!    of the pair — the camera crossed it, a lane change — is handed over to that side with its
 //!    filter, [`TrackerCounters::lane_changes`]): gradient over the
 //!    whole ROI, Hough over the lane's angle band and LS parabola on the band around the line

@@ -345,7 +345,8 @@ pub struct TrackConfig {
     /// Re-validation (an addition beyond the paper; joint initialisation only): while both
     /// lanes are tracked, every this many frames the whole ROI goes through the joint
     /// initialisation and the tracked lanes compete with its candidates for the ego pair; a
-    /// lane the choice replaces by a candidate on another mark is initialised there. Frames,
+    /// lane the choice replaces by a candidate on another mark is initialised there (and, with
+    /// it on, a tracked lane competes so too when the other side is initialised again). Frames,
     /// 0..=100000; 0 (default when absent): never (the paper: a lane is re-initialised only
     /// when lost).
     #[serde(default)]

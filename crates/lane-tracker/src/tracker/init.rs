@@ -253,9 +253,18 @@ impl LaneTracker {
         let mut m = 0;
         // This search's candidates follow those of an earlier search on the same frame.
         let first = self.init_candidates.len();
-        // Both lanes tracked: a re-validation (`track.revalidate_every_frames`), in which the
-        // tracked lanes compete with the candidates on their own row coverage, none locked.
-        let revalidating = self.lanes.iter().all(Lane::has_estimate);
+        // With re-validation on (`track.revalidate_every_frames > 0`), a lane tracked from
+        // earlier frames competes with the candidates, weighed by its own row coverage: in a
+        // re-validation (both tracked) and when the other side is (re-)initialised. A lane
+        // initialised on this frame (the first search's, during the second search) is locked
+        // into the pair instead, as every tracked lane is with re-validation off.
+        let competes: [bool; 2] = std::array::from_fn(|i| {
+            let lane = &self.lanes[i];
+            self.cfg.track.revalidate_every_frames > 0
+                && self.cfg.init.candidate_coverage
+                && lane.has_estimate()
+                && !lane.initialised_now
+        });
         let mut tracked_support = [0.0f64; 2];
         for (k, _) in vote.into_iter().enumerate().filter(|&(_, votes)| votes) {
             let (class, band) = (self.lanes[k].class, self.lanes[k].band);
@@ -265,11 +274,11 @@ impl LaneTracker {
             if self.cfg.init.candidate_coverage || self.cfg.init.orientation_tolerance_deg > 0.0 {
                 self.sort_candidates_by_row(class);
             }
-            if revalidating && self.cfg.init.candidate_coverage {
-                // Each tracked lane's coverage by this band's pixels; the better band counts (on
-                // a bend a boundary leans into the other band).
+            if competes.contains(&true) {
+                // Each competing lane's coverage by this band's pixels; the better band counts
+                // (on a bend a boundary leans into the other band).
                 for (i, support) in tracked_support.iter_mut().enumerate() {
-                    if let Some(f) = self.lanes[i].filter.as_ref() {
+                    if let (true, Some(f)) = (competes[i], self.lanes[i].filter.as_ref()) {
                         let p = Parabola::from_coeffs(f.coeffs());
                         *support = support.max(self.row_coverage(&p));
                     }
@@ -336,16 +345,19 @@ impl LaneTracker {
             }
         }
         let s_max = chords[..m].iter().map(|c| c.support).fold(0.0, f64::max);
-        // Tracked lanes as chords after the candidates: in a re-validation both, unlocked, each
-        // with its row coverage counted `track.revalidate_keep_factor` times; otherwise the
-        // first one with an estimate, locked into the pair, with the strongest support.
+        // Lanes with an estimate as chords after the candidates: a competing one with its row
+        // coverage counted `track.revalidate_keep_factor` times, unlocked; otherwise the first
+        // one, locked into the pair with the strongest support.
         let mut locked = None;
         let mut tracked_at = [None; 2];
         for (i, lane) in self.lanes.iter().enumerate() {
             let (true, Some(f)) = (lane.has_estimate(), lane.filter.as_ref()) else {
                 continue;
             };
-            let support = if revalidating {
+            if !competes[i] && locked.is_some() {
+                continue;
+            }
+            let support = if competes[i] {
                 tracked_support[i] * self.cfg.track.revalidate_keep_factor
             } else {
                 s_max
@@ -356,11 +368,10 @@ impl LaneTracker {
                 support,
             };
             tracked_at[i] = Some(m);
-            m += 1;
-            if !revalidating {
-                locked = Some((m - 1, i));
-                break;
+            if !competes[i] {
+                locked = Some((m, i));
             }
+            m += 1;
         }
         let choice = choose_ego_pair(
             &chords[..m],
@@ -369,9 +380,15 @@ impl LaneTracker {
             &self.cfg.init.ego_pair,
             locked.map(|(j, _)| j),
         );
+        // A locked lane the choice put on the other side: leave both as they are.
+        if let Some((j, i)) = locked
+            && [choice.left, choice.right][i] != Some(j)
+        {
+            return;
+        }
         let picks = [choice.left, choice.right];
-        // The tracked lane each pick lies on, if any: its own chord, or (in a re-validation) a
-        // candidate within the tracking window of it at every ROI row — its own mark.
+        // The lane each pick lies on, if any: its own chord, or (a competing lane) a candidate
+        // within the tracking window of it at every ROI row — its own mark.
         let w = self.cfg.track.window_half_width_px as f64;
         let owner = |j: usize| -> Option<usize> {
             if let Some(k) = tracked_at.iter().position(|&t| t == Some(j)) {
@@ -379,7 +396,7 @@ impl LaneTracker {
             }
             let c = self.init_candidates.get(first + j)?;
             let p = Parabola::from_coeffs(c.coeffs);
-            (0..2).filter(|_| revalidating).find(|&k| {
+            (0..2).filter(|&k| competes[k]).find(|&k| {
                 self.lanes[k].filter.as_ref().is_some_and(|f| {
                     (top..bottom)
                         .all(|y| (p.col_at_row(y as f64) - f.col_at_row(y as f64)).abs() <= w)
@@ -387,7 +404,7 @@ impl LaneTracker {
             })
         };
         let owners = picks.map(|p| p.and_then(owner));
-        // A tracked lane the choice put on the other side: the camera crossed it (a lane
+        // A competing lane the choice put on the other side: the camera crossed it (a lane
         // change), and it is that side's boundary now. It moves over with its filter; the lane
         // it replaces there is dropped unless the choice gives that side a candidate below.
         if let Some(i) = (0..2).find(|&i| owners[i] == Some(1 - i)) {
@@ -400,13 +417,14 @@ impl LaneTracker {
             if let Some(c) = self.init_candidates.get_mut(first + j) {
                 c.chosen = Some(self.lanes[i].side);
             }
-            // A tracked lane kept on its side (or just handed over to it).
-            if owners[i].is_some() || (!revalidating && self.lanes[i].has_estimate()) {
+            // A lane kept on its side (or just handed over to it), or a locked one.
+            let replaced = self.lanes[i].has_estimate();
+            if owners[i].is_some() || (replaced && !competes[i]) {
                 continue;
             }
             self.fill_candidates(classes[j]);
             if let Ok(init) = fit_around_line(&self.candidates, lines[j], &self.init_params) {
-                if revalidating {
+                if replaced {
                     self.counters.revalidation_switches[i] += 1;
                 }
                 self.install(i, &init);

@@ -126,7 +126,9 @@ pub struct TrackerCounters {
     /// Re-validations (`track.revalidate_every_frames`): frames on which the tracked pair was
     /// weighed against a fresh initialisation's candidates.
     pub revalidations: u64,
-    /// Lanes a re-validation replaced by another candidate, per lane.
+    /// Tracked lanes the joint choice replaced by a candidate off their mark (with
+    /// re-validation on: in a re-validation, or when the other side was initialised again),
+    /// per lane.
     pub revalidation_switches: [u64; 2],
     /// Lane changes: a tracked boundary the joint initialisation or a re-validation put on the
     /// other side of the pair (the camera crossed it), handed over to that side.

@@ -1185,3 +1185,63 @@ fn a_lane_change_hands_the_crossed_boundary_to_the_other_side() {
     assert_eq!(tracker.counters().lane_changes, 1);
     assert_eq!(tracker.counters().initialisations, [1, 2]);
 }
+
+#[test]
+fn a_tracked_lane_on_a_faint_line_competes_when_the_other_side_is_initialised_again() {
+    // The right lane is lost while the left one sits on the faint line beside its mark: the
+    // initialisation that looks for the right lane weighs the left one against the candidates
+    // (re-validation on) and moves it to its mark on the same frame; with re-validation off
+    // the left lane is locked into the pair and stays where it was.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(cfg.track.revalidate_every_frames > 1);
+    let frame = two_marks_and_a_faint_dashed_line(320, 240);
+    let marks = [
+        |y: f64| 100.0 - 0.45 * (y - 239.0),
+        |y: f64| 220.0 + 0.45 * (y - 239.0),
+    ];
+    let run = |cfg: &TrackerConfig| {
+        let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let (top, bottom) = tracker.roi;
+        tracker.track(&frame).expect("a frame");
+        let line = nalgebra::Vector3::new(0.0, -0.45, faint_line(0.0));
+        tracker.lanes[0].filter = Some(tracker.new_filter(&line).expect("a filter"));
+        tracker.lanes[1].filter = None;
+        tracker.lanes[1].state = LaneState::Lost;
+        let report = tracker.track(&frame).expect("a frame");
+        let worst = |k: usize, truth: &dyn Fn(f64) -> f64| {
+            report.lanes[k].coeffs.map_or(f64::INFINITY, |c| {
+                (top..bottom)
+                    .map(|y| {
+                        (Parabola::from_coeffs(c).col_at_row(y as f64) - truth(y as f64)).abs()
+                    })
+                    .fold(0.0, f64::max)
+            })
+        };
+        (
+            [
+                worst(0, &marks[0]),
+                worst(0, &faint_line),
+                worst(1, &marks[1]),
+            ],
+            *tracker.counters(),
+        )
+    };
+    let ([left_on_mark, _, right_on_mark], counters) = run(&cfg);
+    assert!(
+        left_on_mark < 2.0 && right_on_mark < 2.0,
+        "left {left_on_mark} px, right {right_on_mark} px from their marks"
+    );
+    assert_eq!(counters.revalidation_switches, [1, 0]);
+    assert_eq!(
+        counters.revalidations, 0,
+        "a re-initialisation, not a re-validation"
+    );
+    let mut locked = cfg;
+    locked.track.revalidate_every_frames = 0;
+    let ([_, left_on_line, _], counters) = run(&locked);
+    assert!(
+        left_on_line < 2.0,
+        "locked: left {left_on_line} px from the faint line"
+    );
+    assert_eq!(counters.revalidation_switches, [0, 0]);
+}
