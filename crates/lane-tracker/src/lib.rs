@@ -147,7 +147,8 @@
 //!   side of the centre, among those leaning at least `init.ego_pair.lone_min_lean_deg` from
 //!   the vertical (a vertical line alone may be a door frame or a pole: one still gives no
 //!   ground plane; a mark straight ahead is found with its partner). A lane still tracked stays
-//!   in the pair. Each band's vote, support and least squares take the pixels of its edge
+//!   in the pair (with re-validation on, one tracked from earlier frames competes instead: *The
+//!   loop*, step 3). Each band's vote, support and least squares take the pixels of its edge
 //!   class **and every pixel whose edge runs within 10° of the vertical** (`|gy| ≤ tan 10°·|gx|`,
 //!   `tracker::init::counts_as`): along a mark straight ahead `gy` is the floor's noise, its
 //!   sign — the class — falls either way, and each band saw about half of the mark. While
@@ -179,7 +180,7 @@
 //! - **searches again over taller rows** (`roi.fallback_top_row_fraction`): a side still
 //!   without a lane after the initialisation in the ROI is looked for over the rows from that
 //!   fraction of the height down (gradient, candidates, coverage and choice as above, the side
-//!   found in the ROI kept in the pair as a tracked lane is; the lane is refined over the same
+//!   found in the ROI locked into the pair; the lane is refined over the same
 //!   rows). A dashed mark whose near field falls in the gap between two dashes, or a camera
 //!   tilted down so that a mark is visible only far ahead, is then found where it is. A fit
 //!   needs as many rows as in the first search (a quarter of the ROI's, not of the taller

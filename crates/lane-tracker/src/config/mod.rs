@@ -342,7 +342,8 @@ pub struct TrackConfig {
     /// absent; 0 is read as 1).
     #[serde(default)]
     pub refine_passes: u32,
-    /// Re-validation (an addition beyond the paper; joint initialisation only): while both
+    /// Re-validation (an addition beyond the paper; joint initialisation with
+    /// `init.candidate_coverage` only, never otherwise): while both
     /// lanes are tracked, every this many frames the whole ROI goes through the joint
     /// initialisation and the tracked lanes compete with its candidates for the ego pair; a
     /// lane the choice replaces by a candidate on another mark is initialised there (and, with
@@ -351,9 +352,10 @@ pub struct TrackConfig {
     /// when lost).
     #[serde(default)]
     pub revalidate_every_frames: u32,
-    /// In a re-validation, a tracked lane's row coverage counts this many times (≥ 1, finite;
-    /// default 3 when absent): a candidate replaces it only when clearly stronger, not on the
-    /// frame-to-frame noise of the choice.
+    /// When a tracked lane competes with the candidates (a re-validation, or the other side's
+    /// initialisation with re-validation on), its row coverage counts this many times (≥ 1,
+    /// finite; default 3 when absent): a candidate replaces it only when clearly stronger, not
+    /// on the frame-to-frame noise of the choice.
     #[serde(default = "default_revalidate_keep_factor")]
     pub revalidate_keep_factor: f64,
 }

@@ -4,8 +4,8 @@
 //! checks that accept a fit.
 
 use hough_init::{
-    Chord, HoughLine, LaneInit, OrientedPoint, Parabola, choose_ego_pair, fit_around_line,
-    init_lane,
+    Chord, EgoPairParams, HoughLine, LaneInit, OrientedPoint, Parabola, choose_ego_pair,
+    fit_around_line, init_lane,
 };
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
@@ -17,6 +17,7 @@ use vision_gradient::{
 use super::points::{NEAR_VERTICAL_SLOPE, fit_profile};
 use super::{
     Estimator, InitCandidate, Lane, LaneFilter, LaneState, LaneTracker, MAX_CANDIDATE_LINES,
+    Replaced,
 };
 use crate::TrackerError;
 use crate::error::FilterFailure;
@@ -85,9 +86,9 @@ pub(super) fn extend_with_class(
 }
 
 impl LaneTracker {
-    /// Initialise the sides without an estimate in the ROI, then, with
-    /// `roi.fallback_top_row_fraction`, a side still without one over the taller rows (the
-    /// side found first kept in the pair, as a tracked one is).
+    /// Initialise the sides without an estimate in the ROI (or, both tracked, re-validate
+    /// them: `track.revalidate_every_frames`), then, with `roi.fallback_top_row_fraction`, a
+    /// side still without one over the taller rows (the side found first locked into the pair).
     pub(super) fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
         self.initialise_in_roi(image, [true, true])?;
         let Some(tall) = self.fallback_roi else {
@@ -230,8 +231,12 @@ impl LaneTracker {
     /// Joint initialisation (`init.candidate_lines > 0`, crate docs): the strongest
     /// `candidate_lines` Hough lines of each band (each pixel voting near its own edge normal
     /// with `init.orientation_tolerance_deg > 0`), the ego pair chosen among all of them by
-    /// `hough_init::choose_ego_pair` (a lane still tracked is kept in the pair), each chosen
-    /// line refined by least squares on the pixels of its own class.
+    /// `hough_init::choose_ego_pair`, each chosen line refined by least squares on the pixels of
+    /// its own class. A lane tracked from earlier frames competes with the candidates (with
+    /// re-validation on), weighed by its own row coverage × `track.revalidate_keep_factor`, and
+    /// is replaced only by a candidate off its mark, or handed over to the other side when the
+    /// choice puts it there (a lane change); otherwise, and for a lane initialised on this
+    /// frame, it is locked into the pair.
     ///
     /// `vote[k]`: whether band `k`'s pixels vote (the second search votes only in the bands of
     /// the sides still without a lane; a side's boundary leans into the other band only on a
@@ -373,11 +378,22 @@ impl LaneTracker {
             }
             m += 1;
         }
+        // With tracked lanes competing, a pair need only not diverge upwards (the pair gate's
+        // bound, `update::pair_gate`): the choice's 0.9 margin would refuse the tracked pair of a
+        // camera looking down and pair one of its lanes with clutter instead.
+        let ego_pair = if competes.contains(&true) {
+            EgoPairParams {
+                max_top_width_ratio: self.cfg.init.ego_pair.max_top_width_ratio.max(1.0),
+                ..self.cfg.init.ego_pair
+            }
+        } else {
+            self.cfg.init.ego_pair
+        };
         let choice = choose_ego_pair(
             &chords[..m],
             self.width as f64,
             yb - yt,
-            &self.cfg.init.ego_pair,
+            &ego_pair,
             locked.map(|(j, _)| j),
         );
         // A locked lane the choice put on the other side: leave both as they are.
@@ -389,7 +405,6 @@ impl LaneTracker {
         let picks = [choice.left, choice.right];
         // The lane each pick lies on, if any: its own chord, or (a competing lane) a candidate
         // within the tracking window of it at every ROI row — its own mark.
-        let w = self.cfg.track.window_half_width_px as f64;
         let owner = |j: usize| -> Option<usize> {
             if let Some(k) = tracked_at.iter().position(|&t| t == Some(j)) {
                 return Some(k);
@@ -397,6 +412,8 @@ impl LaneTracker {
             let c = self.init_candidates.get(first + j)?;
             let p = Parabola::from_coeffs(c.coeffs);
             (0..2).filter(|&k| competes[k]).find(|&k| {
+                // The lane's tracking window (wider on a double line: both its lines).
+                let w = self.window_half_width(k, true) as f64;
                 self.lanes[k].filter.as_ref().is_some_and(|f| {
                     (top..bottom)
                         .all(|y| (p.col_at_row(y as f64) - f.col_at_row(y as f64)).abs() <= w)
@@ -407,8 +424,11 @@ impl LaneTracker {
         // A competing lane the choice put on the other side: the camera crossed it (a lane
         // change), and it is that side's boundary now. It moves over with its filter; the lane
         // it replaces there is dropped unless the choice gives that side a candidate below.
-        if let Some(i) = (0..2).find(|&i| owners[i] == Some(1 - i)) {
-            self.hand_over(1 - i, i);
+        if owners == [Some(1), Some(0)] {
+            // Both put on the other side (not a pair the gates let through; kept, swapped).
+            self.hand_over(1, 0, false);
+        } else if let Some(i) = (0..2).find(|&i| owners[i] == Some(1 - i)) {
+            self.hand_over(1 - i, i, true);
             self.counters.lane_changes += 1;
         }
         for (i, pick) in picks.into_iter().enumerate() {
@@ -424,19 +444,33 @@ impl LaneTracker {
             }
             self.fill_candidates(classes[j]);
             if let Ok(init) = fit_around_line(&self.candidates, lines[j], &self.init_params) {
-                if replaced {
+                // The estimate a switch replaces is kept for the crossing gate, which restores
+                // it if it undoes the switch.
+                let lane = &self.lanes[i];
+                let before = lane
+                    .filter
+                    .clone()
+                    .filter(|_| replaced)
+                    .map(|filter| Replaced {
+                        filter,
+                        kerb_offset_px: lane.kerb_offset_px,
+                        kerb_misses: lane.kerb_misses,
+                        pair_half_gap_px: lane.pair_half_gap_px,
+                    });
+                if self.install(i, &init) && replaced {
+                    self.lanes[i].replaced = before;
                     self.counters.revalidation_switches[i] += 1;
                 }
-                self.install(i, &init);
             }
         }
     }
 
-    /// Lane `from` becomes lane `to` (its filter, state and buffers move; each slot keeps its
-    /// side, edge class and angle band), and the lane that was at `to` is dropped into `from`
-    /// (no estimate: initialised again unless replaced on this frame). No allocation (the
-    /// buffers are swapped).
-    fn hand_over(&mut self, from: usize, to: usize) {
+    /// Lane `from` becomes lane `to`: its filter, state and buffers move, each slot keeps its
+    /// side, edge class and angle band, and a kerb's offset is dropped (it was read towards the
+    /// old side). With `drop_other`, the lane that was at `to` is dropped into slot `from` (no
+    /// estimate, no windows or points: the choice's candidate for that side, if any, is
+    /// installed next); without, the two are swapped. No allocation (the buffers are swapped).
+    fn hand_over(&mut self, from: usize, to: usize, drop_other: bool) {
         if from == to || from > 1 || to > 1 {
             return;
         }
@@ -445,12 +479,13 @@ impl LaneTracker {
         std::mem::swap(&mut a.side, &mut b.side);
         std::mem::swap(&mut a.class, &mut b.class);
         std::mem::swap(&mut a.band, &mut b.band);
-        let dropped = &mut self.lanes[from];
-        dropped.filter = None;
-        dropped.predicted = None;
-        dropped.state = LaneState::Lost;
-        dropped.points_now = 0;
-        dropped.initialised_now = false;
+        for lane in &mut self.lanes {
+            lane.kerb_offset_px = [0.0; 2];
+            lane.kerb_misses = 0;
+        }
+        if drop_other {
+            self.lanes[from].drop_estimate();
+        }
     }
 
     /// `self.by_row` = the edge pixels of `class` as `(column, weight)` sorted by row then

@@ -197,9 +197,34 @@ struct Lane {
     pair_half_gap_px: f64,
     updated_now: bool,
     fresh: bool,
+    /// The tracked lane a switch replaced on this frame (the lane is `initialised_now`),
+    /// restored if the crossing gate undoes the switch; `None` otherwise.
+    replaced: Option<Replaced>,
+}
+
+/// What a switch to another candidate replaced: the tracked estimate and the offsets read for
+/// it (a kerb's foot, a double line's gap).
+#[derive(Debug, Clone)]
+struct Replaced {
+    filter: LaneFilter,
+    kerb_offset_px: [f64; 2],
+    kerb_misses: u32,
+    pair_half_gap_px: f64,
 }
 
 impl Lane {
+    /// No estimate any more (lost: initialised again), and no windows or points to draw.
+    fn drop_estimate(&mut self) {
+        self.filter = None;
+        self.predicted = None;
+        self.state = LaneState::Lost;
+        self.points_now = 0;
+        self.initialised_now = false;
+        self.replaced = None;
+        self.spans.fill(ColSpan::EMPTY);
+        self.points.clear();
+    }
+
     fn report(&self) -> LaneReport {
         let coeffs = match self.state {
             LaneState::Tracking | LaneState::Coasting => {
@@ -245,10 +270,11 @@ pub struct InitCandidate {
     /// Its support in the choice: the row coverage net of the clutter beside it
     /// (`init.candidate_coverage`), else its Hough votes.
     pub support: f64,
-    /// The side the choice gave it, if any. A side without an estimate (or, in a re-validation,
-    /// whose tracked lane lies off this candidate's mark) is then initialised from this
-    /// candidate's line refitted by least squares and refined in the windows
-    /// (`track.refine_passes`), unless the fit or the sanity checks refuse it. A side the choice
+    /// The side the choice gave it, if any. A side without an estimate, or whose competing
+    /// tracked lane (re-validation on) lies off this candidate's mark, is then initialised from
+    /// this candidate's line refitted by least squares and refined in the windows
+    /// (`track.refine_passes`), unless the fit or the sanity checks refuse it; a candidate on
+    /// the tracked lane's own mark is marked but leaves the lane as it is. A side the choice
     /// gave a tracked lane's own chord has no chosen candidate.
     pub chosen: Option<Side>,
 }
@@ -381,6 +407,7 @@ impl LaneTracker {
             pair_half_gap_px: 0.0,
             updated_now: false,
             fresh: false,
+            replaced: None,
         };
         let lanes = [
             make_lane(Side::Left, EdgeClass::LeftLane, left_band),
@@ -520,10 +547,11 @@ impl LaneTracker {
         lane.has_estimate().then_some(lane.fit)
     }
 
-    /// The Hough candidate lines of the last frame's joint initialisation, both angle bands
-    /// (at most `init.candidate_lines` each), with their support and the side the choice gave
-    /// them ([`InitCandidate`]). Empty when the last frame ran no joint initialisation (both
-    /// lanes tracked, or `init.candidate_lines = 0`, the paper's one line per band).
+    /// The Hough candidate lines of the last frame's joint initialisation or re-validation, both
+    /// angle bands (at most `init.candidate_lines` each), with their support and the side the
+    /// choice gave them ([`InitCandidate`]). Empty when the last frame ran neither (both lanes
+    /// tracked between re-validations, or `init.candidate_lines = 0`, the paper's one line per
+    /// band).
     pub fn init_candidates(&self) -> &[InitCandidate] {
         &self.init_candidates
     }
@@ -572,6 +600,7 @@ impl LaneTracker {
             lane.found_in_fallback = false;
             lane.updated_now = false;
             lane.points_now = 0;
+            lane.replaced = None;
             if lane.has_estimate() {
                 self.track_lane(i, &image, true)?;
             } else {

@@ -7,7 +7,7 @@ use vision_gradient::{EdgeClass, EdgePixel, GreyImage};
 use wrls::WrlsError;
 
 use super::init::counts_as;
-use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, Side};
+use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, Replaced, Side};
 use crate::{FilterFailure, GreyFrame, TrackerConfig};
 use hough_init::Parabola;
 
@@ -1021,7 +1021,8 @@ fn a_tracked_pair_as_wide_at_the_top_as_a_camera_looking_down_sees_it_is_kept() 
     // Marks 5 px wide from columns 60 and 260 at the bottom row to 65 and 255 at the ROI's
     // top: a top/bottom width ratio of 0.95, which the choice among candidates refuses
     // (`max_top_width_ratio` 0.9) but labelled ego pairs reach (0.92 on `seame`). Tracked, the
-    // pair is kept: the gate asks only that it does not diverge upwards.
+    // pair is kept: the gate asks only that it does not diverge upwards, and a re-validation
+    // (whose choice holds a tracked pair to the same bound) keeps both lanes.
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     assert!(cfg.init.ego_pair.max_top_width_ratio < 0.95);
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
@@ -1046,7 +1047,9 @@ fn a_tracked_pair_as_wide_at_the_top_as_a_camera_looking_down_sees_it_is_kept() 
         tracker.lanes[k].filter = Some(tracker.new_filter(mark).expect("a filter"));
         tracker.lanes[k].state = LaneState::Tracking;
     }
-    for n in 0..3 {
+    // Over two re-validations too: the choice among candidates holds the pair to the same bound.
+    let frames = 2 * cfg.track.revalidate_every_frames + 1;
+    for n in 0..frames {
         let report = tracker.track(&frame).expect("a frame");
         for (k, mark) in marks.iter().enumerate() {
             let c = report.lanes[k].coeffs.expect("both lanes");
@@ -1058,8 +1061,11 @@ fn a_tracked_pair_as_wide_at_the_top_as_a_camera_looking_down_sees_it_is_kept() 
             assert!(e < 1.5, "frame {n}, lane {k}: {e} px");
         }
     }
-    assert_eq!(tracker.counters().gated_pairs, 0);
-    assert_eq!(tracker.counters().initialisations, [0, 0]);
+    let counters = tracker.counters();
+    assert_eq!(counters.gated_pairs, 0);
+    assert_eq!(counters.revalidations, 2);
+    assert_eq!(counters.revalidation_switches, [0, 0]);
+    assert_eq!(counters.initialisations, [0, 0]);
 }
 
 /// `two_marks` with a faint dashed line 25 px left of the left mark and parallel to it: 2 px
@@ -1112,6 +1118,7 @@ fn a_lane_left_on_a_faint_line_is_moved_to_the_mark_by_the_next_revalidation() {
         "after {every} frames: {on_mark} px from the mark"
     );
     assert_eq!(counters.revalidation_switches, [1, 0]);
+    assert_eq!(counters.revalidations, 1);
     assert_eq!(counters.gated_pairs, 0);
     // Without re-validation the lane stays on the faint line: it keeps enough points.
     let mut never = cfg;
@@ -1244,4 +1251,50 @@ fn a_tracked_lane_on_a_faint_line_competes_when_the_other_side_is_initialised_ag
         "locked: left {left_on_line} px from the faint line"
     );
     assert_eq!(counters.revalidation_switches, [0, 0]);
+}
+
+#[test]
+fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
+    // A switch (a tracked lane replaced by another candidate) that crosses the other lane is
+    // undone by the crossing gate: the tracked estimate comes back, not a lost lane.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let frame = two_marks(320, 240);
+    for _ in 0..3 {
+        tracker.track(&frame).expect("a frame");
+    }
+    let tracked = tracker.lanes[0].filter.clone().expect("a left lane");
+    let (yt, yb) = (top as f64, (bottom - 1) as f64);
+    // The switch put the left lane right of the right one (crossed at every row).
+    let crossing = nalgebra::Vector3::new(0.0, 0.0, 300.0);
+    tracker.lanes[0].filter = Some(tracker.new_filter(&crossing).expect("a filter"));
+    tracker.lanes[0].initialised_now = true;
+    tracker.lanes[0].kerb_offset_px = [0.0; 2];
+    tracker.lanes[0].replaced = Some(Replaced {
+        filter: tracked.clone(),
+        kerb_offset_px: [1.5, 0.0],
+        kerb_misses: 0,
+        pair_half_gap_px: 0.0,
+    });
+    tracker.counters.initialisations[0] += 1;
+    tracker.counters.revalidation_switches[0] += 1;
+    let before = *tracker.counters();
+    tracker.crossing_gate();
+    let lane = &tracker.lanes[0];
+    let restored = lane.filter.as_ref().expect("the tracked lane back");
+    for y in [yt, yb] {
+        assert!((restored.col_at_row(y) - tracked.col_at_row(y)).abs() < 1e-9);
+    }
+    assert_eq!(lane.state, LaneState::Tracking);
+    assert_eq!(lane.kerb_offset_px, [1.5, 0.0]);
+    assert!(!lane.initialised_now && lane.replaced.is_none());
+    let after = tracker.counters();
+    assert_eq!(after.initialisations[0], before.initialisations[0] - 1);
+    assert_eq!(after.revalidation_switches, [0, 0]);
+    assert_eq!(after.gated_crossings, [1, 0]);
+    assert!(
+        tracker.lanes[1].has_estimate(),
+        "the right lane is untouched"
+    );
 }

@@ -160,9 +160,7 @@ impl LaneTracker {
         }
         self.counters.gated_pairs += 1;
         for lane in &mut self.lanes {
-            lane.filter = None;
-            lane.points_now = 0;
-            lane.state = LaneState::Lost;
+            lane.drop_estimate();
         }
         true
     }
@@ -207,7 +205,20 @@ impl LaneTracker {
         };
         self.counters.gated_crossings[victim] += 1;
         let lane = &mut self.lanes[victim];
-        if lane.initialised_now {
+        if let Some(before) = lane.replaced.take() {
+            // A switch to another candidate (re-validation): the tracked lane it replaced comes
+            // back as it was after this frame's update.
+            lane.initialised_now = false;
+            lane.filter = Some(before.filter);
+            lane.kerb_offset_px = before.kerb_offset_px;
+            lane.kerb_misses = before.kerb_misses;
+            lane.pair_half_gap_px = before.pair_half_gap_px;
+            lane.state = LaneState::Tracking;
+            lane.points_now = 0;
+            let c = &mut self.counters;
+            c.initialisations[victim] = c.initialisations[victim].saturating_sub(1);
+            c.revalidation_switches[victim] = c.revalidation_switches[victim].saturating_sub(1);
+        } else if lane.initialised_now {
             lane.initialised_now = false;
             lane.filter = None;
             lane.points_now = 0;
