@@ -4,8 +4,8 @@
 //! checks that accept a fit.
 
 use hough_init::{
-    Chord, EgoPairParams, HoughLine, LaneInit, OrientedPoint, Parabola, choose_ego_pair,
-    fit_around_line, init_lane,
+    Chord, HoughLine, LaneInit, OrientedPoint, Parabola, choose_ego_pair, fit_around_line,
+    init_lane,
 };
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
@@ -367,25 +367,18 @@ impl LaneTracker {
             } else {
                 s_max
             };
-            chords[m] = Chord {
-                col_top_px: f.col_at_row(yt),
-                col_bottom_px: f.col_at_row(yb),
-                support,
-            };
+            chords[m] = f.chord(yt, yb, support);
             tracked_at[i] = Some(m);
             if !competes[i] {
                 locked = Some((m, i));
             }
             m += 1;
         }
-        // With tracked lanes competing, a pair need only not diverge upwards (the pair gate's
-        // bound, `update::pair_gate`): the choice's 0.9 margin would refuse the tracked pair of a
-        // camera looking down and pair one of its lanes with clutter instead.
+        // With tracked lanes competing, the pair gate's rules: the choice's 0.9 margin would
+        // refuse the tracked pair of a camera looking down and pair one of its lanes with
+        // clutter instead.
         let ego_pair = if competes.contains(&true) {
-            EgoPairParams {
-                max_top_width_ratio: self.cfg.init.ego_pair.max_top_width_ratio.max(1.0),
-                ..self.cfg.init.ego_pair
-            }
+            self.tracked_pair_rules()
         } else {
             self.cfg.init.ego_pair
         };

@@ -1,7 +1,7 @@
 //! The tracking loop (paper Fig. 1): directional gradient → Hough + LS initialisation → KIF
 //! (or WRLS) recursion, per lane, with a state machine and sanity gates.
 
-use hough_init::{AngleBand, HoughWorkspace, LaneInitParams, OrientedPoint, Parabola};
+use hough_init::{AngleBand, Chord, HoughWorkspace, LaneInitParams, OrientedPoint, Parabola};
 use info_filter::{ParabolaKif, ProcessNoise, RowNorm, ThetaCov};
 use lane_geometry::FitRows;
 use nalgebra::{Matrix3, Vector3};
@@ -149,6 +149,14 @@ impl LaneFilter {
         match self {
             LaneFilter::Kif(k) => k.col_at_row_px(row_px),
             LaneFilter::Wrls(w) => w.col_at_row_px(row_px),
+        }
+    }
+    /// Its chord between rows `yt` and `yb` with `support` (the ego pair's view of a lane).
+    fn chord(&self, yt: f64, yb: f64, support: f64) -> Chord {
+        Chord {
+            col_top_px: self.col_at_row(yt),
+            col_bottom_px: self.col_at_row(yb),
+            support,
         }
     }
     fn coeffs(&self) -> [f64; 3] {
@@ -619,12 +627,12 @@ impl LaneTracker {
             && self.cfg.init.candidate_coverage
             && every > 0
             && self.frames_since_full_gradient + 1 >= every;
-        if need_init || revalidate {
-            self.frames_since_full_gradient = 0;
-        } else {
-            self.frames_since_full_gradient += 1;
-        }
         self.counters.revalidations += u64::from(revalidate);
+        self.frames_since_full_gradient = if need_init || revalidate {
+            0
+        } else {
+            self.frames_since_full_gradient + 1
+        };
         if need_init || revalidate {
             self.initialise(&image)?;
             // Refine a fresh initialisation on the same frame: one windowed update around the

@@ -1,7 +1,7 @@
 //! Stage III, measurement update and gates: the filter update (KIF eqs. 6, 12 or WRLS eqs.
 //! 25–27), the jump gate, misses, and the crossing gate between the two lanes.
 
-use hough_init::{Chord, EgoPairParams, pair_shape_is_plausible};
+use hough_init::{EgoPairParams, pair_shape_is_plausible};
 use vision_gradient::{GreyImage, Region, keep_bright_stripes};
 
 use super::points::{fit_profile, weighted_scatter};
@@ -123,16 +123,26 @@ impl LaneTracker {
         };
     }
 
+    /// The ego pair's rules for a pair with a tracked lane in it (the pair gate, and the joint
+    /// choice while tracked lanes compete): `[init.ego_pair]`, except that a tracked pair need
+    /// only not diverge upwards (top width ≤ bottom width): `max_top_width_ratio` is a margin for
+    /// choosing among candidates, and labelled ego pairs on a camera looking down reach a ratio
+    /// of 0.92 (`seame`).
+    pub(super) fn tracked_pair_rules(&self) -> EgoPairParams {
+        EgoPairParams {
+            max_top_width_ratio: 1.0,
+            ..self.cfg.init.ego_pair
+        }
+    }
+
     /// The pair gate (joint initialisation only, `init.candidate_lines > 0`): two tracked lanes
     /// whose chords over the ROI rows no longer have the shape of an ego lane have lost at
     /// least one boundary to something else — and which one cannot be told from the pair
     /// alone. Both are dropped, and the joint initialisation that follows on the same frame
     /// chooses the pair again among all candidates. The shape is
-    /// `hough_init::pair_shape_is_plausible` with `[init.ego_pair]` (the width at the bottom ROI
-    /// row, meeting above the ROI or within its top `meet_top_frac`), except that a tracked pair
-    /// need only not diverge upwards (top width ≤ bottom width): `max_top_width_ratio` is a
-    /// margin for choosing among candidates, and labelled ego pairs on a camera looking down
-    /// reach a ratio of 0.92 (`seame`). Returns whether the pair was dropped.
+    /// `hough_init::pair_shape_is_plausible` with [`Self::tracked_pair_rules`] (the width at the
+    /// bottom ROI row, in order below the ROI's top `meet_top_frac`, not diverging upwards).
+    /// Returns whether the pair was dropped.
     pub(super) fn pair_gate(&mut self) -> bool {
         if self.cfg.init.candidate_lines == 0 {
             return false;
@@ -146,16 +156,8 @@ impl LaneTracker {
         }
         let (top, bottom) = self.search_rows;
         let (yt, yb) = (top as f64, (bottom - 1) as f64);
-        let chord = |f: &LaneFilter| Chord {
-            col_top_px: f.col_at_row(yt),
-            col_bottom_px: f.col_at_row(yb),
-            support: 0.0,
-        };
-        let shape = EgoPairParams {
-            max_top_width_ratio: 1.0,
-            ..self.cfg.init.ego_pair
-        };
-        if pair_shape_is_plausible(&chord(lf), &chord(rf), self.width as f64, &shape) {
+        let (left, right) = (lf.chord(yt, yb, 0.0), rf.chord(yt, yb, 0.0));
+        if pair_shape_is_plausible(&left, &right, self.width as f64, &self.tracked_pair_rules()) {
             return false;
         }
         self.counters.gated_pairs += 1;
