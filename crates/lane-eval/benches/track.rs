@@ -38,6 +38,15 @@ fn synthetic_frame(w: usize, h: usize) -> GreyFrame {
     frame
 }
 
+/// A tracker for `frame`'s size that has tracked it five times (its lanes settled on it).
+fn warmed_up(cfg: &TrackerConfig, estimator: Estimator, frame: &GreyFrame) -> LaneTracker {
+    let mut tracker = LaneTracker::new(cfg, estimator, frame.width(), frame.height()).unwrap();
+    for _ in 0..5 {
+        tracker.track(frame).unwrap();
+    }
+    tracker
+}
+
 fn tracking_frame(c: &mut Criterion) {
     let cfg = TrackerConfig::outdoor().unwrap();
     let mut group = c.benchmark_group("tracking_frame");
@@ -48,10 +57,7 @@ fn tracking_frame(c: &mut Criterion) {
     ];
     for (name, frame) in &cases {
         for (est_name, est) in [("kif", Estimator::Kif), ("wrls", Estimator::Wrls)] {
-            let mut tracker = LaneTracker::new(&cfg, est, frame.width(), frame.height()).unwrap();
-            for _ in 0..5 {
-                tracker.track(frame).unwrap();
-            }
+            let mut tracker = warmed_up(&cfg, est, frame);
             let r = tracker.track(frame).unwrap();
             assert!(
                 !r.full_gradient,
@@ -64,11 +70,7 @@ fn tracking_frame(c: &mut Criterion) {
         // The KIF with sub-pixel mark centres and the measured R (`track.mark_centres`).
         let mut centres = cfg;
         centres.track.mark_centres = true;
-        let mut tracker =
-            LaneTracker::new(&centres, Estimator::Kif, frame.width(), frame.height()).unwrap();
-        for _ in 0..5 {
-            tracker.track(frame).unwrap();
-        }
+        let mut tracker = warmed_up(&centres, Estimator::Kif, frame);
         assert!(!tracker.track(frame).unwrap().full_gradient, "{name}");
         group.bench_function(BenchmarkId::new("kif_mark_centres", name), |b| {
             b.iter(|| black_box(tracker.track(black_box(frame)).unwrap()));
@@ -82,34 +84,23 @@ fn tracking_frame(c: &mut Criterion) {
                 black_box(tracker.track(black_box(frame)).unwrap())
             });
         });
-        // The default configuration (joint initialisation, stripe pairing): a tracking frame and
-        // an initialisation frame (several Hough candidates per band, ego-pair choice, two
-        // refinements in the wider window).
-        // The tracked frame alone: the default re-validates every
-        // `track.revalidate_every_frames`-th frame (an initialisation's work, measured apart
-        // below), so the tracked frame is measured with re-validation off.
+        // The default configuration (joint initialisation, stripe pairing): a tracking frame, a
+        // re-validation frame and initialisation frames (several Hough candidates per band,
+        // ego-pair choice, two refinements in the wider window). The default re-validates every
+        // `track.revalidate_every_frames`-th frame, so the tracked frame alone is measured with
+        // re-validation off and a re-validation frame with it on every frame.
         let default = TrackerConfig::default_preset().unwrap();
         let mut tracked_only = default;
         tracked_only.track.revalidate_every_frames = 0;
-        let mut tracking =
-            LaneTracker::new(&tracked_only, Estimator::Kif, frame.width(), frame.height()).unwrap();
-        for _ in 0..5 {
-            tracking.track(frame).unwrap();
-        }
+        let mut tracking = warmed_up(&tracked_only, Estimator::Kif, frame);
         if !tracking.track(frame).unwrap().full_gradient {
             group.bench_function(BenchmarkId::new("kif_default", name), |b| {
                 b.iter(|| black_box(tracking.track(black_box(frame)).unwrap()));
             });
         }
-        // A re-validation frame: both lanes tracked, the joint initialisation run over the ROI
-        // and the tracked lanes weighed against its candidates (here on every frame).
         let mut every_frame = default;
         every_frame.track.revalidate_every_frames = 1;
-        let mut revalidating =
-            LaneTracker::new(&every_frame, Estimator::Kif, frame.width(), frame.height()).unwrap();
-        for _ in 0..5 {
-            revalidating.track(frame).unwrap();
-        }
+        let mut revalidating = warmed_up(&every_frame, Estimator::Kif, frame);
         group.bench_function(BenchmarkId::new("revalidation_frame_default", name), |b| {
             b.iter(|| black_box(revalidating.track(black_box(frame)).unwrap()));
         });

@@ -14,10 +14,19 @@ use hough_init::Parabola;
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator::new();
 
+/// The centre of `two_marks`' left (`/`) mark at row `y`, px.
+fn mark_left(y: f64) -> f64 {
+    100.0 - 0.45 * (y - 239.0)
+}
+
+/// The centre of `two_marks`' right (`\`) mark at row `y`, px.
+fn mark_right(y: f64) -> f64 {
+    220.0 + 0.45 * (y - 239.0)
+}
+
 /// Two bright marks (`/` left, `\` right) 5 px wide on a dark floor.
 fn two_marks(w: usize, h: usize) -> GreyFrame {
-    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
-    let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
+    let (left, right) = (mark_left, mark_right);
     let mut pixels = vec![60u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
@@ -103,7 +112,7 @@ fn two_marks_and_a_crossing_bar(w: usize, h: usize) -> GreyFrame {
 
 #[test]
 fn the_orientation_gate_keeps_a_crossing_bar_out_of_the_window_points() {
-    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let left = mark_left;
     let far_points = |cfg: &TrackerConfig| {
         let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
         tracker.track(&two_marks(320, 240)).expect("a frame");
@@ -127,8 +136,7 @@ fn the_orientation_gate_keeps_a_crossing_bar_out_of_the_window_points() {
 
 #[test]
 fn the_joint_initialisation_reports_its_candidates_and_the_chosen_pair() {
-    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
-    let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
+    let (left, right) = (mark_left, mark_right);
     let col = |c: [f64; 3], y: f64| c[0] * y * y + c[1] * y + c[2];
     let frame = two_marks(320, 240);
     let cfg = TrackerConfig::default_preset().expect("the default preset");
@@ -311,8 +319,7 @@ fn the_second_search_accepts_a_dash_as_long_as_the_roi_would() {
 /// of `two_marks`' geometry, with its single right mark; `inner_only` paints only the line
 /// `left(y) + s(y)`.
 fn double_line_left(w: usize, h: usize, inner_only: bool) -> GreyFrame {
-    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
-    let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
+    let (left, right) = (mark_left, mark_right);
     let mut pixels = vec![60u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
@@ -328,7 +335,7 @@ fn double_line_left(w: usize, h: usize, inner_only: bool) -> GreyFrame {
 
 #[test]
 fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
-    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let left = mark_left;
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
     let (top, bottom) = tracker.roi;
@@ -389,7 +396,7 @@ fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
 /// continuous, pixel `x` covering `[x, x + 1)`: an edge at `e` lies between the pixels
 /// around `e − ½` in the tracker's column coordinates.
 fn kerb_right(w: usize, h: usize, plain: bool, extra_px: f64) -> GreyFrame {
-    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let left = mark_left;
     let overlap = |x: f64, a: f64, b: f64| (b.min(x + 1.0) - a.max(x)).clamp(0.0, 1.0);
     let mut pixels = vec![55u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
@@ -480,7 +487,7 @@ fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
     for y in rows {
         let d = off_foot(report.lanes[1].coeffs, y);
         assert!(d.abs() < 1.0, "row {y}: {d} px off the foot");
-        let l = report.lanes[0].col_at_row(y).expect("a left lane") - (100.0 - 0.45 * (y - 239.0));
+        let l = report.lanes[0].col_at_row(y).expect("a left lane") - mark_left(y);
         assert!(l.abs() < 1.5, "row {y}: the left lane {l} px off its mark");
     }
     // Tracked on while the face widens by 2 px: the kerb is read again and the offset follows.
@@ -661,8 +668,7 @@ fn unpaired_pixels_count_one_steps_worth_a_row_in_the_row_coverage() {
 /// rising and falling edge pixels as those marks' outer sides, but each the side of a region
 /// far wider than a mark (no stripe pairs them).
 fn road_between_marks(w: usize, h: usize) -> GreyFrame {
-    let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
-    let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
+    let (left, right) = (mark_left, mark_right);
     let mut pixels = vec![60u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
@@ -749,10 +755,7 @@ fn crosswalk(w: usize, h: usize, marks: bool) -> GreyFrame {
 
 #[test]
 fn a_crosswalk_is_not_reported_as_a_lane_and_marks_across_it_are() {
-    let marks = [
-        |y: f64| 100.0 - 0.45 * (y - 239.0),
-        |y: f64| 220.0 + 0.45 * (y - 239.0),
-    ];
+    let marks = [mark_left, mark_right];
     // Largest distance of each reported lane from its mark over the ROI rows (`None`: no lane).
     let errors = |cfg: &TrackerConfig, frame: &GreyFrame| {
         let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
@@ -794,9 +797,7 @@ fn a_crosswalk_is_not_reported_as_a_lane_and_marks_across_it_are() {
 /// grey 60 with a deterministic texture of ±3 grey levels: along the vertical mark's edges
 /// `gy` is that texture, so its sign — the pixel's class — is random.
 fn mark_straight_ahead(w: usize, h: usize) -> GreyFrame {
-    let on_mark = |x: f64, y: f64| {
-        (141.0..147.0).contains(&x) || (x - (220.0 + 0.45 * (y - 239.0))).abs() < 3.0
-    };
+    let on_mark = |x: f64, y: f64| (141.0..147.0).contains(&x) || (x - mark_right(y)).abs() < 3.0;
     let pixels = (0..w * h)
         .map(|i| {
             let (x, y) = ((i % w) as f64, (i / w) as f64);
@@ -866,7 +867,7 @@ fn a_mark_straight_ahead_votes_with_all_its_edges_in_the_initialisation() {
     let report = tracker
         .track(&mark_straight_ahead(320, 240))
         .expect("a frame");
-    let marks = [|_: f64| 143.5, |y: f64| 220.0 + 0.45 * (y - 239.0)];
+    let marks = [|_: f64| 143.5, mark_right];
     let col = |c: [f64; 3], y: f64| Parabola::from_coeffs(c).col_at_row(y);
     let worst = |c: [f64; 3], k: usize| {
         (top..bottom)
@@ -978,10 +979,7 @@ fn outward_bar(y: f64) -> f64 {
 fn a_tracked_pair_that_diverges_upwards_is_initialised_again() {
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     let frame = two_marks_and_an_outward_bar(320, 240);
-    let marks = [
-        |y: f64| 100.0 - 0.45 * (y - 239.0),
-        |y: f64| 220.0 + 0.45 * (y - 239.0),
-    ];
+    let marks = [mark_left, mark_right];
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
     let (top, bottom) = tracker.roi;
     // Largest distance of each lane from `truth[k]` over the ROI rows (infinite: no lane).
@@ -1092,7 +1090,7 @@ fn a_lane_left_on_a_faint_line_is_moved_to_the_mark_by_the_next_revalidation() {
     let every = cfg.track.revalidate_every_frames;
     assert!(every > 0 && cfg.track.revalidate_keep_factor < 4.0);
     let frame = two_marks_and_a_faint_dashed_line(320, 240);
-    let mark = |y: f64| 100.0 - 0.45 * (y - 239.0);
+    let mark = mark_left;
     // Largest distance of the left lane from `truth` over the ROI rows after `frames` more
     // frames, the left lane having been put on the faint line first.
     let left_after = |cfg: &TrackerConfig, frames: u32, truth: &dyn Fn(f64) -> f64| {
@@ -1202,10 +1200,7 @@ fn a_tracked_lane_on_a_faint_line_competes_when_the_other_side_is_initialised_ag
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     assert!(cfg.track.revalidate_every_frames > 1);
     let frame = two_marks_and_a_faint_dashed_line(320, 240);
-    let marks = [
-        |y: f64| 100.0 - 0.45 * (y - 239.0),
-        |y: f64| 220.0 + 0.45 * (y - 239.0),
-    ];
+    let marks = [mark_left, mark_right];
     let run = |cfg: &TrackerConfig| {
         let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
         let (top, bottom) = tracker.roi;
