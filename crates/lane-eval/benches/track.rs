@@ -87,11 +87,13 @@ fn tracking_frame(c: &mut Criterion) {
         // The default configuration (joint initialisation, stripe pairing): a tracking frame, a
         // re-validation frame and initialisation frames (several Hough candidates per band,
         // ego-pair choice, two refinements in the wider window). The default re-validates every
-        // `track.revalidate_every_frames`-th frame, so the tracked frame alone is measured with
+        // `track.revalidate_every_frames`-th frame (and on a frame with a weak lane,
+        // `track.revalidate_below_points`), so the tracked frame alone is measured with
         // re-validation off and a re-validation frame with it on every frame.
         let default = TrackerConfig::default_preset().unwrap();
         let mut tracked_only = default;
         tracked_only.track.revalidate_every_frames = 0;
+        tracked_only.track.revalidate_below_points = 0;
         let mut tracking = warmed_up(&tracked_only, Estimator::Kif, frame);
         if !tracking.track(frame).unwrap().full_gradient {
             group.bench_function(BenchmarkId::new("kif_default", name), |b| {

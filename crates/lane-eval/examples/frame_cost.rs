@@ -35,6 +35,9 @@ fn main() {
         "revalidate" => 1,
         _ => cfg.track.revalidate_every_frames,
     };
+    if kind == "track" {
+        cfg.track.revalidate_below_points = 0;
+    }
     let mut tracker =
         LaneTracker::new(&cfg, Estimator::Kif, frame.width(), frame.height()).unwrap();
     for _ in 0..5 {

@@ -93,7 +93,9 @@
 //!    of points).
 //! 3. *(Re-)initialisation* (first frame, every frame a lane is lost, and — the *re-validation*,
 //!    an addition beyond the paper, joint initialisation only — every
-//!    `track.revalidate_every_frames`-th frame while both lanes are tracked, where the tracked
+//!    `track.revalidate_every_frames`-th frame while both lanes are tracked, and at once on a
+//!    frame a tracked lane's window gave fewer than `track.revalidate_below_points` points — a
+//!    lane on clutter or whose mark left its window —, where the tracked
 //!    lanes compete with the candidates, each weighed by its own row coverage ×
 //!    `track.revalidate_keep_factor`, and a lane is replaced only by a candidate off its mark,
 //!    [`TrackerCounters::revalidations`]; with re-validation on, a lane tracked from earlier

@@ -358,6 +358,17 @@ pub struct TrackConfig {
     /// on the frame-to-frame noise of the choice.
     #[serde(default = "default_revalidate_keep_factor")]
     pub revalidate_keep_factor: f64,
+    /// Re-validation on weak evidence (an addition beyond the paper; as
+    /// `revalidate_every_frames`, joint initialisation with `init.candidate_coverage` only):
+    /// while both lanes are tracked, a frame on which a tracked lane's window gave fewer
+    /// points than this (a miss included, `reinit_min_points`) is re-validated at once, not at
+    /// the period's next frame. A lane that slid onto clutter or whose mark left the window
+    /// keeps few points for a few frames before it misses often enough to be lost; a lane on a
+    /// solid mark fills its window (up to `max_points_per_lane`) and does not trigger it, a
+    /// dashed mark between two dashes may (a re-validation keeps a lane on its own mark). Points,
+    /// `0..=max_points_per_lane`; 0 (default when absent): the period only.
+    #[serde(default)]
+    pub revalidate_below_points: usize,
 }
 
 fn default_revalidate_keep_factor() -> f64 {
@@ -365,6 +376,12 @@ fn default_revalidate_keep_factor() -> f64 {
 }
 
 impl TrackConfig {
+    /// Whether re-validation is on: a period (`revalidate_every_frames`) or a trigger on weak
+    /// evidence (`revalidate_below_points`).
+    pub fn revalidates(&self) -> bool {
+        self.revalidate_every_frames > 0 || self.revalidate_below_points > 0
+    }
+
     /// The window half-width of the refinement after an initialisation, px.
     pub fn refine_window_half_width(&self) -> usize {
         if self.refine_window_half_width_px == 0 {
@@ -630,6 +647,12 @@ impl TrackerConfig {
             "track.revalidate_every_frames",
             t.revalidate_every_frames,
             "must be in 0..=100000 frames (0: never)",
+        )?;
+        check(
+            t.revalidate_below_points <= t.max_points_per_lane,
+            "track.revalidate_below_points",
+            t.revalidate_below_points,
+            "must be in 0..=max_points_per_lane points (0: the period only)",
         )?;
         check(
             t.revalidate_keep_factor >= 1.0 && t.revalidate_keep_factor.is_finite(),

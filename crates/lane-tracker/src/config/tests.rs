@@ -129,6 +129,9 @@ fn each_out_of_range_field_is_named() {
         ("track.revalidate_every_frames", |c| {
             c.track.revalidate_every_frames = 100_001
         }),
+        ("track.revalidate_below_points", |c| {
+            c.track.revalidate_below_points = c.track.max_points_per_lane + 1
+        }),
         ("track.revalidate_keep_factor", |c| {
             c.track.revalidate_keep_factor = 0.5
         }),

@@ -258,14 +258,14 @@ impl LaneTracker {
         let mut m = 0;
         // This search's candidates follow those of an earlier search on the same frame.
         let first = self.init_candidates.len();
-        // With re-validation on (`track.revalidate_every_frames > 0`), a lane tracked from
+        // With re-validation on (`TrackConfig::revalidates`), a lane tracked from
         // earlier frames competes with the candidates, weighed by its own row coverage: in a
         // re-validation (both tracked) and when the other side is (re-)initialised. A lane
         // initialised on this frame (the first search's, during the second search) is locked
         // into the pair instead, as every tracked lane is with re-validation off.
         let competes: [bool; 2] = std::array::from_fn(|i| {
             let lane = &self.lanes[i];
-            self.cfg.track.revalidate_every_frames > 0
+            self.cfg.track.revalidates()
                 && self.cfg.init.candidate_coverage
                 && lane.has_estimate()
                 && !lane.initialised_now

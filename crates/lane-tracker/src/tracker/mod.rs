@@ -618,15 +618,21 @@ impl LaneTracker {
         }
         self.pair_gate();
         let need_init = self.lanes.iter().any(|l| !l.has_estimate());
-        // Re-validation (`track.revalidate_every_frames`; joint initialisation weighing its
-        // candidates by row coverage only): both lanes tracked, the joint initialisation runs
-        // over the ROI and the tracked lanes compete with its candidates.
-        let every = u64::from(self.cfg.track.revalidate_every_frames);
+        // Re-validation (`track.revalidate_every_frames`, `track.revalidate_below_points`;
+        // joint initialisation weighing its candidates by row coverage only): both lanes
+        // tracked, the joint initialisation runs over the ROI and the tracked lanes compete with
+        // its candidates — every `revalidate_every_frames` frames, and at once on a frame a
+        // lane's window gave fewer than `revalidate_below_points` points.
+        let track_cfg = &self.cfg.track;
+        let every = u64::from(track_cfg.revalidate_every_frames);
+        let weak = self
+            .lanes
+            .iter()
+            .any(|l| l.points_now < track_cfg.revalidate_below_points);
         let revalidate = !need_init
             && self.cfg.init.candidate_lines > 0
             && self.cfg.init.candidate_coverage
-            && every > 0
-            && self.frames_since_full_gradient + 1 >= every;
+            && ((every > 0 && self.frames_since_full_gradient + 1 >= every) || weak);
         self.counters.revalidations += u64::from(revalidate);
         self.frames_since_full_gradient = if need_init || revalidate {
             0

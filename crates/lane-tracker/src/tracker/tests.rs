@@ -1061,7 +1061,10 @@ fn a_tracked_pair_as_wide_at_the_top_as_a_camera_looking_down_sees_it_is_kept() 
     }
     let counters = tracker.counters();
     assert_eq!(counters.gated_pairs, 0);
-    assert_eq!(counters.revalidations, 2);
+    // At least the period's two; also every frame the weak-evidence trigger fires on (these
+    // noise-free marks near the vertical give edge pixels only where their rasterisation
+    // steps, fewer than `revalidate_below_points` a lane).
+    assert!(counters.revalidations >= 2, "{counters:?}");
     assert_eq!(counters.revalidation_switches, [0, 0]);
     assert_eq!(counters.initialisations, [0, 0]);
 }
@@ -1192,6 +1195,59 @@ fn a_lane_change_hands_the_crossed_boundary_to_the_other_side() {
 }
 
 #[test]
+fn a_pair_whose_marks_left_its_windows_is_revalidated_on_that_frame() {
+    // The camera jumps 40 px right between two frames (a cut in the video, a jolt): both
+    // marks leave the tracking windows (±10 px). With `track.revalidate_below_points` the
+    // frame on which the windows come up empty is re-validated and the pair moves onto the
+    // marks at once; with the period alone the lanes coast at their old places until the next
+    // period's frame or until they are lost.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(cfg.track.revalidate_below_points > cfg.track.reinit_min_points);
+    assert!(cfg.track.revalidate_every_frames > 3);
+    assert!(cfg.track.window_half_width_px < 40);
+    let run = |cfg: &TrackerConfig| {
+        let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let (top, bottom) = tracker.roi;
+        for _ in 0..2 {
+            tracker
+                .track(&three_marks_shifted(320, 240, 0.0))
+                .expect("a frame");
+        }
+        let report = tracker
+            .track(&three_marks_shifted(320, 240, 40.0))
+            .expect("a frame");
+        let worst = [40.0, 200.0].map(|bottom_col| {
+            let k = usize::from(bottom_col > 160.0);
+            report.lanes[k].coeffs.map_or(f64::INFINITY, |c| {
+                (top..bottom)
+                    .map(|y| {
+                        let y = y as f64;
+                        let truth = mark_towards_vp(bottom_col, y);
+                        (Parabola::from_coeffs(c).col_at_row(y) - truth).abs()
+                    })
+                    .fold(0.0, f64::max)
+            })
+        });
+        (worst, *tracker.counters())
+    };
+    let (worst, counters) = run(&cfg);
+    assert!(
+        worst.iter().all(|&e| e < 3.0),
+        "{worst:?} px from the marks"
+    );
+    assert_eq!(counters.revalidations, 1);
+    assert_eq!(counters.revalidation_switches, [1, 1]);
+    let mut period_only = cfg;
+    period_only.track.revalidate_below_points = 0;
+    let (worst, counters) = run(&period_only);
+    assert!(
+        worst.iter().all(|&e| e > 20.0),
+        "{worst:?} px from the marks"
+    );
+    assert_eq!(counters.revalidations, 0);
+}
+
+#[test]
 fn a_tracked_lane_on_a_faint_line_competes_when_the_other_side_is_initialised_again() {
     // The right lane is lost while the left one sits on the faint line beside its mark: the
     // initialisation that looks for the right lane weighs the left one against the candidates
@@ -1240,6 +1296,7 @@ fn a_tracked_lane_on_a_faint_line_competes_when_the_other_side_is_initialised_ag
     );
     let mut locked = cfg;
     locked.track.revalidate_every_frames = 0;
+    locked.track.revalidate_below_points = 0;
     let ([_, left_on_line, _], counters) = run(&locked);
     assert!(
         left_on_line < 2.0,
