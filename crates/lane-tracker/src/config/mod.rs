@@ -365,8 +365,11 @@ pub struct TrackConfig {
     /// the period's next frame. A lane that slid onto clutter or whose mark left the window
     /// keeps few points for a few frames before it misses often enough to be lost; a lane on a
     /// solid mark fills its window (up to `max_points_per_lane`) and does not trigger it, a
-    /// dashed mark between two dashes may (a re-validation keeps a lane on its own mark). Points,
-    /// `0..=max_points_per_lane`; 0 (default when absent): the period only.
+    /// dashed mark between two dashes may (a re-validation keeps a lane on its own mark). In
+    /// any re-validation, a lane this weak that the choice gives nothing to on its side
+    /// (neither kept nor replaced) is dropped and its side searched for again on the same frame
+    /// (the second search over `roi.fallback_top_row_fraction`'s rows included). Points,
+    /// `0..=max_points_per_lane`; 0 (default when absent): the period only, and no lane dropped.
     #[serde(default)]
     pub revalidate_below_points: usize,
 }

@@ -456,6 +456,23 @@ impl LaneTracker {
                 }
             }
         }
+        // A weak lane (fewer than `track.revalidate_below_points` points on this frame) the
+        // choice gave nothing to on its side — neither kept nor replaced — is dropped: its side
+        // is searched for again on this frame (the second search over the taller rows
+        // included), as if it had been lost, instead of coasting on a prediction with nothing
+        // under it until it is. Only in the ROI's search, the one the second search follows.
+        if competes.contains(&true) && self.search_rows == self.roi {
+            let weak_below = self.cfg.track.revalidate_below_points;
+            for (lane, pick) in self.lanes.iter_mut().zip(picks) {
+                if pick.is_none()
+                    && lane.has_estimate()
+                    && !lane.initialised_now
+                    && lane.points_now < weak_below
+                {
+                    lane.drop_estimate();
+                }
+            }
+        }
     }
 
     /// Lane `from` becomes lane `to`: its filter, state and buffers move, each slot keeps its

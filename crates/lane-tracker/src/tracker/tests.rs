@@ -223,10 +223,15 @@ fn right_mark_above_the_roi(w: usize, h: usize) -> GreyFrame {
     right_dash_on_rows(w, h, 80.0..140.0)
 }
 fn right_dash_on_rows(w: usize, h: usize, rows: std::ops::Range<f64>) -> GreyFrame {
+    right_dash_shifted(w, h, rows, 0.0)
+}
+/// [`right_dash_on_rows`] with the right mark `shift_px` to the right of `right`.
+fn right_dash_shifted(w: usize, h: usize, rows: std::ops::Range<f64>, shift_px: f64) -> GreyFrame {
     let mut pixels = vec![60u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
-        if (x - left(y)).abs() < 2.5 || ((x - right(y)).abs() < 2.5 && rows.contains(&y)) {
+        let on_right = (x - right(y) - shift_px).abs() < 2.5 && rows.contains(&y);
+        if (x - left(y)).abs() < 2.5 || on_right {
             *p = 200;
         }
     }
@@ -275,6 +280,61 @@ fn a_side_missing_from_the_roi_is_found_by_the_second_search_over_the_taller_row
         .collect();
     assert_eq!(chosen.len(), 1, "{cands:?}");
     assert!(chosen[0] >= first_search, "{cands:?}");
+}
+
+#[test]
+fn a_weak_lane_the_revalidation_does_not_keep_is_searched_for_again_on_that_frame() {
+    // Both lanes tracked on their marks; then the right mark is gone from the ROI and a dash of
+    // another one, 30 px farther right, lies above it (a lane ending, a camera pitched up over
+    // a crest). The right window comes up empty, so the frame is re-validated
+    // (`track.revalidate_below_points`); the choice keeps the left lane and has nothing for the
+    // right one, which is dropped and searched for again on the same frame — found on the dash
+    // by the second search over the taller rows. With the period alone it coasts at its old
+    // place until it is lost.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(
+        cfg.roi
+            .fallback_top_row_fraction
+            .is_some_and(|f| f < 80.0 / 240.0)
+    );
+    let run = |cfg: &TrackerConfig| {
+        let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let (top, bottom) = tracker.roi;
+        let both = right_dash_on_rows(320, 240, 0.0..240.0);
+        for _ in 0..2 {
+            let report = tracker.track(&both).expect("a frame");
+            assert!(report.lanes.iter().all(|l| l.state == LaneState::Tracking));
+        }
+        let report = tracker
+            .track(&right_dash_shifted(320, 240, 80.0..140.0, 30.0))
+            .expect("a frame");
+        let left_off = report.lanes[0].coeffs.map_or(f64::INFINITY, |c| {
+            (top..bottom)
+                .map(|y| (Parabola::from_coeffs(c).col_at_row(y as f64) - left(y as f64)).abs())
+                .fold(0.0, f64::max)
+        });
+        let right_off = [80.0, 110.0, 139.0].map(|y| {
+            report.lanes[1]
+                .col_at_row(y)
+                .map_or(f64::INFINITY, |x| (x - right(y) - 30.0).abs())
+        });
+        (left_off, right_off, report.lanes[1], *tracker.counters())
+    };
+    let (left_off, right_off, r, counters) = run(&cfg);
+    assert!(left_off < 1.5, "left lane {left_off} px off its mark");
+    assert!(
+        right_off.iter().all(|&e| e < 1.5),
+        "right lane {right_off:?} px off the dash"
+    );
+    assert!(r.initialised && r.state == LaneState::Tracking, "{r:?}");
+    assert_eq!(counters.revalidations, 1);
+    assert_eq!(counters.initialisations, [1, 2]);
+    let mut period_only = cfg;
+    period_only.track.revalidate_below_points = 0;
+    let (_, right_off, r, counters) = run(&period_only);
+    assert!(right_off.iter().all(|&e| e > 20.0), "{right_off:?} px");
+    assert_eq!(r.state, LaneState::Coasting);
+    assert_eq!(counters.revalidations, 0);
 }
 
 /// The second search asks a lane for as many rows as the first one does (a quarter of the
