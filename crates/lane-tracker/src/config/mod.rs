@@ -366,7 +366,8 @@ pub struct TrackConfig {
     /// keeps few points for a few frames before it misses often enough to be lost; a lane on a
     /// solid mark fills its window (up to `max_points_per_lane`) and does not trigger it, a
     /// dashed mark between two dashes may (a re-validation keeps a lane on its own mark). In
-    /// any re-validation, a lane this weak that the choice gives nothing to on its side
+    /// any choice a tracked lane competes in (a re-validation, or the other side's
+    /// initialisation with re-validation on), a lane this weak that it gives nothing to on its side
     /// (neither kept nor replaced) is dropped and its side searched for again on the same frame
     /// (the second search over `roi.fallback_top_row_fraction`'s rows included). Points,
     /// `0..=max_points_per_lane`; 0 (default when absent): the period only, and no lane dropped.
