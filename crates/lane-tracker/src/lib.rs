@@ -95,8 +95,9 @@
 //!    an addition beyond the paper, joint initialisation only — every
 //!    `track.revalidate_every_frames`-th frame while both lanes are tracked, and at once on a
 //!    frame a tracked lane's window gave fewer than `track.revalidate_below_points` points — a
-//!    lane on clutter or whose mark left its window; such a weak lane the choice gives nothing
-//!    to is dropped and searched for again on the frame —, where the tracked
+//!    lane on clutter or whose mark left its window; such a weak lane the choice keeps nothing
+//!    of is set aside and searched for again on the frame, and put back if nothing is found
+//!    —, where the tracked
 //!    lanes compete with the candidates, each weighed by its own row coverage ×
 //!    `track.revalidate_keep_factor`, and a lane is replaced only by a candidate off its mark,
 //!    [`TrackerCounters::revalidations`]; with re-validation on, a lane tracked from earlier

@@ -347,9 +347,10 @@ pub struct TrackConfig {
     /// lanes are tracked, every this many frames the whole ROI goes through the joint
     /// initialisation and the tracked lanes compete with its candidates for the ego pair; a
     /// lane the choice replaces by a candidate on another mark is initialised there (and, with
-    /// it on, a tracked lane competes so too when the other side is initialised again). Frames,
-    /// 0..=100000; 0 (default when absent): never (the paper: a lane is re-initialised only
-    /// when lost).
+    /// re-validation on — this or `revalidate_below_points`, [`TrackConfig::revalidates`] — a
+    /// tracked lane competes so too when the other side is initialised again). Frames,
+    /// 0..=100000; 0 (default when absent): no period (with `revalidate_below_points` also 0,
+    /// never: the paper, a lane is re-initialised only when lost).
     #[serde(default)]
     pub revalidate_every_frames: u32,
     /// When a tracked lane competes with the candidates (a re-validation, or the other side's
@@ -361,16 +362,18 @@ pub struct TrackConfig {
     /// Re-validation on weak evidence (an addition beyond the paper; as
     /// `revalidate_every_frames`, joint initialisation with `init.candidate_coverage` only):
     /// while both lanes are tracked, a frame on which a tracked lane's window gave fewer
-    /// points than this (a miss included, `reinit_min_points`) is re-validated at once, not at
-    /// the period's next frame. A lane that slid onto clutter or whose mark left the window
-    /// keeps few points for a few frames before it misses often enough to be lost; a lane on a
-    /// solid mark fills its window (up to `max_points_per_lane`) and does not trigger it, a
-    /// dashed mark between two dashes may (a re-validation keeps a lane on its own mark). In
-    /// any choice a tracked lane competes in (a re-validation, or the other side's
-    /// initialisation with re-validation on), a lane this weak that it gives nothing to on its side
-    /// (neither kept nor replaced) is dropped and its side searched for again on the same frame
-    /// (the second search over `roi.fallback_top_row_fraction`'s rows included). Points,
-    /// `0..=max_points_per_lane`; 0 (default when absent): the period only, and no lane dropped.
+    /// points than this (a miss, a jump-gated or refused update counting 0) is re-validated at
+    /// once, not at the period's next frame. A lane that slid onto clutter or whose mark left
+    /// the window keeps few points for a few frames before it misses often enough to be lost;
+    /// a lane on a solid mark in a camera image fills its window (up to `max_points_per_lane`)
+    /// and does not trigger it, a dashed mark between two dashes may (a re-validation keeps a
+    /// lane on its own mark). In any choice a tracked lane competes in (a re-validation, or
+    /// the other side's initialisation with re-validation on), a lane this weak that the
+    /// choice keeps nothing of (neither kept nor replaced) is set aside and its side searched
+    /// for again on the same frame (the second search over
+    /// `roi.fallback_top_row_fraction`'s rows included); if nothing is found it is put back
+    /// as it was (it coasts through a short occlusion). Points, `0..=max_points_per_lane`;
+    /// 0 (default when absent): the period only.
     #[serde(default)]
     pub revalidate_below_points: usize,
 }
@@ -650,13 +653,7 @@ impl TrackerConfig {
             t.revalidate_every_frames <= 100_000,
             "track.revalidate_every_frames",
             t.revalidate_every_frames,
-            "must be in 0..=100000 frames (0: never)",
-        )?;
-        check(
-            t.revalidate_below_points <= t.max_points_per_lane,
-            "track.revalidate_below_points",
-            t.revalidate_below_points,
-            "must be in 0..=max_points_per_lane points (0: the period only)",
+            "must be in 0..=100000 frames (0: no period)",
         )?;
         check(
             t.revalidate_keep_factor >= 1.0 && t.revalidate_keep_factor.is_finite(),
@@ -681,6 +678,12 @@ impl TrackerConfig {
             "track.max_points_per_lane",
             t.max_points_per_lane,
             "must be in 3..=1000",
+        )?;
+        check(
+            t.revalidate_below_points <= t.max_points_per_lane,
+            "track.revalidate_below_points",
+            t.revalidate_below_points,
+            "must be in 0..=max_points_per_lane points (0: the period only)",
         )?;
         check(
             t.reinit_min_points >= 3 && t.reinit_min_points <= t.max_points_per_lane,

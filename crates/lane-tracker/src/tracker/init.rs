@@ -17,7 +17,7 @@ use vision_gradient::{
 use super::points::{NEAR_VERTICAL_SLOPE, fit_profile};
 use super::{
     Estimator, InitCandidate, Lane, LaneFilter, LaneState, LaneTracker, MAX_CANDIDATE_LINES,
-    Replaced,
+    Replaced, SetAside,
 };
 use crate::TrackerError;
 use crate::error::FilterFailure;
@@ -87,10 +87,34 @@ pub(super) fn extend_with_class(
 
 impl LaneTracker {
     /// Initialise the sides without an estimate in the ROI (or, both tracked, re-validate
-    /// them: `track.revalidate_every_frames`), then, with `roi.fallback_top_row_fraction`, a
-    /// side still without one over the taller rows (the side found first locked into the pair).
+    /// them: `track.revalidate_every_frames`, `track.revalidate_below_points`), then, with
+    /// `roi.fallback_top_row_fraction`, a side still without one over the taller rows (the side
+    /// found first locked into the pair). A weak lane the ROI's choice set aside
+    /// (`initialise_jointly`) is back as it was if neither search found its side, else it is
+    /// what the new lane replaced (a switch, which the crossing gate may undo).
     pub(super) fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
-        self.initialise_in_roi(image, [true, true])?;
+        let searched = self.search_both(image);
+        for i in 0..2 {
+            let lane = &mut self.lanes[i];
+            let Some(set_aside) = lane.set_aside.take() else {
+                continue;
+            };
+            if lane.has_estimate() {
+                lane.replaced = Some(set_aside.estimate);
+                self.counters.revalidation_switches[i] += 1;
+            } else {
+                lane.filter = Some(set_aside.estimate.filter);
+                lane.predicted = set_aside.predicted;
+                lane.state = set_aside.state;
+            }
+        }
+        searched
+    }
+
+    /// [`Self::initialise`]'s two searches: the ROI's (which may set weak lanes aside), then
+    /// the taller rows' for the sides still without a lane.
+    fn search_both(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
+        self.initialise_in_roi(image, [true, true], true)?;
         let Some(tall) = self.fallback_roi else {
             return Ok(());
         };
@@ -99,7 +123,7 @@ impl LaneTracker {
         }
         let without = [!self.lanes[0].has_estimate(), !self.lanes[1].has_estimate()];
         self.search_rows = tall;
-        let searched = self.initialise_in_roi(image, without);
+        let searched = self.initialise_in_roi(image, without, false);
         self.search_rows = self.roi;
         for (lane, was_without) in self.lanes.iter_mut().zip(without) {
             lane.found_in_fallback = was_without && lane.initialised_now;
@@ -108,11 +132,13 @@ impl LaneTracker {
     }
 
     /// Stages I–II over the rows `self.search_rows`; with the joint initialisation, the Hough
-    /// candidates of the bands `vote[k]` only.
+    /// candidates of the bands `vote[k]` only, and with `set_aside_weak` a weak lane the choice
+    /// gives nothing to set aside ([`Self::initialise_jointly`]).
     fn initialise_in_roi(
         &mut self,
         image: &GreyImage<'_>,
         vote: [bool; 2],
+        set_aside_weak: bool,
     ) -> Result<(), TrackerError> {
         let outward = self.outward_col();
         let (top, bottom) = self.search_rows;
@@ -141,7 +167,7 @@ impl LaneTracker {
             );
         }
         if self.cfg.init.candidate_lines > 0 {
-            self.initialise_jointly(vote);
+            self.initialise_jointly(vote, set_aside_weak);
             return Ok(());
         }
         for i in 0..2 {
@@ -236,12 +262,15 @@ impl LaneTracker {
     /// re-validation on), weighed by its own row coverage × `track.revalidate_keep_factor`, and
     /// is replaced only by a candidate off its mark, or handed over to the other side when the
     /// choice puts it there (a lane change); otherwise, and for a lane initialised on this
-    /// frame, it is locked into the pair.
+    /// frame, it is locked into the pair. With `set_aside_weak` (the ROI's search), a competing
+    /// lane with fewer than `track.revalidate_below_points` points on this frame that the
+    /// choice keeps nothing of is set aside (`Lane::set_aside`) for the searches to replace;
+    /// [`Self::initialise`] puts it back if they do not.
     ///
     /// `vote[k]`: whether band `k`'s pixels vote (the second search votes only in the bands of
     /// the sides still without a lane; a side's boundary leans into the other band only on a
     /// tight bend, where the ROI holds its near part).
-    fn initialise_jointly(&mut self, vote: [bool; 2]) {
+    fn initialise_jointly(&mut self, vote: [bool; 2], set_aside_weak: bool) {
         const MAX_LINES: usize = MAX_CANDIDATE_LINES;
         let none = HoughLine {
             rho_px: 0.0,
@@ -457,19 +486,34 @@ impl LaneTracker {
             }
         }
         // A weak lane (fewer than `track.revalidate_below_points` points on this frame) the
-        // choice gave nothing to on its side — neither kept nor replaced — is dropped: its side
-        // is searched for again on this frame (the second search over the taller rows
-        // included), as if it had been lost, instead of coasting on a prediction with nothing
-        // under it until it is. Only in the ROI's search, the one the second search follows.
-        if competes.contains(&true) && self.search_rows == self.roi {
+        // choice kept nothing of — no pick on its mark or chord, and no candidate installed in
+        // its place — is set aside: its side is searched for again on this frame (the second
+        // search over the taller rows included), as for a lost lane, and `initialise` puts it
+        // back as it was if nothing is found (a short occlusion still coasts). Before, it
+        // coasted on a prediction with nothing under it until its third miss. `owners` is by
+        // side, so it holds after a hand-over too.
+        if set_aside_weak && competes.contains(&true) {
             let weak_below = self.cfg.track.revalidate_below_points;
-            for (lane, pick) in self.lanes.iter_mut().zip(picks) {
-                if pick.is_none()
-                    && lane.has_estimate()
-                    && !lane.initialised_now
-                    && lane.points_now < weak_below
+            for (lane, owner) in self.lanes.iter_mut().zip(owners) {
+                if owner.is_some()
+                    || lane.initialised_now
+                    || !lane.has_estimate()
+                    || lane.points_now >= weak_below
                 {
-                    lane.drop_estimate();
+                    continue;
+                }
+                if let Some(filter) = lane.filter.take() {
+                    lane.set_aside = Some(SetAside {
+                        estimate: Replaced {
+                            filter,
+                            kerb_offset_px: lane.kerb_offset_px,
+                            kerb_misses: lane.kerb_misses,
+                            pair_half_gap_px: lane.pair_half_gap_px,
+                        },
+                        predicted: lane.predicted.take(),
+                        state: lane.state,
+                    });
+                    lane.state = LaneState::Lost;
                 }
             }
         }

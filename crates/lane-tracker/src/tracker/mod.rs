@@ -123,12 +123,14 @@ pub struct TrackerCounters {
     /// Frames on which the tracked pair had lost an ego lane's shape and both lanes were
     /// initialised again (the pair gate; joint initialisation only).
     pub gated_pairs: u64,
-    /// Re-validations (`track.revalidate_every_frames`): frames on which the tracked pair was
-    /// weighed against a fresh initialisation's candidates.
+    /// Re-validations (`track.revalidate_every_frames`, `track.revalidate_below_points`):
+    /// frames on which the tracked pair was weighed against a fresh initialisation's
+    /// candidates.
     pub revalidations: u64,
     /// Tracked lanes the joint choice replaced by a candidate off their mark (with
     /// re-validation on: in a re-validation, or when the other side was initialised again),
-    /// per lane.
+    /// or a weak lane it set aside replaced by the frame's searches
+    /// (`track.revalidate_below_points`), per lane.
     pub revalidation_switches: [u64; 2],
     /// Lane changes: a tracked boundary the joint initialisation or a re-validation put on the
     /// other side of the pair (the camera crossed it), handed over to that side.
@@ -208,6 +210,19 @@ struct Lane {
     /// The tracked lane a switch replaced on this frame (the lane is `initialised_now`),
     /// restored if the crossing gate undoes the switch; `None` otherwise.
     replaced: Option<Replaced>,
+    /// A weak lane the joint choice gave nothing to on this frame, set aside while its side is
+    /// searched for again (`track.revalidate_below_points`); `None` otherwise and after the
+    /// initialisation.
+    set_aside: Option<SetAside>,
+}
+
+/// A weak tracked lane set aside by the joint choice: back as it was if the searches of the
+/// frame find nothing on its side, else what the new lane replaced.
+#[derive(Debug, Clone)]
+struct SetAside {
+    estimate: Replaced,
+    predicted: Option<LaneFilter>,
+    state: LaneState,
 }
 
 /// What a switch to another candidate replaced: the tracked estimate and the offsets read for
@@ -416,6 +431,7 @@ impl LaneTracker {
             updated_now: false,
             fresh: false,
             replaced: None,
+            set_aside: None,
         };
         let lanes = [
             make_lane(Side::Left, EdgeClass::LeftLane, left_band),
@@ -609,6 +625,7 @@ impl LaneTracker {
             lane.updated_now = false;
             lane.points_now = 0;
             lane.replaced = None;
+            lane.set_aside = None;
             if lane.has_estimate() {
                 self.track_lane(i, &image, true)?;
             } else {

@@ -329,12 +329,49 @@ fn a_weak_lane_the_revalidation_does_not_keep_is_searched_for_again_on_that_fram
     assert!(r.initialised && r.state == LaneState::Tracking, "{r:?}");
     assert_eq!(counters.revalidations, 1);
     assert_eq!(counters.initialisations, [1, 2]);
+    assert_eq!(counters.revalidation_switches, [0, 1]);
     let mut period_only = cfg;
     period_only.track.revalidate_below_points = 0;
     let (_, right_off, r, counters) = run(&period_only);
     assert!(right_off.iter().all(|&e| e > 20.0), "{right_off:?} px");
     assert_eq!(r.state, LaneState::Coasting);
     assert_eq!(counters.revalidations, 0);
+}
+
+#[test]
+fn a_weak_lane_set_aside_coasts_on_when_nothing_replaces_it() {
+    // Both lanes tracked; for one frame the right mark is gone everywhere (a car over it, a
+    // glare). The right window comes up empty, the frame is re-validated and the right lane
+    // set aside, but neither search finds a right boundary: the lane is put back and coasts
+    // on its prediction, then tracks the mark again when it returns — no re-initialisation.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(cfg.track.lost_after_frames > 1);
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let both = right_dash_on_rows(320, 240, 0.0..240.0);
+    let mut before = None;
+    for _ in 0..3 {
+        before = tracker.track(&both).expect("a frame").lanes[1].coeffs;
+    }
+    let before = before.expect("a right lane");
+    let report = tracker
+        .track(&right_dash_on_rows(320, 240, 0.0..0.0))
+        .expect("a frame");
+    let r = report.lanes[1];
+    assert_eq!(r.state, LaneState::Coasting, "{r:?}");
+    let coasting = r.coeffs.expect("the right lane, coasting");
+    let (top, bottom) = tracker.roi;
+    for y in [top, bottom - 1] {
+        let y = y as f64;
+        let moved = Parabola::from_coeffs(coasting).col_at_row(y)
+            - Parabola::from_coeffs(before).col_at_row(y);
+        assert!(moved.abs() < 0.5, "row {y}: moved {moved} px");
+    }
+    let counters = *tracker.counters();
+    assert_eq!(counters.revalidations, 1);
+    assert_eq!(counters.revalidation_switches, [0, 0]);
+    let report = tracker.track(&both).expect("a frame");
+    assert!(report.lanes.iter().all(|l| l.state == LaneState::Tracking));
+    assert_eq!(tracker.counters().initialisations, [1, 1]);
 }
 
 /// The second search asks a lane for as many rows as the first one does (a quarter of the
@@ -1121,10 +1158,11 @@ fn a_tracked_pair_as_wide_at_the_top_as_a_camera_looking_down_sees_it_is_kept() 
     }
     let counters = tracker.counters();
     assert_eq!(counters.gated_pairs, 0);
-    // At least the period's two; also every frame the weak-evidence trigger fires on (these
-    // noise-free marks near the vertical give edge pixels only where their rasterisation
-    // steps, fewer than `revalidate_below_points` a lane).
-    assert!(counters.revalidations >= 2, "{counters:?}");
+    // Every frame: these noise-free marks near the vertical give edge pixels only where their
+    // rasterisation steps, 20 a lane, fewer than `revalidate_below_points` (the weak-evidence
+    // trigger), and the pair is kept each time.
+    assert!(cfg.track.revalidate_below_points > 20);
+    assert_eq!(counters.revalidations, u64::from(frames), "{counters:?}");
     assert_eq!(counters.revalidation_switches, [0, 0]);
     assert_eq!(counters.initialisations, [0, 0]);
 }
@@ -1184,6 +1222,7 @@ fn a_lane_left_on_a_faint_line_is_moved_to_the_mark_by_the_next_revalidation() {
     // Without re-validation the lane stays on the faint line: it keeps enough points.
     let mut never = cfg;
     never.track.revalidate_every_frames = 0;
+    never.track.revalidate_below_points = 0;
     let (on_line, counters) = left_after(&never, 3 * every, &faint_line);
     assert!(on_line < 2.0, "without: {on_line} px from the faint line");
     assert_eq!(counters.revalidations, 0);
@@ -1264,10 +1303,13 @@ fn a_pair_whose_marks_left_its_windows_is_revalidated_on_that_frame() {
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     assert!(cfg.track.revalidate_below_points > cfg.track.reinit_min_points);
     assert!(cfg.track.revalidate_every_frames > 3);
-    assert!(cfg.track.window_half_width_px < 40);
     let run = |cfg: &TrackerConfig| {
         let mut tracker = LaneTracker::new(cfg, Estimator::Kif, 320, 240).expect("a tracker");
         let (top, bottom) = tracker.roi;
+        // The marks move least at the ROI's top row (they meet at row 100): beyond the window
+        // and the marks' half-width there too.
+        let shift_at_top = mark_towards_vp(40.0, top as f64) - mark_towards_vp(0.0, top as f64);
+        assert!((cfg.track.window_half_width_px as f64) + 2.5 < shift_at_top);
         for _ in 0..2 {
             tracker
                 .track(&three_marks_shifted(320, 240, 0.0))
