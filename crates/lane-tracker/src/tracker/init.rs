@@ -17,7 +17,6 @@ use vision_gradient::{
 use super::points::{NEAR_VERTICAL_SLOPE, fit_profile};
 use super::{
     Estimator, InitCandidate, Lane, LaneFilter, LaneState, LaneTracker, MAX_CANDIDATE_LINES,
-    Replaced, SetAside,
 };
 use crate::TrackerError;
 use crate::error::FilterFailure;
@@ -100,12 +99,10 @@ impl LaneTracker {
                 continue;
             };
             if lane.has_estimate() {
-                lane.replaced = Some(set_aside.estimate);
+                lane.replaced = Some(set_aside);
                 self.counters.revalidation_switches[i] += 1;
             } else {
-                lane.filter = Some(set_aside.estimate.filter);
-                lane.predicted = set_aside.predicted;
-                lane.state = set_aside.state;
+                lane.restore(set_aside);
             }
         }
         searched
@@ -473,12 +470,7 @@ impl LaneTracker {
                     .filter
                     .clone()
                     .filter(|_| replaced)
-                    .map(|filter| Replaced {
-                        filter,
-                        kerb_offset_px: lane.kerb_offset_px,
-                        kerb_misses: lane.kerb_misses,
-                        pair_half_gap_px: lane.pair_half_gap_px,
-                    });
+                    .map(|filter| lane.estimate_with(filter));
                 if self.install(i, &init) && replaced {
                     self.lanes[i].replaced = before;
                     self.counters.revalidation_switches[i] += 1;
@@ -503,16 +495,8 @@ impl LaneTracker {
                     continue;
                 }
                 if let Some(filter) = lane.filter.take() {
-                    lane.set_aside = Some(SetAside {
-                        estimate: Replaced {
-                            filter,
-                            kerb_offset_px: lane.kerb_offset_px,
-                            kerb_misses: lane.kerb_misses,
-                            pair_half_gap_px: lane.pair_half_gap_px,
-                        },
-                        predicted: lane.predicted.take(),
-                        state: lane.state,
-                    });
+                    lane.set_aside = Some(lane.estimate_with(filter));
+                    lane.predicted = None;
                     lane.state = LaneState::Lost;
                 }
             }
@@ -533,6 +517,8 @@ impl LaneTracker {
         std::mem::swap(&mut a.side, &mut b.side);
         std::mem::swap(&mut a.class, &mut b.class);
         std::mem::swap(&mut a.band, &mut b.band);
+        // A lane set aside on this frame stays with its side: the searches replace it there.
+        std::mem::swap(&mut a.set_aside, &mut b.set_aside);
         for lane in &mut self.lanes {
             lane.kerb_offset_px = [0.0; 2];
             lane.kerb_misses = 0;

@@ -210,32 +210,55 @@ struct Lane {
     /// The tracked lane a switch replaced on this frame (the lane is `initialised_now`),
     /// restored if the crossing gate undoes the switch; `None` otherwise.
     replaced: Option<Replaced>,
-    /// A weak lane the joint choice gave nothing to on this frame, set aside while its side is
-    /// searched for again (`track.revalidate_below_points`); `None` otherwise and after the
-    /// initialisation.
-    set_aside: Option<SetAside>,
+    /// A weak lane the ROI's joint choice kept nothing of on this frame, set aside while its
+    /// side is searched for again (`track.revalidate_below_points`); tied to its side (not
+    /// moved by a hand-over); `None` otherwise and after the initialisation.
+    set_aside: Option<Replaced>,
 }
 
-/// A weak tracked lane set aside by the joint choice: back as it was if the searches of the
-/// frame find nothing on its side, else what the new lane replaced.
-#[derive(Debug, Clone)]
-struct SetAside {
-    estimate: Replaced,
-    predicted: Option<LaneFilter>,
-    state: LaneState,
-}
-
-/// What a switch to another candidate replaced: the tracked estimate and the offsets read for
-/// it (a kerb's foot, a double line's gap).
+/// A tracked estimate taken out of its lane on this frame — replaced by a switch to another
+/// candidate, or set aside — with what it carried: filter, prediction, state, misses and the
+/// offsets read for it (a kerb's foot, a double line's gap). [`Lane::restore`] puts it back.
 #[derive(Debug, Clone)]
 struct Replaced {
     filter: LaneFilter,
+    predicted: Option<LaneFilter>,
+    state: LaneState,
+    misses: u32,
     kerb_offset_px: [f64; 2],
     kerb_misses: u32,
     pair_half_gap_px: f64,
 }
 
 impl Lane {
+    /// The lane's estimate as a [`Replaced`], its filter `filter` (the lane's own, taken or
+    /// cloned by the caller).
+    fn estimate_with(&self, filter: LaneFilter) -> Replaced {
+        Replaced {
+            filter,
+            predicted: self.predicted.clone(),
+            state: self.state,
+            misses: self.misses,
+            kerb_offset_px: self.kerb_offset_px,
+            kerb_misses: self.kerb_misses,
+            pair_half_gap_px: self.pair_half_gap_px,
+        }
+    }
+
+    /// Puts back an estimate taken out on this frame ([`Replaced`]): not initialised on this
+    /// frame, no points counted for it.
+    fn restore(&mut self, before: Replaced) {
+        self.filter = Some(before.filter);
+        self.predicted = before.predicted;
+        self.state = before.state;
+        self.misses = before.misses;
+        self.kerb_offset_px = before.kerb_offset_px;
+        self.kerb_misses = before.kerb_misses;
+        self.pair_half_gap_px = before.pair_half_gap_px;
+        self.initialised_now = false;
+        self.points_now = 0;
+    }
+
     /// No estimate any more (lost: initialised again), and no windows or points to draw.
     fn drop_estimate(&mut self) {
         self.filter = None;

@@ -288,8 +288,8 @@ fn a_weak_lane_the_revalidation_does_not_keep_is_searched_for_again_on_that_fram
     // another one, 30 px farther right, lies above it (a lane ending, a camera pitched up over
     // a crest). The right window comes up empty, so the frame is re-validated
     // (`track.revalidate_below_points`); the choice keeps the left lane and has nothing for the
-    // right one, which is dropped and searched for again on the same frame — found on the dash
-    // by the second search over the taller rows. With the period alone it coasts at its old
+    // right one, which is set aside while the second search looks for its side over the taller
+    // rows on the same frame — and finds the dash. With the period alone it coasts at its old
     // place until it is lost.
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     assert!(
@@ -344,6 +344,9 @@ fn a_weak_lane_set_aside_coasts_on_when_nothing_replaces_it() {
     // glare). The right window comes up empty, the frame is re-validated and the right lane
     // set aside, but neither search finds a right boundary: the lane is put back and coasts
     // on its prediction, then tracks the mark again when it returns — no re-initialisation.
+    // (That the set-aside lane is searched for is
+    // `a_weak_lane_the_revalidation_does_not_keep_is_searched_for_again_on_that_frame`; this
+    // one fails if the lane is not put back: it is then lost.)
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     assert!(cfg.track.lost_after_frames > 1);
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
@@ -1158,11 +1161,10 @@ fn a_tracked_pair_as_wide_at_the_top_as_a_camera_looking_down_sees_it_is_kept() 
     }
     let counters = tracker.counters();
     assert_eq!(counters.gated_pairs, 0);
-    // Every frame: these noise-free marks near the vertical give edge pixels only where their
-    // rasterisation steps, 20 a lane, fewer than `revalidate_below_points` (the weak-evidence
-    // trigger), and the pair is kept each time.
-    assert!(cfg.track.revalidate_below_points > 20);
-    assert_eq!(counters.revalidations, u64::from(frames), "{counters:?}");
+    // At least the period's two (these noise-free marks near the vertical give edge pixels
+    // only where their rasterisation steps, fewer than `revalidate_below_points`, so the
+    // weak-evidence trigger adds more); the pair is kept each time.
+    assert!(counters.revalidations >= 2, "{counters:?}");
     assert_eq!(counters.revalidation_switches, [0, 0]);
     assert_eq!(counters.initialisations, [0, 0]);
 }
@@ -1425,8 +1427,12 @@ fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
     tracker.lanes[0].filter = Some(tracker.new_filter(&crossing).expect("a filter"));
     tracker.lanes[0].initialised_now = true;
     tracker.lanes[0].kerb_offset_px = [0.0; 2];
+    // The replaced lane had missed this frame (a weak lane set aside, or a switched one).
     tracker.lanes[0].replaced = Some(Replaced {
         filter: tracked.clone(),
+        predicted: Some(tracked.clone()),
+        state: LaneState::Coasting,
+        misses: 1,
         kerb_offset_px: [1.5, 0.0],
         kerb_misses: 0,
         pair_half_gap_px: 0.0,
@@ -1440,7 +1446,9 @@ fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
     for y in [yt, yb] {
         assert!((restored.col_at_row(y) - tracked.col_at_row(y)).abs() < 1e-9);
     }
-    assert_eq!(lane.state, LaneState::Tracking);
+    // As it was: coasting, one miss counted towards `lost_after_frames`.
+    assert_eq!(lane.state, LaneState::Coasting);
+    assert_eq!(lane.misses, 1);
     assert_eq!(lane.kerb_offset_px, [1.5, 0.0]);
     assert!(!lane.initialised_now && lane.replaced.is_none());
     let after = tracker.counters();

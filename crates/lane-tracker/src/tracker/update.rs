@@ -208,15 +208,10 @@ impl LaneTracker {
         self.counters.gated_crossings[victim] += 1;
         let lane = &mut self.lanes[victim];
         if let Some(before) = lane.replaced.take() {
-            // A switch to another candidate (re-validation): the tracked lane it replaced comes
-            // back as it was after this frame's update.
-            lane.initialised_now = false;
-            lane.filter = Some(before.filter);
-            lane.kerb_offset_px = before.kerb_offset_px;
-            lane.kerb_misses = before.kerb_misses;
-            lane.pair_half_gap_px = before.pair_half_gap_px;
-            lane.state = LaneState::Tracking;
-            lane.points_now = 0;
+            // A switch to another candidate (re-validation), or a lane set aside and replaced
+            // by the frame's searches: the tracked lane comes back as it was after this frame's
+            // update (or miss).
+            lane.restore(before);
             let c = &mut self.counters;
             c.initialisations[victim] = c.initialisations[victim].saturating_sub(1);
             c.revalidation_switches[victim] = c.revalidation_switches[victim].saturating_sub(1);
