@@ -3,9 +3,10 @@
 //!
 //! Synthetic sequences (ground truth): mean and worst per-frame lateral error at fixed rows, a
 //! TuSimple-style accuracy (correct within 20 px at 1280 px width, scaled to the frame width),
-//! frames to regain a lane after it reappears, initialisation count. Real sequences (no labels):
-//! frames with both lanes reported, median and worst bottom-row change frame to frame,
-//! initialisation count. A regression beyond the tolerances below fails the command.
+//! frames to regain a lane after it reappears, initialisation count. Real sequences (no labels;
+//! the udacity clip with the outdoor preset, and with the default configuration plain and with
+//! occlusions laid over some frames): frames with both lanes reported, median and worst
+//! bottom-row change frame to frame, initialisation count. A regression beyond the tolerances below fails the command.
 //! `--record` writes the current figures as the new expectations.
 
 use std::collections::BTreeMap;
@@ -16,6 +17,7 @@ use anyhow::{Context, Result, bail};
 use lane_eval::eval::{ContinuityScore, SequenceScore, continuity, run_tracker, score_sequence};
 use lane_eval::synth::{SCENES, SceneSource, SequenceTruth};
 use lane_io::y4m::Y4mSource;
+use lane_io::{FrameMeta, FrameSource, LaneIoError};
 use lane_tracker::{Estimator, TrackerConfig};
 
 use crate::paths::workspace_root;
@@ -61,14 +63,112 @@ fn read_text(path: &Path) -> Result<Option<String>> {
     })?))
 }
 
+/// One real (unlabelled) sequence of the regression: a clip, how many of its frames, the
+/// configuration, and the occlusions laid over it.
+struct RealSequence {
+    name: &'static str,
+    clip: PathBuf,
+    max_frames: Option<u64>,
+    config: fn() -> Result<TrackerConfig, lane_tracker::TrackerError>,
+    occlusions: &'static [Occlusion],
+}
+
+/// Frames `frames` painted a uniform grey over rows `[top, 1)·H` and columns `[left, 1)·W`
+/// (fractions of the frame): a glare or a blank frame (the whole frame), a car over the right
+/// lane (the right half of the lower rows).
+struct Occlusion {
+    frames: std::ops::Range<u64>,
+    top_frac: f64,
+    left_frac: f64,
+}
+
+/// The grey an occlusion paints (the udacity clip's road is darker, its sky brighter).
+const OCCLUSION_GREY: u8 = 90;
+
+/// The udacity clip with the default configuration and two occlusions: frames 100–101 blank,
+/// frame 150's right half blank below 62 % of the height (the ROI). Both lanes must coast
+/// through them and track again without a new initialisation.
+const UDACITY_OCCLUSIONS: &[Occlusion] = &[
+    Occlusion {
+        frames: 100..102,
+        top_frac: 0.0,
+        left_frac: 0.0,
+    },
+    Occlusion {
+        frames: 150..151,
+        top_frac: 0.62,
+        left_frac: 0.5,
+    },
+];
+
+/// A frame source with [`Occlusion`]s laid over another one's frames.
+struct Occluded<'a, S> {
+    inner: S,
+    occlusions: &'a [Occlusion],
+}
+
+impl<S: FrameSource> FrameSource for Occluded<'_, S> {
+    fn next_frame(
+        &mut self,
+        frame: &mut lane_tracker::GreyFrame,
+    ) -> Result<Option<FrameMeta>, LaneIoError> {
+        let meta = self.inner.next_frame(frame)?;
+        if let Some(m) = &meta {
+            let (w, h) = (frame.width(), frame.height());
+            for o in self
+                .occlusions
+                .iter()
+                .filter(|o| o.frames.contains(&m.index))
+            {
+                let (top, left) = (
+                    (o.top_frac * h as f64) as usize,
+                    (o.left_frac * w as f64) as usize,
+                );
+                for row in frame.data_mut().chunks_mut(w).skip(top) {
+                    row[left.min(w)..].fill(OCCLUSION_GREY);
+                }
+            }
+        }
+        Ok(meta)
+    }
+
+    fn describe(&self) -> String {
+        format!("{} (occluded)", self.inner.describe())
+    }
+
+    fn frame_rate_hz(&self) -> Option<f64> {
+        self.inner.frame_rate_hz()
+    }
+}
+
 /// Real (unlabelled) sequences, read from the data root (`lane_eval::data`: `../shared/data`
 /// beside the checkout, or `$ITA_NAV_DATA`; third-party, never in the repository): the udacity
-/// clip's first 30 frames and all 221. A missing clip is an error naming it.
-fn real_sequences() -> Result<Vec<(String, PathBuf, Option<u64>)>> {
+/// clip's first 30 frames and all 221 with the outdoor preset, all 221 with the default
+/// configuration, plain and with [`UDACITY_OCCLUSIONS`]. A missing clip is an error naming it.
+fn real_sequences() -> Result<Vec<RealSequence>> {
     let clip = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP)?;
+    let seq = |name, max_frames, config, occlusions| RealSequence {
+        name,
+        clip: clip.clone(),
+        max_frames,
+        config,
+        occlusions,
+    };
     Ok(vec![
-        ("udacity_first30".to_owned(), clip.clone(), Some(30)),
-        ("udacity_full221".to_owned(), clip, None),
+        seq("udacity_first30", Some(30), TrackerConfig::outdoor, &[]),
+        seq("udacity_full221", None, TrackerConfig::outdoor, &[]),
+        seq(
+            "udacity_full221_default",
+            None,
+            TrackerConfig::default_preset,
+            &[],
+        ),
+        seq(
+            "udacity_occluded_default",
+            None,
+            TrackerConfig::default_preset,
+            UDACITY_OCCLUSIONS,
+        ),
     ])
 }
 
@@ -131,10 +231,14 @@ pub fn run(args: RegressArgs) -> Result<()> {
         "{:22} {:>8} {:>8} {:>8} {:>10} {:>8} {:>5}  acceptance",
         "real sequence", "frames", "both tr", "both rep", "median Δx", "max Δx", "inits"
     );
-    for (name, path, max_frames) in real_sequences()? {
-        let cfg = TrackerConfig::outdoor()?;
-        let mut source = open_y4m(&path)?;
-        let outcome = run_tracker(&mut source, &cfg, estimator, max_frames)?;
+    for seq in real_sequences()? {
+        let name = seq.name.to_owned();
+        let cfg = (seq.config)()?;
+        let mut source = Occluded {
+            inner: open_y4m(&seq.clip)?,
+            occlusions: seq.occlusions,
+        };
+        let outcome = run_tracker(&mut source, &cfg, estimator, seq.max_frames)?;
         let c = continuity(&outcome.reports, 239.0);
         let accept = c.frames_both_reported == c.frames
             && c.median_bottom_change_px <= ACCEPT_MEDIAN_CHANGE_PX;

@@ -368,11 +368,13 @@ pub struct TrackConfig {
     /// a lane on a solid mark in a camera image fills its window (up to `max_points_per_lane`)
     /// and does not trigger it, a dashed mark between two dashes may (a re-validation keeps a
     /// lane on its own mark). In the ROI's choice a tracked lane competes in (a re-validation,
-    /// or the other side's initialisation with re-validation on), a lane this weak that the
-    /// choice keeps nothing of (neither kept nor replaced) is set aside while the second
-    /// search (over `roi.fallback_top_row_fraction`'s rows) looks for its side on the same
-    /// frame; if that finds nothing (or there is no second search) it is put back as it was,
-    /// so it coasts through a short occlusion. Points, `0..=max_points_per_lane`; 0 (default
+    /// or the other side's initialisation with re-validation on), a lane this weak on this
+    /// frame and the one before that the choice keeps nothing of (neither kept nor replaced)
+    /// is set aside while the second search (over `roi.fallback_top_row_fraction`'s rows)
+    /// looks for its side on the same frame; if that finds nothing (or there is no second
+    /// search) it is put back as it was. A lane weak on one frame only (a dropout, a car over
+    /// it) coasts, as it did: the second search would initialise it from the far field above
+    /// the occlusion. Points, `0..=max_points_per_lane`; 0 (default
     /// when absent): the period only.
     #[serde(default)]
     pub revalidate_below_points: usize,

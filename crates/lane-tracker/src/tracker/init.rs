@@ -260,8 +260,9 @@ impl LaneTracker {
     /// is replaced only by a candidate off its mark, or handed over to the other side when the
     /// choice puts it there (a lane change); otherwise, and for a lane initialised on this
     /// frame, it is locked into the pair. With `set_aside_weak` (the ROI's search), a competing
-    /// lane with fewer than `track.revalidate_below_points` points on this frame that the
-    /// choice keeps nothing of is set aside (`Lane::set_aside`) for the searches to replace;
+    /// lane with fewer than `track.revalidate_below_points` points on this frame and the one
+    /// before that the choice keeps nothing of is set aside (`Lane::set_aside`) for the second
+    /// search to replace;
     /// [`Self::initialise`] puts it back if they do not.
     ///
     /// `vote[k]`: whether band `k`'s pixels vote (the second search votes only in the bands of
@@ -477,13 +478,14 @@ impl LaneTracker {
                 }
             }
         }
-        // A weak lane (fewer than `track.revalidate_below_points` points on this frame) the
-        // choice kept nothing of — no pick on its mark or chord, and no candidate installed in
-        // its place — is set aside: its side is searched for again on this frame (the second
-        // search over the taller rows included), as for a lost lane, and `initialise` puts it
-        // back as it was if nothing is found (a short occlusion still coasts). Before, it
-        // coasted on a prediction with nothing under it until its third miss. `owners` is by
-        // side, so it holds after a hand-over too.
+        // A lane weak on this frame and the one before (fewer than
+        // `track.revalidate_below_points` points on each) that the choice kept nothing of — no
+        // pick on its mark or chord, and no candidate installed in its place — is set aside:
+        // the second search looks for its side on this frame, as for a lost lane, and
+        // `initialise` puts it back as it was if nothing is found. A lane weak on one frame
+        // only (a dropout, a car passing over it) coasts as before: the second search would
+        // initialise it from the far field above the occlusion. `owners` is by side, so it
+        // holds after a hand-over too.
         if set_aside_weak && competes.contains(&true) {
             let weak_below = self.cfg.track.revalidate_below_points;
             for (lane, owner) in self.lanes.iter_mut().zip(owners) {
@@ -491,6 +493,7 @@ impl LaneTracker {
                     || lane.initialised_now
                     || !lane.has_estimate()
                     || lane.points_now >= weak_below
+                    || lane.points_before >= weak_below
                 {
                     continue;
                 }

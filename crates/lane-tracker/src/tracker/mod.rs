@@ -188,6 +188,9 @@ struct Lane {
     /// Rows and weights of the points behind the last update or initialisation.
     fit: FitRows,
     points_now: usize,
+    /// `points_now` of the frame before (a weak lane is set aside only when weak on two frames
+    /// in a row, `track.revalidate_below_points`).
+    points_before: usize,
     initialised_now: bool,
     /// Initialised on this frame by the second search (`roi.fallback_top_row_fraction`): its
     /// refinement runs over the taller rows.
@@ -446,6 +449,7 @@ impl LaneTracker {
             rows: [0.0, 0.0],
             fit: FitRows::uniform(0.0, 0.0),
             points_now: 0,
+            points_before: 0,
             initialised_now: false,
             found_in_fallback: false,
             kerb_offset_px: [0.0; 2],
@@ -646,6 +650,7 @@ impl LaneTracker {
             lane.initialised_now = false;
             lane.found_in_fallback = false;
             lane.updated_now = false;
+            lane.points_before = lane.points_now;
             lane.points_now = 0;
             lane.replaced = None;
             lane.set_aside = None;
