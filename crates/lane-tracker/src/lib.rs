@@ -97,7 +97,8 @@
 //!    frame a tracked lane's window gave fewer than `track.revalidate_below_points` points — a
 //!    lane on clutter or whose mark left its window; a lane that weak on two frames in a row
 //!    that the choice keeps nothing of is set aside while the second search looks for its
-//!    side, and put back if it finds nothing —, where the tracked lanes compete with the candidates, each weighed by its own row coverage ×
+//!    side, and put back if it finds nothing —, where the tracked lanes compete with the
+//!    candidates, each weighed by its own row coverage ×
 //!    `track.revalidate_keep_factor`, and a lane is replaced only by a candidate off its mark,
 //!    [`TrackerCounters::revalidations`]; with re-validation on, a lane tracked from earlier
 //!    frames competes so too when the other side is initialised again, instead of being locked

@@ -372,9 +372,10 @@ pub struct TrackConfig {
     /// frame and the one before that the choice keeps nothing of (neither kept nor replaced)
     /// is set aside while the second search (over `roi.fallback_top_row_fraction`'s rows)
     /// looks for its side on the same frame; if that finds nothing (or there is no second
-    /// search) it is put back as it was. A lane weak on one frame only (a dropout, a car over
-    /// it) coasts, as it did: the second search would initialise it from the far field above
-    /// the occlusion. Points, `0..=max_points_per_lane`; 0 (default
+    /// search) it is put back as it was. A lane weak on one frame only (a dropout) coasts, as
+    /// it did: the second search would initialise it from the far field above an occlusion of
+    /// the ROI; a longer occlusion is searched for from its second frame (a lost lane's
+    /// initialisation, from its third). Points, `0..=max_points_per_lane`; 0 (default
     /// when absent): the period only.
     #[serde(default)]
     pub revalidate_below_points: usize,

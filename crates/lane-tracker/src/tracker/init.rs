@@ -89,8 +89,9 @@ impl LaneTracker {
     /// them: `track.revalidate_every_frames`, `track.revalidate_below_points`), then, with
     /// `roi.fallback_top_row_fraction`, a side still without one over the taller rows (the side
     /// found first locked into the pair). A weak lane the ROI's choice set aside
-    /// (`initialise_jointly`) is back as it was if neither search found its side, else it is
-    /// what the new lane replaced (a switch, which the crossing gate may undo).
+    /// (`initialise_jointly`) is back as it was if the second search did not find its side
+    /// (or there is none), else it is what the new lane replaced (a switch, which the crossing
+    /// gate may undo).
     pub(super) fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
         let searched = self.search_both(image);
         for i in 0..2 {
@@ -263,7 +264,7 @@ impl LaneTracker {
     /// lane with fewer than `track.revalidate_below_points` points on this frame and the one
     /// before that the choice keeps nothing of is set aside (`Lane::set_aside`) for the second
     /// search to replace;
-    /// [`Self::initialise`] puts it back if they do not.
+    /// [`Self::initialise`] puts it back if it does not.
     ///
     /// `vote[k]`: whether band `k`'s pixels vote (the second search votes only in the bands of
     /// the sides still without a lane; a side's boundary leans into the other band only on a
@@ -483,8 +484,9 @@ impl LaneTracker {
         // pick on its mark or chord, and no candidate installed in its place — is set aside:
         // the second search looks for its side on this frame, as for a lost lane, and
         // `initialise` puts it back as it was if nothing is found. A lane weak on one frame
-        // only (a dropout, a car passing over it) coasts as before: the second search would
-        // initialise it from the far field above the occlusion. `owners` is by side, so it
+        // only (a dropout) coasts as before: the second search would initialise it from the
+        // far field above an occlusion of the ROI. A longer occlusion is searched for from its
+        // second frame (a lost lane's initialisation would from its third). `owners` is by side, so it
         // holds after a hand-over too.
         if set_aside_weak && competes.contains(&true) {
             let weak_below = self.cfg.track.revalidate_below_points;
