@@ -472,7 +472,7 @@ impl LaneTracker {
                     .filter
                     .clone()
                     .filter(|_| replaced)
-                    .map(|filter| lane.estimate_with(filter));
+                    .map(|filter| lane.saved_with(filter, lane.predicted.clone()));
                 if self.install(i, &init) && replaced {
                     self.lanes[i].replaced = before;
                     self.counters.revalidation_switches[i] += 1;
@@ -499,11 +499,7 @@ impl LaneTracker {
                 {
                     continue;
                 }
-                if let Some(filter) = lane.filter.take() {
-                    lane.set_aside = Some(lane.estimate_with(filter));
-                    lane.predicted = None;
-                    lane.state = LaneState::Lost;
-                }
+                lane.set_aside = lane.take_estimate();
             }
         }
     }

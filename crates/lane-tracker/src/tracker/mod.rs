@@ -212,18 +212,20 @@ struct Lane {
     fresh: bool,
     /// The tracked lane a switch replaced on this frame (the lane is `initialised_now`),
     /// restored if the crossing gate undoes the switch; `None` otherwise.
-    replaced: Option<Replaced>,
+    replaced: Option<SavedEstimate>,
     /// A weak lane the ROI's joint choice kept nothing of on this frame, set aside while its
     /// side is searched for again (`track.revalidate_below_points`); tied to its side (not
     /// moved by a hand-over); `None` otherwise and after the initialisation.
-    set_aside: Option<Replaced>,
+    set_aside: Option<SavedEstimate>,
 }
 
 /// A tracked estimate taken out of its lane on this frame — replaced by a switch to another
-/// candidate, or set aside — with what it carried: filter, prediction, state, misses and the
-/// offsets read for it (a kerb's foot, a double line's gap). [`Lane::restore`] puts it back.
+/// candidate, or set aside — with what it carried: filter, prediction, state, misses, the
+/// offsets read for it (a kerb's foot, a double line's gap), whether its next update is its
+/// first (`fresh`, not jump-gated), and this frame's update (its rows, row profile and points).
+/// [`Lane::restore`] puts it back; only the point buffer (for overlays) is not kept.
 #[derive(Debug, Clone)]
-struct Replaced {
+struct SavedEstimate {
     filter: LaneFilter,
     predicted: Option<LaneFilter>,
     state: LaneState,
@@ -231,26 +233,44 @@ struct Replaced {
     kerb_offset_px: [f64; 2],
     kerb_misses: u32,
     pair_half_gap_px: f64,
+    fresh: bool,
+    rows: [f64; 2],
+    fit: FitRows,
+    points_now: usize,
 }
 
 impl Lane {
-    /// The lane's estimate as a [`Replaced`], its filter `filter` (the lane's own, taken or
-    /// cloned by the caller).
-    fn estimate_with(&self, filter: LaneFilter) -> Replaced {
-        Replaced {
+    /// The lane's estimate with `filter` and `predicted` (the lane's own, taken or cloned by
+    /// the caller).
+    fn saved_with(&self, filter: LaneFilter, predicted: Option<LaneFilter>) -> SavedEstimate {
+        SavedEstimate {
             filter,
-            predicted: self.predicted.clone(),
+            predicted,
             state: self.state,
             misses: self.misses,
             kerb_offset_px: self.kerb_offset_px,
             kerb_misses: self.kerb_misses,
             pair_half_gap_px: self.pair_half_gap_px,
+            fresh: self.fresh,
+            rows: self.rows,
+            fit: self.fit,
+            points_now: self.points_now,
         }
     }
 
-    /// Puts back an estimate taken out on this frame ([`Replaced`]): not initialised on this
-    /// frame, no points counted for it.
-    fn restore(&mut self, before: Replaced) {
+    /// Takes the estimate out of the lane (filter and prediction moved, not copied), leaving
+    /// it lost; `None` without a filter.
+    fn take_estimate(&mut self) -> Option<SavedEstimate> {
+        let filter = self.filter.take()?;
+        let predicted = self.predicted.take();
+        let saved = self.saved_with(filter, predicted);
+        self.state = LaneState::Lost;
+        Some(saved)
+    }
+
+    /// Puts back an estimate taken out on this frame ([`SavedEstimate`]), as it was after this
+    /// frame's update or miss: not initialised on this frame.
+    fn restore(&mut self, before: SavedEstimate) {
         self.filter = Some(before.filter);
         self.predicted = before.predicted;
         self.state = before.state;
@@ -258,8 +278,11 @@ impl Lane {
         self.kerb_offset_px = before.kerb_offset_px;
         self.kerb_misses = before.kerb_misses;
         self.pair_half_gap_px = before.pair_half_gap_px;
+        self.fresh = before.fresh;
+        self.rows = before.rows;
+        self.fit = before.fit;
+        self.points_now = before.points_now;
         self.initialised_now = false;
-        self.points_now = 0;
     }
 
     /// No estimate any more (lost: initialised again), and no windows or points to draw.

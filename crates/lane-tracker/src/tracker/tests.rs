@@ -7,7 +7,7 @@ use vision_gradient::{EdgeClass, EdgePixel, GreyImage};
 use wrls::WrlsError;
 
 use super::init::counts_as;
-use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, Replaced, Side};
+use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, SavedEstimate, Side};
 use crate::{FilterFailure, GreyFrame, TrackerConfig};
 use hough_init::Parabola;
 
@@ -1436,14 +1436,20 @@ fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
         tracker.track(&frame).expect("a frame");
     }
     let tracked = tracker.lanes[0].filter.clone().expect("a left lane");
+    let tracked_fit = tracker.lanes[0].fit;
     let (yt, yb) = (top as f64, (bottom - 1) as f64);
-    // The switch put the left lane right of the right one (crossed at every row).
+    // The switch put the left lane right of the right one (crossed at every row), as an
+    // installation does: a fresh filter (its first update not jump-gated), the candidate's
+    // rows and points.
     let crossing = nalgebra::Vector3::new(0.0, 0.0, 300.0);
-    tracker.lanes[0].filter = Some(tracker.new_filter(&crossing).expect("a filter"));
-    tracker.lanes[0].initialised_now = true;
-    tracker.lanes[0].kerb_offset_px = [0.0; 2];
+    let lane = &mut tracker.lanes[0];
+    lane.initialised_now = true;
+    lane.kerb_offset_px = [0.0; 2];
+    lane.fresh = true;
+    lane.rows = [200.0, 239.0];
+    lane.points_now = 40;
     // The replaced lane had missed this frame (a weak lane set aside, or a switched one).
-    tracker.lanes[0].replaced = Some(Replaced {
+    lane.replaced = Some(SavedEstimate {
         filter: tracked.clone(),
         predicted: Some(tracked.clone()),
         state: LaneState::Coasting,
@@ -1451,7 +1457,12 @@ fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
         kerb_offset_px: [1.5, 0.0],
         kerb_misses: 0,
         pair_half_gap_px: 0.0,
+        fresh: false,
+        rows: [150.0, 239.0],
+        fit: tracked_fit,
+        points_now: 0,
     });
+    tracker.lanes[0].filter = Some(tracker.new_filter(&crossing).expect("a filter"));
     tracker.counters.initialisations[0] += 1;
     tracker.counters.revalidation_switches[0] += 1;
     let before = *tracker.counters();
@@ -1466,6 +1477,12 @@ fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
     assert_eq!(lane.misses, 1);
     assert_eq!(lane.kerb_offset_px, [1.5, 0.0]);
     assert!(!lane.initialised_now && lane.replaced.is_none());
+    // Its next update is jump-gated again, and the report describes its own update (no
+    // points: it missed), not the candidate's.
+    assert!(!lane.fresh, "a restored lane's next update is gated");
+    assert_eq!(lane.rows, [150.0, 239.0]);
+    assert_eq!(lane.fit, tracked_fit);
+    assert_eq!(lane.report().points, 0);
     let after = tracker.counters();
     assert_eq!(after.initialisations[0], before.initialisations[0] - 1);
     assert_eq!(after.revalidation_switches, [0, 0]);
