@@ -218,6 +218,32 @@ impl Decimation {
     }
 }
 
+/// Largest |offset| of a row's residual bins, px: far beyond any column (an image is at most
+/// `u16::MAX` px wide), so that the clamped offset still puts every pixel of a far-off
+/// prediction in an end bin, and `i32` arithmetic cannot overflow.
+const BIN_OFFSET_LIMIT: f64 = 1_000_000.0;
+
+/// The residual bin of column `x` in a window `±w` px about the prediction `x̂` is the residual
+/// rounded half up and shifted into `0..=2w`, `⌊x − x̂ + w + ½⌋` clamped. `x` is an integer,
+/// so that is `x + ⌊w + ½ − x̂⌋`: this offset, once per row (a NaN prediction puts every pixel
+/// in bin 0, an infinite one in an end bin). [`residual_bin`] applies it.
+fn bin_offset(col_pred_px: f64, w: i64) -> i32 {
+    let offset = (w as f64 + 0.5 - col_pred_px).floor();
+    let offset = if offset.is_nan() {
+        -BIN_OFFSET_LIMIT
+    } else {
+        offset.clamp(-BIN_OFFSET_LIMIT, BIN_OFFSET_LIMIT)
+    };
+    offset as i32
+}
+
+/// Column `col_px`'s residual bin with its row's [`bin_offset`], clamped to `0..=bin_max` (2w).
+#[inline]
+fn residual_bin(col_px: u16, offset: i32, bin_max: i32) -> usize {
+    // (Not `clamp`, which panics for a negative `bin_max`.)
+    (i32::from(col_px) + offset).max(0).min(bin_max) as usize
+}
+
 /// Row bands of point selection's outlier rejection (thirds of the ROI rows).
 pub(super) const BANDS: usize = 3;
 
@@ -242,6 +268,7 @@ impl LaneTracker {
         // midhinge residual (mean of the quartiles) are dropped (clutter, noise, the edges of a shadow).
         let band_rows = [top + (bottom - top) / 3, top + 2 * (bottom - top) / 3];
         let w_us = w as usize;
+        let bin_max = (2 * w_us) as i32; // ≤ 2·MAX_WINDOW_HALF_WIDTH (the configuration's range)
         // One pass over the window pixels of the lane's class: residual bin (r + w, rounded;
         // window pixels are within ±w of the prediction) and row band, histogrammed per band.
         // (The tracker's buffer, cleared over the bins this window uses.)
@@ -285,6 +312,7 @@ impl LaneTracker {
                 Some(EdgeClass::RightLane)
             };
             let slope_f32 = slope as f32;
+            let offset = bin_offset(col_pred, w);
             let band = usize::from(row >= band_rows[0]) + usize::from(row >= band_rows[1]);
             let Some(hist) = hist.get_mut(band) else {
                 continue;
@@ -300,9 +328,7 @@ impl LaneTracker {
                         continue;
                     }
                 }
-                let v = f64::from(p.col_px) - col_pred;
-                // Truncation of a non-negative value is floor: this rounds v to the nearest bin.
-                let bin = ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w_us);
+                let bin = residual_bin(p.col_px, offset, bin_max);
                 if let Some(count) = hist.get_mut(bin) {
                     *count += 1;
                 }
@@ -341,10 +367,17 @@ impl LaneTracker {
             }
         }
         // |bin − centre| ≤ inlier_half_width_px for an integer difference: ≤ its floor (the
-        // configuration keeps it finite and > 0).
+        // configuration keeps it finite and > 0); per band, the bins `lo..=hi`.
         let inlier = self.cfg.track.inlier_half_width_px.floor() as i64;
-        let is_inlier =
-            |c: &Candidate| (i64::from(c.bin) - centre[usize::from(c.band)]).abs() <= inlier;
+        let bounds = centre.map(|c| {
+            let lo = (c - inlier).clamp(0, i64::from(u16::MAX)) as u16;
+            let hi = (c + inlier).clamp(-1, i64::from(u16::MAX)) as i32;
+            (lo, hi)
+        });
+        let is_inlier = |c: &Candidate| {
+            let (lo, hi) = bounds[usize::from(c.band) % BANDS];
+            c.bin >= lo && i32::from(c.bin) <= hi
+        };
         // With `track.mark_centres`, one sub-pixel point per row (crate docs, "Mark centres"):
         // the inlier edge pixels of a row (both edges of the mark; the detector emits them row
         // by row) bracket the mark, and the centroid of its grey level above the local
@@ -355,7 +388,20 @@ impl LaneTracker {
         if !mark_centres {
             // The paper's measurement: the inlier edge pixels, uniformly decimated (in row
             // order) down to max_points, spread over the rows and over both edges of a mark.
-            let total = self.scratch.iter().filter(|c| is_inlier(c)).count();
+            // Every counted pixel was stored (the buffer holds the detector's whole capacity),
+            // so the inliers are the histograms' bins within the bounds.
+            let total = if self.scratch.len() < self.scratch.capacity() {
+                hist.iter()
+                    .zip(bounds)
+                    .map(|(h, (lo, hi))| {
+                        let (lo, hi) = (usize::from(lo), usize::try_from(hi).unwrap_or(0));
+                        h.get(lo..=hi.min(2 * w_us))
+                            .map_or(0, |b| b.iter().sum::<u32>())
+                    })
+                    .sum::<u32>() as usize
+            } else {
+                self.scratch.iter().filter(|c| is_inlier(c)).count()
+            };
             let mut decimation = Decimation::new(max_points, total);
             for c in self.scratch.iter().filter(|c| is_inlier(c)) {
                 if decimation.keep() {
@@ -448,6 +494,43 @@ mod tests {
         let dark: Vec<u8> = row(15.2, 18.9).iter().map(|&p| 255 - p + 35).collect();
         let (x, _) = mark_centre(&dark, 15, 18, 0.0).unwrap();
         assert!((x - 17.05).abs() < 0.04, "{x}");
+    }
+
+    #[test]
+    fn the_residual_bin_is_the_rounded_residual_shifted_into_the_window() {
+        // The per-pixel formula the per-row offset replaces: ⌊x − x̂ + w + ½⌋, negative → 0,
+        // capped at 2w.
+        let direct = |x: u16, pred: f64, w: i64| {
+            let v = f64::from(x) - pred;
+            ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w as usize)
+        };
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20_000 {
+            let w = 1 + (uniform() * 40.0) as i64;
+            let x = (uniform() * 640.0) as u16;
+            // Predictions near the pixel (in the window and just outside it), on half-pixel
+            // ties, and far away.
+            let pred = match (uniform() * 4.0) as u32 {
+                0 => f64::from(x) + (uniform() - 0.5) * 4.0 * w as f64,
+                1 => f64::from(x) + ((uniform() * 8.0) as i64 - 4) as f64 + 0.5,
+                2 => (uniform() - 0.5) * 1e7,
+                _ => f64::from(x) - w as f64 - 0.5 + (uniform() - 0.5) * 1e-9,
+            };
+            let bin = residual_bin(x, bin_offset(pred, w), 2 * w as i32);
+            assert_eq!(bin, direct(x, pred, w), "x {x}, prediction {pred}, w {w}");
+        }
+        for pred in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300] {
+            for x in [0u16, 17, u16::MAX] {
+                let bin = residual_bin(x, bin_offset(pred, 10), 20);
+                assert_eq!(bin, direct(x, pred, 10), "x {x}, prediction {pred}");
+            }
+        }
     }
 
     #[test]
