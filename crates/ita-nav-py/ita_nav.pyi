@@ -50,6 +50,7 @@ class Counters(TypedDict):
     gated_pairs: int
     revalidations: int
     revalidation_switches: Tuple[int, int]
+    set_asides: Tuple[int, int]
     lane_changes: int
 
 class LaneTracker:

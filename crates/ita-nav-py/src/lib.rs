@@ -320,6 +320,7 @@ impl LaneTracker {
             "revalidation_switches",
             (c.revalidation_switches[0], c.revalidation_switches[1]),
         )?;
+        d.set_item("set_asides", (c.set_asides[0], c.set_asides[1]))?;
         d.set_item("lane_changes", c.lane_changes)?;
         Ok(d)
     }

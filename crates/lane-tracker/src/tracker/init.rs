@@ -490,7 +490,12 @@ impl LaneTracker {
         // holds after a hand-over too.
         if set_aside_weak && competes.contains(&true) {
             let weak_below = self.cfg.track.revalidate_below_points;
-            for (lane, owner) in self.lanes.iter_mut().zip(owners) {
+            for ((lane, owner), count) in self
+                .lanes
+                .iter_mut()
+                .zip(owners)
+                .zip(&mut self.counters.set_asides)
+            {
                 if owner.is_some()
                     || lane.initialised_now
                     || !lane.has_estimate()
@@ -500,6 +505,7 @@ impl LaneTracker {
                     continue;
                 }
                 lane.set_aside = lane.take_estimate();
+                *count += u64::from(lane.set_aside.is_some());
             }
         }
     }

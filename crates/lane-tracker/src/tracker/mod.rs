@@ -132,6 +132,11 @@ pub struct TrackerCounters {
     /// or a weak lane it set aside replaced by the frame's searches
     /// (`track.revalidate_below_points`), per lane.
     pub revalidation_switches: [u64; 2],
+    /// Weak lanes set aside while the frame's second search looked for their side
+    /// (`track.revalidate_below_points`: weak on two frames in a row, kept nothing of by the
+    /// ROI's choice), per lane; those the search replaced count in `revalidation_switches`
+    /// too, the others were put back as they were.
+    pub set_asides: [u64; 2],
     /// Lane changes: a tracked boundary the joint initialisation or a re-validation put on the
     /// other side of the pair (the camera crossed it), handed over to that side.
     pub lane_changes: u64,

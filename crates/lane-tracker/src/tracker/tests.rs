@@ -343,6 +343,11 @@ fn a_weak_lane_the_revalidation_does_not_keep_is_searched_for_again_on_its_secon
     assert_eq!(counters.revalidations, 2);
     assert_eq!(counters.initialisations, [1, 2]);
     assert_eq!(counters.revalidation_switches, [0, 1]);
+    assert_eq!(
+        counters.set_asides,
+        [0, 1],
+        "set aside on its second weak frame only"
+    );
     let mut period_only = cfg;
     period_only.track.revalidate_below_points = 0;
     let (_, _, right_off, r, counters) = run(&period_only);
@@ -387,6 +392,7 @@ fn a_weak_lane_set_aside_coasts_on_when_nothing_replaces_it() {
     let counters = *tracker.counters();
     assert_eq!(counters.revalidations, 2);
     assert_eq!(counters.revalidation_switches, [0, 0]);
+    assert_eq!(counters.set_asides, [0, 1], "set aside, then put back");
     let report = tracker.track(&both).expect("a frame");
     assert!(report.lanes.iter().all(|l| l.state == LaneState::Tracking));
     assert_eq!(tracker.counters().initialisations, [1, 1]);

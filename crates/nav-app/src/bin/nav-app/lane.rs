@@ -476,7 +476,8 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
             let c = t.counters();
             eprintln!(
                 "nav-app: initialisations left {} right {}; gated jumps {:?}; gated crossings {:?}; \
-                 pairs initialised again {}; re-validations {} (lanes replaced {:?}); lane changes {}",
+                 pairs initialised again {}; re-validations {} (lanes replaced {:?}); weak lanes set \
+                 aside {:?}; lane changes {}",
                 c.initialisations[0],
                 c.initialisations[1],
                 c.gated_jumps,
@@ -484,6 +485,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 c.gated_pairs,
                 c.revalidations,
                 c.revalidation_switches,
+                c.set_asides,
                 c.lane_changes
             );
         }
