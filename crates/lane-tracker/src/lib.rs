@@ -184,8 +184,10 @@
 //! - **searches again over taller rows** (`roi.fallback_top_row_fraction`): a side still
 //!   without a lane after the initialisation in the ROI is looked for over the rows from that
 //!   fraction of the height down (gradient, candidates, coverage and choice as above, the side
-//!   found in the ROI locked into the pair; the lane is refined over the same
-//!   rows). A dashed mark whose near field falls in the gap between two dashes, or a camera
+//!   found in the ROI locked into the pair; the lane is refined, then tracked, over the same
+//!   rows until it is initialised again from the ROI — tracked over the ROI's rows alone, a
+//!   lane whose mark lies only above them would miss on every frame and be searched for again
+//!   every other frame). A dashed mark whose near field falls in the gap between two dashes, or a camera
 //!   tilted down so that a mark is visible only far ahead, is then found where it is. A fit
 //!   needs as many rows as in the first search (a quarter of the ROI's, not of the taller
 //!   rows': a dash far ahead is no longer there than one near the camera). A fit

@@ -90,7 +90,8 @@ pub struct RoiConfig {
     /// (gradient, Hough candidates and choice over the taller region, the side found in the ROI
     /// kept in the pair): a dashed mark whose near field falls in a gap between dashes, or a
     /// camera looking down with the road's far part above the ROI. Its windowed refinement runs
-    /// over the same rows. Dimensionless in `[0, top_row_fraction)`; absent (the default when
+    /// over the same rows, and so does its tracking until it is initialised again from the ROI
+    /// (its mark may lie above the ROI only). Dimensionless in `[0, top_row_fraction)`; absent (the default when
     /// absent) = no second search.
     #[serde(default)]
     pub fallback_top_row_fraction: Option<f64>,

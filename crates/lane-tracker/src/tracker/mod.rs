@@ -200,6 +200,9 @@ struct Lane {
     /// Initialised on this frame by the second search (`roi.fallback_top_row_fraction`): its
     /// refinement runs over the taller rows.
     found_in_fallback: bool,
+    /// Found by the second search: tracked over the taller rows (`roi.fallback_top_row_fraction`
+    /// down), where its mark was, until it is initialised again from the ROI.
+    tracked_tall: bool,
     /// `[α, β]`: the boundary reported lies `α + β·y` px from the edge the filter tracks — a
     /// kerb's foot from its top edge (`init.kerb_foot`); zero otherwise. Set after an
     /// initialisation, read again on each tracked frame and dropped after
@@ -239,6 +242,7 @@ struct SavedEstimate {
     kerb_misses: u32,
     pair_half_gap_px: f64,
     fresh: bool,
+    tracked_tall: bool,
     rows: [f64; 2],
     fit: FitRows,
     points_now: usize,
@@ -257,6 +261,7 @@ impl Lane {
             kerb_misses: self.kerb_misses,
             pair_half_gap_px: self.pair_half_gap_px,
             fresh: self.fresh,
+            tracked_tall: self.tracked_tall,
             rows: self.rows,
             fit: self.fit,
             points_now: self.points_now,
@@ -284,6 +289,7 @@ impl Lane {
         self.kerb_misses = before.kerb_misses;
         self.pair_half_gap_px = before.pair_half_gap_px;
         self.fresh = before.fresh;
+        self.tracked_tall = before.tracked_tall;
         self.rows = before.rows;
         self.fit = before.fit;
         self.points_now = before.points_now;
@@ -480,6 +486,7 @@ impl LaneTracker {
             points_before: 0,
             initialised_now: false,
             found_in_fallback: false,
+            tracked_tall: false,
             kerb_offset_px: [0.0; 2],
             kerb_misses: 0,
             pair_half_gap_px: 0.0,
@@ -576,6 +583,7 @@ impl LaneTracker {
             lane.weights.clear();
             lane.spans.fill(ColSpan::EMPTY);
             lane.points_now = 0;
+            lane.tracked_tall = false;
         }
         self.init_candidates.clear();
         self.counters = TrackerCounters::default();
@@ -683,7 +691,11 @@ impl LaneTracker {
             lane.replaced = None;
             lane.set_aside = None;
             if lane.has_estimate() {
-                self.track_lane(i, &image, true)?;
+                let tall = self.fallback_roi.filter(|_| lane.tracked_tall);
+                self.search_rows = tall.unwrap_or(self.roi);
+                let tracked = self.track_lane(i, &image, true);
+                self.search_rows = self.roi;
+                tracked?;
             } else {
                 lane.spans.fill(ColSpan::EMPTY);
                 lane.points.clear();
@@ -745,6 +757,7 @@ impl LaneTracker {
                         lane.misses = 0;
                     }
                     lane.initialised_now = true;
+                    lane.tracked_tall = lane.found_in_fallback;
                 }
             }
         }

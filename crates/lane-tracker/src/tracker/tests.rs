@@ -283,6 +283,54 @@ fn a_side_missing_from_the_roi_is_found_by_the_second_search_over_the_taller_row
 }
 
 #[test]
+fn a_lane_the_second_search_found_is_tracked_over_the_taller_rows() {
+    // The right mark lies only above the ROI (a camera looking down, the far dash of a dashed
+    // mark). The second search finds it; on the next frames the lane is tracked where its mark
+    // is — over the taller rows — not searched for again: tracking on every frame, on the mark,
+    // no new initialisation. Tracked over the ROI's rows alone its windows would be empty: a
+    // miss, then a set-aside and a new initialisation every other frame.
+    let frame = right_mark_above_the_roi(320, 240);
+    let run = |tall_tracking: bool| {
+        let cfg = TrackerConfig::default_preset().expect("the default preset");
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let first = tracker.track(&frame).expect("a frame");
+        assert!(first.lanes[1].initialised, "found by the second search");
+        let mut states = Vec::new();
+        let mut worst_px = 0.0f64;
+        for _ in 0..6 {
+            if !tall_tracking {
+                tracker.lanes[1].tracked_tall = false;
+            }
+            let r = tracker.track(&frame).expect("a frame").lanes[1];
+            states.push((r.state, r.points));
+            for y in [80.0, 110.0, 139.0] {
+                let x = r.col_at_row(y).unwrap_or(f64::INFINITY);
+                worst_px = worst_px.max((x - right(y)).abs());
+            }
+        }
+        (states, worst_px, *tracker.counters())
+    };
+    let (states, worst_px, counters) = run(true);
+    assert!(
+        states
+            .iter()
+            .all(|&(s, points)| s == LaneState::Tracking && points >= 30),
+        "{states:?}"
+    );
+    assert!(worst_px < 1.5, "{worst_px} px off the right mark");
+    assert_eq!(counters.initialisations, [1, 1]);
+    assert_eq!(counters.set_asides, [0, 0]);
+    // Over the ROI's rows alone (the flag cleared before each frame), the lane is searched
+    // for again and again.
+    let (states, _, counters) = run(false);
+    assert!(
+        states.iter().any(|&(s, _)| s != LaneState::Tracking),
+        "{states:?}"
+    );
+    assert!(counters.initialisations[1] > 2, "{counters:?}");
+}
+
+#[test]
 fn a_weak_lane_the_revalidation_does_not_keep_is_searched_for_again_on_its_second_weak_frame() {
     // Both lanes tracked on their marks; then the right mark is gone from the ROI and a dash of
     // another one, 30 px farther right, lies above it (a lane ending, a camera pitched up over
@@ -1464,6 +1512,7 @@ fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
         kerb_misses: 0,
         pair_half_gap_px: 0.0,
         fresh: false,
+        tracked_tall: false,
         rows: [150.0, 239.0],
         fit: tracked_fit,
         points_now: 0,
