@@ -125,6 +125,8 @@ impl LaneTracker {
         self.search_rows = self.roi;
         for (lane, was_without) in self.lanes.iter_mut().zip(without) {
             lane.found_in_fallback = was_without && lane.initialised_now;
+            // Tracked over the taller rows from now on (`install` clears it).
+            lane.tracked_tall |= lane.found_in_fallback;
         }
         searched
     }
@@ -291,6 +293,9 @@ impl LaneTracker {
         // re-validation (both tracked) and when the other side is (re-)initialised. A lane
         // initialised on this frame (the first search's, during the second search) is locked
         // into the pair instead, as every tracked lane is with re-validation off.
+        // A lane tracked over the taller rows (`Lane::tracked_tall`) competes too, weighed on the
+        // ROI's rows, where its mark may not be: a candidate of the ROI for its side replaces
+        // it. (Locked instead, lanes of an earlier scene were kept: the stress test fell.)
         let competes: [bool; 2] = std::array::from_fn(|i| {
             let lane = &self.lanes[i];
             self.cfg.track.revalidates()
@@ -852,6 +857,7 @@ impl LaneTracker {
         lane.filter = Some(filter);
         lane.predicted = None;
         lane.fresh = true;
+        lane.tracked_tall = false;
         lane.kerb_offset_px = [0.0; 2];
         lane.kerb_misses = 0;
         lane.pair_half_gap_px = 0.0;

@@ -231,7 +231,8 @@ struct Lane {
 /// candidate, or set aside — with what it carried: filter, prediction, state, misses, the
 /// offsets read for it (a kerb's foot, a double line's gap), whether its next update is its
 /// first (`fresh`, not jump-gated), and this frame's update (its rows, row profile and points).
-/// [`Lane::restore`] puts it back; only the point buffer (for overlays) is not kept.
+/// [`Lane::restore`] puts it back; the buffers (points and weights, for overlays, and the
+/// windows) are not kept: after a switch undone they are the candidate's until the next frame.
 #[derive(Debug, Clone)]
 struct SavedEstimate {
     filter: LaneFilter,
@@ -387,7 +388,8 @@ pub struct LaneTracker {
     /// The ROI's rows `[top, bottom)` (`roi.*_row_fraction`), px; fixed.
     roi: (usize, usize),
     /// The rows the current stage reads, `[top, bottom)`, px: [`Self::roi`], or the second
-    /// search's taller rows while it runs and while a lane it found is refined.
+    /// search's taller rows while it runs, while a lane it found is refined, and while such a
+    /// lane (`Lane::tracked_tall`) is tracked and its kerb read again.
     search_rows: (usize, usize),
     /// The rows of the second search (`roi.fallback_top_row_fraction`), if any.
     fallback_roi: Option<(usize, usize)>,
@@ -414,7 +416,7 @@ pub struct LaneTracker {
     /// buffer's, plus one).
     of_class: Vec<u32>,
     scratch: Vec<Candidate>,
-    /// Point selection's residual histograms, one per third of the ROI rows
+    /// Point selection's residual histograms, one per third of the rows searched
     /// (`points::BANDS`), bins `0..=2w` of a window `±w` px.
     residual_hist: Box<[[u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]>,
     /// The rows' kerb feet `(row, offset)` read by `onto_kerb_foot` and `recheck_kerb_foot`
@@ -757,16 +759,19 @@ impl LaneTracker {
                         lane.misses = 0;
                     }
                     lane.initialised_now = true;
-                    lane.tracked_tall = lane.found_in_fallback;
                 }
             }
         }
         self.crossing_gate();
         // A kerb is read again against the tracked lanes' final estimates (after the crossing
         // gate, which may undo an update).
+        // A lane tracked over the taller rows reads its kerb there, as its refinement did.
         for i in 0..2 {
             if self.lanes[i].has_estimate() && !self.lanes[i].initialised_now {
+                let tall = self.fallback_roi.filter(|_| self.lanes[i].tracked_tall);
+                self.search_rows = tall.unwrap_or(self.roi);
                 self.recheck_kerb_foot(i, &image);
+                self.search_rows = self.roi;
             }
         }
         Ok(TrackReport {

@@ -17,7 +17,7 @@ pub(super) struct Candidate {
     row_px: u16,
     /// Residual `x − x̂(y)` rounded, plus the window half-width (0..=2w).
     bin: u16,
-    /// Third of the ROI rows (0, 1, 2).
+    /// Third of the rows searched (0, 1, 2).
     band: u8,
 }
 
@@ -226,7 +226,9 @@ const BIN_OFFSET_LIMIT: f64 = 1_000_000.0;
 /// The residual bin of column `x` in a window `±w` px about the prediction `x̂` is the residual
 /// rounded half up and shifted into `0..=2w`, `⌊x − x̂ + w + ½⌋` clamped. `x` is an integer,
 /// so that is `x + ⌊w + ½ − x̂⌋`: this offset, once per row (a NaN prediction puts every pixel
-/// in bin 0, an infinite one in an end bin). [`residual_bin`] applies it.
+/// in bin 0, an infinite one in an end bin). [`residual_bin`] applies it. (The per-pixel float
+/// form, `((x − x̂) + w) + ½` rounded at each step, can differ from it by one bin when the sum
+/// lies within a few ulp of an integer; this one rounds once.)
 fn bin_offset(col_pred_px: f64, w: i64) -> i32 {
     let offset = (w as f64 + 0.5 - col_pred_px).floor();
     let offset = if offset.is_nan() {
@@ -244,7 +246,7 @@ fn residual_bin(col_px: u16, offset: i32, bin_max: i32) -> usize {
     (i32::from(col_px) + offset).max(0).min(bin_max) as usize
 }
 
-/// Row bands of point selection's outlier rejection (thirds of the ROI rows).
+/// Row bands of point selection's outlier rejection (thirds of the rows searched).
 pub(super) const BANDS: usize = 3;
 
 /// Largest window half-width accepted by the configuration, px.
@@ -368,7 +370,9 @@ impl LaneTracker {
         }
         // |bin − centre| ≤ inlier_half_width_px for an integer difference: ≤ its floor (the
         // configuration keeps it finite and > 0); per band, the bins `lo..=hi`.
-        let inlier = self.cfg.track.inlier_half_width_px.floor() as i64;
+        // (Capped at the histogram's width: a wider half-width keeps every bin, as it did.)
+        let inlier = (self.cfg.track.inlier_half_width_px.floor() as i64)
+            .min(2 * MAX_WINDOW_HALF_WIDTH as i64);
         let bounds = centre.map(|c| {
             let lo = (c - inlier).clamp(0, i64::from(u16::MAX)) as u16;
             let hi = (c + inlier).clamp(-1, i64::from(u16::MAX)) as i32;
@@ -393,10 +397,11 @@ impl LaneTracker {
             let total = if self.scratch.len() < self.scratch.capacity() {
                 hist.iter()
                     .zip(bounds)
-                    .map(|(h, (lo, hi))| {
-                        let (lo, hi) = (usize::from(lo), usize::try_from(hi).unwrap_or(0));
-                        h.get(lo..=hi.min(2 * w_us))
-                            .map_or(0, |b| b.iter().sum::<u32>())
+                    .map(|(h, (lo, hi))| match usize::try_from(hi) {
+                        Ok(hi) => h
+                            .get(usize::from(lo)..=hi.min(2 * w_us))
+                            .map_or(0, |b| b.iter().sum::<u32>()),
+                        Err(_) => 0, // no bin
                     })
                     .sum::<u32>() as usize
             } else {

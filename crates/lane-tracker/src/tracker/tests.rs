@@ -297,7 +297,9 @@ fn a_lane_the_second_search_found_is_tracked_over_the_taller_rows() {
         assert!(first.lanes[1].initialised, "found by the second search");
         let mut states = Vec::new();
         let mut worst_px = 0.0f64;
-        for _ in 0..6 {
+        // Past the default's periodic re-validation (every 10th frame): with no candidate for
+        // its side in the ROI, the choice keeps it.
+        for _ in 0..12 {
             if !tall_tracking {
                 tracker.lanes[1].tracked_tall = false;
             }
@@ -308,7 +310,13 @@ fn a_lane_the_second_search_found_is_tracked_over_the_taller_rows() {
                 worst_px = worst_px.max((x - right(y)).abs());
             }
         }
-        (states, worst_px, *tracker.counters())
+        let counters = *tracker.counters();
+        tracker.reset();
+        assert!(
+            tracker.lanes.iter().all(|l| !l.tracked_tall),
+            "reset clears it"
+        );
+        (states, worst_px, counters)
     };
     let (states, worst_px, counters) = run(true);
     assert!(
@@ -320,6 +328,7 @@ fn a_lane_the_second_search_found_is_tracked_over_the_taller_rows() {
     assert!(worst_px < 1.5, "{worst_px} px off the right mark");
     assert_eq!(counters.initialisations, [1, 1]);
     assert_eq!(counters.set_asides, [0, 0]);
+    assert!(counters.revalidations >= 1, "{counters:?}");
     // Over the ROI's rows alone (the flag cleared before each frame), the lane is searched
     // for again and again.
     let (states, _, counters) = run(false);
@@ -1481,69 +1490,80 @@ fn a_tracked_lane_on_a_faint_line_competes_when_the_other_side_is_initialised_ag
 #[test]
 fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
     // A switch (a tracked lane replaced by another candidate) that crosses the other lane is
-    // undone by the crossing gate: the tracked estimate comes back, not a lost lane.
+    // undone by the crossing gate: the tracked estimate comes back as it was after this frame's
+    // miss or update, not a lost lane — whether it had missed (coasting, one miss) or been
+    // updated with a few points (a weak lane), and whether it was tracked over the taller rows.
     let cfg = TrackerConfig::default_preset().expect("the default preset");
-    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
-    let (top, bottom) = tracker.roi;
-    let frame = two_marks(320, 240);
-    for _ in 0..3 {
-        tracker.track(&frame).expect("a frame");
+    for (state, misses, points, tall) in [
+        (LaneState::Coasting, 1, 0, false),
+        (LaneState::Tracking, 0, 20, true),
+    ] {
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let (top, bottom) = tracker.roi;
+        let frame = two_marks(320, 240);
+        for _ in 0..3 {
+            tracker.track(&frame).expect("a frame");
+        }
+        let tracked = tracker.lanes[0].filter.clone().expect("a left lane");
+        let tracked_fit = tracker.lanes[0].fit;
+        let (yt, yb) = (top as f64, (bottom - 1) as f64);
+        // The switch put the left lane right of the right one (crossed at every row), as an
+        // installation does: a fresh filter (its first update not jump-gated), over the ROI's
+        // rows, with the candidate's rows, row profile and points.
+        let crossing = nalgebra::Vector3::new(0.0, 0.0, 300.0);
+        let lane = &mut tracker.lanes[0];
+        lane.initialised_now = true;
+        lane.kerb_offset_px = [0.0; 2];
+        lane.fresh = true;
+        lane.tracked_tall = false;
+        lane.rows = [200.0, 239.0];
+        lane.fit = lane_geometry::FitRows {
+            rows_px: [220.0; lane_geometry::FIT_SAMPLES],
+            weights: [1.0; lane_geometry::FIT_SAMPLES],
+        };
+        lane.points_now = 40;
+        lane.replaced = Some(SavedEstimate {
+            filter: tracked.clone(),
+            predicted: Some(tracked.clone()),
+            state,
+            misses,
+            kerb_offset_px: [1.5, 0.0],
+            kerb_misses: 0,
+            pair_half_gap_px: 0.0,
+            fresh: false,
+            tracked_tall: tall,
+            rows: [150.0, 239.0],
+            fit: tracked_fit,
+            points_now: points,
+        });
+        tracker.lanes[0].filter = Some(tracker.new_filter(&crossing).expect("a filter"));
+        tracker.counters.initialisations[0] += 1;
+        tracker.counters.revalidation_switches[0] += 1;
+        let before = *tracker.counters();
+        tracker.crossing_gate();
+        let lane = &tracker.lanes[0];
+        let restored = lane.filter.as_ref().expect("the tracked lane back");
+        for y in [yt, yb] {
+            assert!((restored.col_at_row(y) - tracked.col_at_row(y)).abs() < 1e-9);
+        }
+        // As it was: its state and misses (a miss counts towards `lost_after_frames`), its
+        // offsets and rows; its next update jump-gated again; the report describes its own
+        // update, not the candidate's (the next frame counts it weak or not by these points).
+        assert_eq!((lane.state, lane.misses), (state, misses));
+        assert_eq!(lane.kerb_offset_px, [1.5, 0.0]);
+        assert!(!lane.initialised_now && lane.replaced.is_none());
+        assert!(!lane.fresh, "a restored lane's next update is gated");
+        assert_eq!(lane.tracked_tall, tall);
+        assert_eq!(lane.rows, [150.0, 239.0]);
+        assert_eq!(lane.fit, tracked_fit);
+        assert_eq!(lane.report().points, points);
+        let after = tracker.counters();
+        assert_eq!(after.initialisations[0], before.initialisations[0] - 1);
+        assert_eq!(after.revalidation_switches, [0, 0]);
+        assert_eq!(after.gated_crossings, [1, 0]);
+        assert!(
+            tracker.lanes[1].has_estimate(),
+            "the right lane is untouched"
+        );
     }
-    let tracked = tracker.lanes[0].filter.clone().expect("a left lane");
-    let tracked_fit = tracker.lanes[0].fit;
-    let (yt, yb) = (top as f64, (bottom - 1) as f64);
-    // The switch put the left lane right of the right one (crossed at every row), as an
-    // installation does: a fresh filter (its first update not jump-gated), the candidate's
-    // rows and points.
-    let crossing = nalgebra::Vector3::new(0.0, 0.0, 300.0);
-    let lane = &mut tracker.lanes[0];
-    lane.initialised_now = true;
-    lane.kerb_offset_px = [0.0; 2];
-    lane.fresh = true;
-    lane.rows = [200.0, 239.0];
-    lane.points_now = 40;
-    // The replaced lane had missed this frame (a weak lane set aside, or a switched one).
-    lane.replaced = Some(SavedEstimate {
-        filter: tracked.clone(),
-        predicted: Some(tracked.clone()),
-        state: LaneState::Coasting,
-        misses: 1,
-        kerb_offset_px: [1.5, 0.0],
-        kerb_misses: 0,
-        pair_half_gap_px: 0.0,
-        fresh: false,
-        tracked_tall: false,
-        rows: [150.0, 239.0],
-        fit: tracked_fit,
-        points_now: 0,
-    });
-    tracker.lanes[0].filter = Some(tracker.new_filter(&crossing).expect("a filter"));
-    tracker.counters.initialisations[0] += 1;
-    tracker.counters.revalidation_switches[0] += 1;
-    let before = *tracker.counters();
-    tracker.crossing_gate();
-    let lane = &tracker.lanes[0];
-    let restored = lane.filter.as_ref().expect("the tracked lane back");
-    for y in [yt, yb] {
-        assert!((restored.col_at_row(y) - tracked.col_at_row(y)).abs() < 1e-9);
-    }
-    // As it was: coasting, one miss counted towards `lost_after_frames`.
-    assert_eq!(lane.state, LaneState::Coasting);
-    assert_eq!(lane.misses, 1);
-    assert_eq!(lane.kerb_offset_px, [1.5, 0.0]);
-    assert!(!lane.initialised_now && lane.replaced.is_none());
-    // Its next update is jump-gated again, and the report describes its own update (no
-    // points: it missed), not the candidate's.
-    assert!(!lane.fresh, "a restored lane's next update is gated");
-    assert_eq!(lane.rows, [150.0, 239.0]);
-    assert_eq!(lane.fit, tracked_fit);
-    assert_eq!(lane.report().points, 0);
-    let after = tracker.counters();
-    assert_eq!(after.initialisations[0], before.initialisations[0] - 1);
-    assert_eq!(after.revalidation_switches, [0, 0]);
-    assert_eq!(after.gated_crossings, [1, 0]);
-    assert!(
-        tracker.lanes[1].has_estimate(),
-        "the right lane is untouched"
-    );
 }

@@ -47,7 +47,7 @@ impl LaneTracker {
     }
 
     /// The measurement update of lane `i` with its selected points, then the jump gate at the
-    /// top and bottom ROI rows.
+    /// top and bottom rows searched (the ROI's, or the taller rows of a lane tracked there).
     fn update_and_gate(&mut self, i: usize, coeffs: [f64; 3]) {
         let (top, bottom) = self.search_rows;
         let mark_centres = self.cfg.track.mark_centres;
@@ -83,7 +83,7 @@ impl LaneTracker {
             Self::miss(lane, &self.cfg);
             return;
         }
-        // Jump gate at the top and bottom ROI rows.
+        // Jump gate at the top and bottom rows searched.
         let (Some(new), Some(pred)) = (lane.filter.as_ref(), lane.predicted.as_ref()) else {
             return;
         };

@@ -1,5 +1,6 @@
 //! Stage III, prediction and windows: the filter's time update and the window of interest
-//! `x̂(y) ± track.window_half_width_px` on every ROI row.
+//! `x̂(y) ± track.window_half_width_px` on every row searched (the ROI's, or the taller rows of
+//! a lane the second search found, `Lane::tracked_tall`).
 
 use hough_init::Parabola;
 use vision_gradient::ColSpan;
