@@ -123,10 +123,9 @@ impl LaneTracker {
         self.search_rows = tall;
         let searched = self.initialise_in_roi(image, without, false);
         self.search_rows = self.roi;
+        // A side found here is refined and tracked over these rows (`install` clears the flag).
         for (lane, was_without) in self.lanes.iter_mut().zip(without) {
-            lane.found_in_fallback = was_without && lane.initialised_now;
-            // Tracked over the taller rows from now on (`install` clears it).
-            lane.tracked_tall |= lane.found_in_fallback;
+            lane.tracked_tall |= was_without && lane.initialised_now;
         }
         searched
     }
@@ -491,8 +490,8 @@ impl LaneTracker {
         // `initialise` puts it back as it was if nothing is found. A lane weak on one frame
         // only (a dropout) coasts as before: the second search would initialise it from the
         // far field above an occlusion of the ROI. A longer occlusion is searched for from its
-        // second frame (a lost lane's initialisation would from its third). `owners` is by side, so it
-        // holds after a hand-over too.
+        // second frame (a lost lane's initialisation would from its third). `owners` is by side,
+        // so it holds after a hand-over too.
         if set_aside_weak && competes.contains(&true) {
             let weak_below = self.cfg.track.revalidate_below_points;
             for ((lane, owner), count) in self

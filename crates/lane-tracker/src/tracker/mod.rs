@@ -197,11 +197,9 @@ struct Lane {
     /// in a row, `track.revalidate_below_points`).
     points_before: usize,
     initialised_now: bool,
-    /// Initialised on this frame by the second search (`roi.fallback_top_row_fraction`): its
-    /// refinement runs over the taller rows.
-    found_in_fallback: bool,
-    /// Found by the second search: tracked over the taller rows (`roi.fallback_top_row_fraction`
-    /// down), where its mark was, until it is initialised again from the ROI.
+    /// Found by the second search (`roi.fallback_top_row_fraction`): refined, tracked and its
+    /// kerb read over the taller rows, where its mark was, until it is initialised again from
+    /// the ROI ([`LaneTracker::rows_of`]).
     tracked_tall: bool,
     /// `[α, β]`: the boundary reported lies `α + β·y` px from the edge the filter tracks — a
     /// kerb's foot from its top edge (`init.kerb_foot`); zero otherwise. Set after an
@@ -487,7 +485,6 @@ impl LaneTracker {
             points_now: 0,
             points_before: 0,
             initialised_now: false,
-            found_in_fallback: false,
             tracked_tall: false,
             kerb_offset_px: [0.0; 2],
             kerb_misses: 0,
@@ -549,6 +546,15 @@ impl LaneTracker {
     /// Frame size this tracker takes, px.
     pub fn frame_size(&self) -> (usize, usize) {
         (self.width, self.height)
+    }
+
+    /// The rows lane `i` is refined, tracked and its kerb read over: the second search's taller
+    /// rows for a lane it found (`Lane::tracked_tall`), else the ROI's.
+    fn rows_of(&self, i: usize) -> (usize, usize) {
+        match (self.fallback_roi, self.lanes.get(i)) {
+            (Some(tall), Some(lane)) if lane.tracked_tall => tall,
+            _ => self.roi,
+        }
     }
 
     /// Rows searched, `[top, bottom)`, px.
@@ -686,15 +692,13 @@ impl LaneTracker {
         for i in 0..2 {
             let lane = &mut self.lanes[i];
             lane.initialised_now = false;
-            lane.found_in_fallback = false;
             lane.updated_now = false;
             lane.points_before = lane.points_now;
             lane.points_now = 0;
             lane.replaced = None;
             lane.set_aside = None;
             if lane.has_estimate() {
-                let tall = self.fallback_roi.filter(|_| lane.tracked_tall);
-                self.search_rows = tall.unwrap_or(self.roi);
+                self.search_rows = self.rows_of(i);
                 let tracked = self.track_lane(i, &image, true);
                 self.search_rows = self.roi;
                 tracked?;
@@ -733,10 +737,7 @@ impl LaneTracker {
             for i in 0..2 {
                 if self.lanes[i].initialised_now {
                     // A lane the second search found is refined over the rows it was found in.
-                    if let (true, Some(tall)) = (self.lanes[i].found_in_fallback, self.fallback_roi)
-                    {
-                        self.search_rows = tall;
-                    }
+                    self.search_rows = self.rows_of(i);
                     let mut refined = Ok(());
                     for _ in 0..self.cfg.track.refine_passes.max(1) {
                         refined = self.track_lane(i, &image, false);
@@ -768,8 +769,7 @@ impl LaneTracker {
         // A lane tracked over the taller rows reads its kerb there, as its refinement did.
         for i in 0..2 {
             if self.lanes[i].has_estimate() && !self.lanes[i].initialised_now {
-                let tall = self.fallback_roi.filter(|_| self.lanes[i].tracked_tall);
-                self.search_rows = tall.unwrap_or(self.roi);
+                self.search_rows = self.rows_of(i);
                 self.recheck_kerb_foot(i, &image);
                 self.search_rows = self.roi;
             }
