@@ -94,6 +94,14 @@ impl LaneTracker {
     /// gate may undo).
     pub(super) fn initialise(&mut self, image: &GreyImage<'_>) -> Result<(), TrackerError> {
         let searched = self.search_both(image);
+        self.settle_set_asides();
+        searched
+    }
+
+    /// After the frame's searches, each lane set aside on it (`Lane::set_aside`, kept with its
+    /// side through a hand-over): what a lane now on its side replaced (a switch, counted, that
+    /// the crossing gate may undo), else put back as it was.
+    pub(super) fn settle_set_asides(&mut self) {
         for i in 0..2 {
             let lane = &mut self.lanes[i];
             let Some(set_aside) = lane.set_aside.take() else {
@@ -106,7 +114,6 @@ impl LaneTracker {
                 lane.restore(set_aside);
             }
         }
-        searched
     }
 
     /// [`Self::initialise`]'s two searches: the ROI's (which may set weak lanes aside), then
@@ -519,7 +526,7 @@ impl LaneTracker {
     /// old side). With `drop_other`, the lane that was at `to` is dropped into slot `from` (no
     /// estimate, no windows or points: the choice's candidate for that side, if any, is
     /// installed next); without, the two are swapped. No allocation (the buffers are swapped).
-    fn hand_over(&mut self, from: usize, to: usize, drop_other: bool) {
+    pub(super) fn hand_over(&mut self, from: usize, to: usize, drop_other: bool) {
         if from == to || from > 1 || to > 1 {
             return;
         }

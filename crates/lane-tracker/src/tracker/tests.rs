@@ -339,6 +339,70 @@ fn a_lane_the_second_search_found_is_tracked_over_the_taller_rows() {
     assert!(counters.initialisations[1] > 2, "{counters:?}");
 }
 
+/// The foot of `kerb_above_the_roi`'s kerb, whose top edge is `right(y)`: its face widens
+/// from 5 px at row 76 to 8 px at row 146.
+fn tall_kerb_foot_col(y: f64) -> f64 {
+    right(y) - (5.0 + 3.0 * (y - 76.0) / 70.0)
+}
+/// The left mark of [`right_mark_above_the_roi`] on every row, and on the right a kerb
+/// (`kerb_level`: top edge `right(y)`, foot `tall_kerb_foot_col(y)`) seen only on rows 76..146,
+/// above the default ROI (from row 148): plain road below.
+fn kerb_above_the_roi(w: usize, h: usize) -> GreyFrame {
+    let mut pixels = vec![55u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if (x - left(y)).abs() < 2.5 {
+            *p = 200;
+        } else if (76.0..146.0).contains(&y) {
+            *p = kerb_level(x, right(y), tall_kerb_foot_col(y), true);
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn a_kerb_the_second_search_found_is_read_again_over_the_taller_rows() {
+    // The right boundary is a kerb seen only above the ROI. The second search finds its top
+    // edge and the boundary is moved to its foot, read over the taller rows; tracked on, the
+    // kerb is read again over the same rows, so the boundary stays on the foot. Read over the
+    // ROI's rows (plain road) the kerb would be missed and its offset dropped after
+    // `track.lost_after_frames` frames: the boundary back on the top edge, 5–8 px off.
+    let frame = kerb_above_the_roi(320, 240);
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    assert!(cfg.init.kerb_foot);
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let rows = [80.0, 110.0, 140.0];
+    let off_foot = |r: &super::LaneReport| {
+        rows.map(|y| r.col_at_row(y).unwrap_or(f64::INFINITY) - (tall_kerb_foot_col(y) - 0.5))
+    };
+    let first = tracker.track(&frame).expect("a frame").lanes[1];
+    assert!(first.initialised && tracker.lanes[1].tracked_tall);
+    assert_ne!(tracker.lanes[1].kerb_offset_px, [0.0; 2], "no kerb read");
+    let d = off_foot(&first);
+    assert!(d.iter().all(|d| d.abs() < 1.0), "{d:?} px off the foot");
+    // The tracked edge is the top edge (the filter keeps what its windows measure).
+    let tracked = tracker.lanes[1].filter.as_ref().map(LaneFilter::coeffs);
+    let top = tracked.map(|c| Parabola::from_coeffs(c).col_at_row(110.0) - (right(110.0) - 0.5));
+    assert!(
+        top.is_some_and(|d| d.abs() < 1.0),
+        "{top:?} px off the top edge"
+    );
+    let frames = 3 * cfg.track.lost_after_frames + 2;
+    for frame_no in 0..frames {
+        let r = tracker.track(&frame).expect("a frame").lanes[1];
+        assert!(
+            !r.initialised && r.state == LaneState::Tracking,
+            "frame {frame_no}: {r:?}"
+        );
+        let d = off_foot(&r);
+        assert!(
+            d.iter().all(|d| d.abs() < 1.0),
+            "frame {frame_no}: {d:?} px off the foot"
+        );
+    }
+    assert_eq!(tracker.counters().initialisations, [1, 1]);
+}
+
 #[test]
 fn a_weak_lane_the_revalidation_does_not_keep_is_searched_for_again_on_its_second_weak_frame() {
     // Both lanes tracked on their marks; then the right mark is gone from the ROI and a dash of
@@ -453,6 +517,60 @@ fn a_weak_lane_set_aside_coasts_on_when_nothing_replaces_it() {
     let report = tracker.track(&both).expect("a frame");
     assert!(report.lanes.iter().all(|l| l.state == LaneState::Tracking));
     assert_eq!(tracker.counters().initialisations, [1, 1]);
+}
+
+#[test]
+fn a_lane_set_aside_stays_with_its_side_through_a_hand_over() {
+    // The right lane, weak, is set aside while the second search looks for its side, and that
+    // search hands the tracked left lane over to the right (the camera crossed it). The record
+    // set aside belongs to the right side: after the searches it is what the lane now on the
+    // right replaced (a switch the crossing gate may undo), and the left side is left without a
+    // lane to initialise — not given the right lane's estimate back.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let frame = two_marks(320, 240);
+    for _ in 0..3 {
+        tracker.track(&frame).expect("a frame");
+    }
+    let coeffs = |t: &LaneTracker, i: usize| t.lanes[i].filter.as_ref().map(LaneFilter::coeffs);
+    let (left_before, right_before) = (coeffs(&tracker, 0), coeffs(&tracker, 1));
+    assert!(left_before.is_some() && right_before.is_some());
+    tracker.lanes[1].set_aside = tracker.lanes[1].take_estimate();
+    tracker.hand_over(0, 1, true);
+    let sides = tracker.lanes.each_ref().map(|l| (l.side, l.class));
+    assert_eq!(
+        sides,
+        [
+            (Side::Left, EdgeClass::LeftLane),
+            (Side::Right, EdgeClass::RightLane)
+        ]
+    );
+    assert_eq!(
+        coeffs(&tracker, 1),
+        left_before,
+        "the left lane, handed over"
+    );
+    assert!(!tracker.lanes[0].has_estimate() && tracker.lanes[0].set_aside.is_none());
+    let kept = tracker.lanes[1]
+        .set_aside
+        .as_ref()
+        .map(|s| s.filter.coeffs());
+    assert_eq!(
+        kept, right_before,
+        "the set-aside record moved with the lane"
+    );
+    tracker.settle_set_asides();
+    let replaced = tracker.lanes[1]
+        .replaced
+        .as_ref()
+        .map(|s| s.filter.coeffs());
+    assert_eq!(replaced, right_before);
+    assert_eq!(coeffs(&tracker, 1), left_before);
+    assert!(
+        !tracker.lanes[0].has_estimate(),
+        "the right lane put back on the left"
+    );
+    assert_eq!(tracker.counters().revalidation_switches, [0, 1]);
 }
 
 /// The second search asks a lane for as many rows as the first one does (a quarter of the
@@ -575,24 +693,29 @@ fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
 /// around `e − ½` in the tracker's column coordinates.
 fn kerb_right(w: usize, h: usize, plain: bool, extra_px: f64) -> GreyFrame {
     let left = mark_left;
-    let overlap = |x: f64, a: f64, b: f64| (b.min(x + 1.0) - a.max(x)).clamp(0.0, 1.0);
     let mut pixels = vec![55u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
-        let (top, foot) = (kerb_top(y), kerb_foot_col(y, extra_px));
-        let pavement = overlap(x, top, f64::INFINITY);
-        let groove = if plain {
-            0.0
-        } else {
-            overlap(x, foot - 2.0, foot)
-        };
         *p = if (x - left(y)).abs() < 2.5 {
             200
         } else {
-            (55.0 + 45.0 * pavement - 10.0 * groove).round() as u8
+            kerb_level(x, kerb_top(y), kerb_foot_col(y, extra_px), !plain)
         };
     }
     GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+/// Pixel `x`'s level across a right-hand kerb whose top edge is at column `top` and foot at
+/// `foot` (continuous, pixel `x` covering `[x, x + 1)`): road and face 55, the groove (45,
+/// 2 px wide, ending at the foot) if `groove`, the pavement 100, each pixel the area average.
+fn kerb_level(x: f64, top: f64, foot: f64, groove: bool) -> u8 {
+    let overlap = |a: f64, b: f64| (b.min(x + 1.0) - a.max(x)).clamp(0.0, 1.0);
+    let pavement = overlap(top, f64::INFINITY);
+    let groove = if groove {
+        overlap(foot - 2.0, foot)
+    } else {
+        0.0
+    };
+    (55.0 + 45.0 * pavement - 10.0 * groove).round() as u8
 }
 fn kerb_top(y: f64) -> f64 {
     230.0 + 0.45 * (y - 239.0)
