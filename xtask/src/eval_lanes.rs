@@ -7,7 +7,9 @@
 //! development part only, and the held-out figures are reported on their own. Scored: the ceiling (parabolas fitted to the labels over the ROI rows), the default
 //! configuration (what `nav-app` runs with no `--config`), the presets, and the classic OpenCV
 //! pipeline (`bench/opencv_peer.py`, in `target/opencv-venv`, made from PyPI on first use; `--no-peer`
-//! leaves it out). Writes
+//! leaves it out). The default's false positives are also split by what they lie on
+//! (`lane_eval::labelled::FalsePositives`: a side without a label, another labelled marking, a
+//! near miss, the rest). Writes
 //! `summary.md`, `summary.json` and `worst_frames.png` (the worst frames of the default run:
 //! labels green, nav-app red, the OpenCV peer blue). `--check` compares the default's figures with
 //! the floors in `fixtures/expectations-lanes-real.json` and fails below them; `--record` writes
@@ -19,8 +21,8 @@ use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 use lane_eval::labelled::{
-    EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, ScoringRules,
-    StageCensus, ceiling_prediction, census_set, score_frame, track_label_set,
+    EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, NEAR_MISS_FRACTION,
+    ScoringRules, StageCensus, ceiling_prediction, census_set, score_frame, track_label_set,
 };
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
@@ -69,7 +71,7 @@ pub struct EvalLanesArgs {
 }
 
 /// Format version of `summary.json`.
-const SUMMARY_SCHEMA: u32 = 1;
+const SUMMARY_SCHEMA: u32 = 2;
 /// Fraction of every set's frames (the first ones, in set order) in the development part.
 const DEV_FRACTION: f64 = 0.7;
 /// Floors: measured accuracy minus this, measured false positives plus this.
@@ -527,6 +529,9 @@ fn pct(x: f64) -> String {
     format!("{:.1}", 100.0 * x)
 }
 
+/// Which part of a set's figures a table row shows.
+type Pick = fn(&SplitRates) -> &LaneRates;
+
 fn render_markdown(s: &Summary, dev_only: bool) -> String {
     let mut md = String::new();
     md += "# Lane tracker on real labelled frames (`cargo xtask eval-lanes`)\n\n";
@@ -542,7 +547,6 @@ fn render_markdown(s: &Summary, dev_only: bool) -> String {
         s.rules.aly_px_at_640,
         100.0 * s.dev_fraction
     );
-    type Pick = fn(&SplitRates) -> &LaneRates;
     let splits: &[(&str, Pick)] = if dev_only {
         &[("dev", |r| &r.dev)]
     } else {
@@ -598,6 +602,42 @@ fn render_markdown(s: &Summary, dev_only: bool) -> String {
                 cfg,
                 split,
                 pick(rates),
+            );
+        }
+    }
+    md += &render_false_positives(s, splits);
+    md
+}
+
+/// The default's unmatched predictions by kind (`lane_eval::labelled::FalsePositives`), per set
+/// and overall, for each of `splits`.
+fn render_false_positives(s: &Summary, splits: &[(&str, Pick)]) -> String {
+    let mut md = format!(
+        "\nFalse positives of the default (TuSimple: predictions not matched) by what they lie on: \
+         a side with no label lane; another labelled marking (the other side's label or an unscored \
+         one: a neighbour's mark, or the sides swapped); near (≥ {:.0} % of the label's points within \
+         the tolerance); far (the rest).\n\n\
+         | set | split | predictions | false positives | no label on the side | another marking | near | far |\n\
+         |---|---|---|---|---|---|---|---|\n",
+        100.0 * NEAR_MISS_FRACTION
+    );
+    let named = s
+        .sets
+        .iter()
+        .filter_map(|set| Some((set.set.as_str(), set.results.get(DEFAULT_NAME)?)))
+        .chain(s.overall.get(DEFAULT_NAME).map(|r| ("**overall**", r)));
+    for (name, rates) in named {
+        for (split, pick) in splits {
+            let r = pick(rates);
+            let k = r.false_positives;
+            md += &format!(
+                "| {name} | {split} | {} | {} | {} | {} | {} | {} |\n",
+                r.predicted_lanes,
+                k.total(),
+                k.unlabelled_side,
+                k.other_marking,
+                k.near,
+                k.far
             );
         }
     }

@@ -259,6 +259,47 @@ pub struct LaneTotals {
     pub abs_err_sum_px: f64,
     /// Points in `abs_err_sum_px`.
     pub abs_err_points: u64,
+    /// The predictions not matched under TuSimple's rule, by what they lie on.
+    #[serde(default)]
+    pub false_positives: FalsePositives,
+}
+
+/// The predictions a frame, a set or all sets got wrong under TuSimple's rule (`predicted −
+/// matched` of [`LaneTotals`]), by what they lie on: a prediction on a side with no scored label
+/// lane; one that meets the rule against another labelled marking of the frame (the other ego
+/// side's label lane or an `Other` one: a neighbour's mark, or the two sides swapped); one with
+/// at least half its label lane's points within the tolerance (the right mark, off by a little:
+/// one edge of a wide mark, a bent end); the rest. The four add up to the unmatched predictions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct FalsePositives {
+    /// On a side with no scored label lane.
+    pub unlabelled_side: u64,
+    /// Off its side's label lane but matching another labelled marking of the frame.
+    pub other_marking: u64,
+    /// At least [`NEAR_MISS_FRACTION`] of its label lane's points within the tolerance, and on
+    /// no other labelled marking.
+    pub near: u64,
+    /// Fewer than [`NEAR_MISS_FRACTION`] of its points within the tolerance, and on no other
+    /// labelled marking.
+    pub far: u64,
+}
+
+/// Least TuSimple point accuracy of a near miss ([`FalsePositives::near`]).
+pub const NEAR_MISS_FRACTION: f64 = 0.5;
+
+impl FalsePositives {
+    /// All of them.
+    pub fn total(&self) -> u64 {
+        self.unlabelled_side + self.other_marking + self.near + self.far
+    }
+
+    /// Add another count.
+    pub fn add(&mut self, o: &FalsePositives) {
+        self.unlabelled_side += o.unlabelled_side;
+        self.other_marking += o.other_marking;
+        self.near += o.near;
+        self.far += o.far;
+    }
 }
 
 impl LaneTotals {
@@ -272,6 +313,7 @@ impl LaneTotals {
         self.aly_matched += o.aly_matched;
         self.abs_err_sum_px += o.abs_err_sum_px;
         self.abs_err_points += o.abs_err_points;
+        self.false_positives.add(&o.false_positives);
     }
 
     /// The rates.
@@ -301,6 +343,7 @@ impl LaneTotals {
             } else {
                 f64::NAN
             },
+            false_positives: self.false_positives,
         }
     }
 }
@@ -326,6 +369,9 @@ pub struct LaneRates {
     pub aly_false_per_label: f64,
     /// Mean |x_pred − x_label| over the label points of predicted lanes, px (NaN if none).
     pub mean_abs_error_px: f64,
+    /// The unmatched predictions by kind (counts).
+    #[serde(default)]
+    pub false_positives: FalsePositives,
 }
 
 fn eval_parabola(coeffs: [f64; 3], y: f64) -> f64 {
@@ -364,6 +410,39 @@ fn tusimple_lane_accuracy(
     correct as f64 / pts.len() as f64
 }
 
+/// Whether prediction `c`, made for `side`, meets TuSimple's rule against another labelled
+/// marking of `labels`: the other ego side's label lane, or any one `Other` lane, each on its
+/// scored points (at least 2).
+fn on_another_marking(
+    labels: &LabelFrame,
+    side: LabelSide,
+    y_top: f64,
+    c: [f64; 3],
+    tus_px: f64,
+    rules: &ScoringRules,
+) -> bool {
+    let mut unused_err_px = 0.0;
+    let mut meets = |pts: &[[f64; 2]]| {
+        pts.len() >= 2
+            && tusimple_lane_accuracy(pts, c, tus_px, &mut unused_err_px)
+                >= rules.tusimple_match_fraction
+    };
+    let other_side = match side {
+        LabelSide::Left => LabelSide::Right,
+        _ => LabelSide::Left,
+    };
+    meets(&scored_points(labels, other_side, y_top))
+        || labels
+            .lanes
+            .iter()
+            .filter(|l| l.side == LabelSide::Other)
+            .any(|l| {
+                let pts: Vec<[f64; 2]> =
+                    l.points.iter().copied().filter(|p| p[1] >= y_top).collect();
+                meets(&pts)
+            })
+}
+
 /// Score one frame's ego prediction against its labels under `rules`.
 pub fn score_frame(
     labels: &LabelFrame,
@@ -391,7 +470,9 @@ pub fn score_frame(
             t.predicted_lanes += 1;
         }
         if pts.is_empty() {
-            continue; // no label on this side: a prediction there is a false positive
+            // No label on this side: a prediction there is a false positive.
+            t.false_positives.unlabelled_side += u64::from(pred.is_some());
+            continue;
         }
         t.label_lanes += 1;
         let Some(c) = pred else { continue };
@@ -400,6 +481,12 @@ pub fn score_frame(
         t.tusimple_acc_sum += acc;
         if acc >= rules.tusimple_match_fraction {
             t.tusimple_matched += 1;
+        } else if on_another_marking(labels, side, y_top, c, tus_px, rules) {
+            t.false_positives.other_marking += 1;
+        } else if acc >= NEAR_MISS_FRACTION {
+            t.false_positives.near += 1;
+        } else {
+            t.false_positives.far += 1;
         }
         // Aly: median nearest-point distance to the prediction sampled on every row.
         let y_lo = (y_top - aly_px).max(0.0).floor() as i64;

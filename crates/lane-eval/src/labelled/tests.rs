@@ -109,6 +109,62 @@ fn missing_and_spurious_predictions_are_false_negatives_and_false_positives() {
 }
 
 #[test]
+fn false_positives_are_split_by_what_they_lie_on_and_add_up() {
+    // Left label x = −0.5·y + 200, right x = 0.6·y + 100, another marking x = 1.5·y (at least
+    // 30 px from the others on the scored rows, y ≥ 144).
+    let f = frame(vec![
+        line(LabelSide::Left, -0.5, 200.0),
+        line(LabelSide::Right, 0.6, 100.0),
+        line(LabelSide::Other, 1.5, 0.0),
+    ]);
+    let rules = ScoringRules::default();
+    let score = |p: EgoPrediction| score_frame(&f, 320, 240, &p, &rules);
+    let kinds = |t: &LaneTotals| {
+        let k = t.false_positives;
+        [k.unlabelled_side, k.other_marking, k.near, k.far]
+    };
+    // Exact: none.
+    let exact = score([Some([0.0, -0.5, 200.0]), Some([0.0, 0.6, 100.0])]);
+    assert_eq!(kinds(&exact), [0, 0, 0, 0]);
+    // The right prediction on the other marking; the left one on the right label (swapped).
+    let neighbour = score([Some([0.0, 0.6, 100.0]), Some([0.0, 1.5, 0.0])]);
+    assert_eq!(kinds(&neighbour), [0, 2, 0, 0]);
+    // The left label's line turned about its bottom point by 0.096 px a row: within the
+    // tolerance (5 px / cos(atan 0.5) = 5.6 px) on the 15 lowest of the 24 scored points.
+    let turned = [0.0, -0.5 - 0.096, 200.0 + 0.096 * 236.0];
+    let near = score([Some(turned), None]);
+    assert!(
+        (near.tusimple_acc_sum - 15.0 / 24.0).abs() < 1e-9,
+        "{near:?}"
+    );
+    assert_eq!(kinds(&near), [0, 0, 1, 0]);
+    // On no marking.
+    let far = score([Some([0.0, 0.0, 20.0]), Some([0.0, 0.0, 300.0])]);
+    assert_eq!(kinds(&far), [0, 0, 0, 2]);
+    // On a side without a label.
+    let left_only = frame(vec![line(LabelSide::Left, -0.5, 200.0)]);
+    let unlabelled = score_frame(
+        &left_only,
+        320,
+        240,
+        &[Some([0.0, -0.5, 200.0]), Some([0.0, 0.6, 100.0])],
+        &rules,
+    );
+    assert_eq!(kinds(&unlabelled), [1, 0, 0, 0]);
+    // Pooled, the kinds add up to the unmatched predictions.
+    let mut all = LaneTotals::default();
+    for t in [exact, neighbour, near, far, unlabelled] {
+        all.add(&t);
+    }
+    assert_eq!(kinds(&all), [1, 2, 1, 2]);
+    assert_eq!(
+        all.false_positives.total(),
+        all.predicted_lanes - all.tusimple_matched
+    );
+    assert_eq!(all.summary().false_positives, all.false_positives);
+}
+
+#[test]
 fn the_far_field_is_not_scored() {
     // A label that lives only above the evaluation row, with a wrong prediction: not scored.
     let far = LabelLane {
