@@ -265,22 +265,22 @@ pub struct LaneTotals {
 }
 
 /// The predictions a frame, a set or all sets got wrong under TuSimple's rule (`predicted −
-/// matched` of [`LaneTotals`]), by what they lie on: a prediction on a side with no scored label
-/// lane; one that meets the rule against another labelled marking of the frame (the other ego
+/// matched` of [`LaneTotals`]), by what they lie on: a prediction on a side with no label lane
+/// (a side labelled only in the far field is not scored, nor its prediction); one that meets the rule against another labelled marking of the frame (the other ego
 /// side's label lane or an `Other` one: a neighbour's mark, or the two sides swapped); one with
 /// at least half its label lane's points within the tolerance (the right mark, off by a little:
 /// one edge of a wide mark, a bent end); the rest. The four add up to the unmatched predictions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct FalsePositives {
-    /// On a side with no scored label lane.
+    /// On a side with no label lane.
     pub unlabelled_side: u64,
     /// Off its side's label lane but matching another labelled marking of the frame.
     pub other_marking: u64,
     /// At least [`NEAR_MISS_FRACTION`] of its label lane's points within the tolerance, and on
     /// no other labelled marking.
     pub near: u64,
-    /// Fewer than [`NEAR_MISS_FRACTION`] of its points within the tolerance, and on no other
-    /// labelled marking.
+    /// Fewer than [`NEAR_MISS_FRACTION`] of its label lane's points within the tolerance, and on
+    /// no other labelled marking.
     pub far: u64,
 }
 

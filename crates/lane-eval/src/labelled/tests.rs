@@ -110,8 +110,8 @@ fn missing_and_spurious_predictions_are_false_negatives_and_false_positives() {
 
 #[test]
 fn false_positives_are_split_by_what_they_lie_on_and_add_up() {
-    // Left label x = −0.5·y + 200, right x = 0.6·y + 100, another marking x = 1.5·y (at least
-    // 30 px from the others on the scored rows, y ≥ 144).
+    // Left label x = −0.5·y + 200, right x = 0.6·y + 100, another marking x = 1.5·y (29.6 px
+    // or more from the others on the scored rows, y ≥ 144).
     let f = frame(vec![
         line(LabelSide::Left, -0.5, 200.0),
         line(LabelSide::Right, 0.6, 100.0),

@@ -344,9 +344,9 @@ fn a_lane_the_second_search_found_is_tracked_over_the_taller_rows() {
 fn tall_kerb_foot_col(y: f64) -> f64 {
     right(y) - (5.0 + 3.0 * (y - 76.0) / 70.0)
 }
-/// The left mark of [`right_mark_above_the_roi`] on every row, and on the right a kerb
-/// (`kerb_level`: top edge `right(y)`, foot `tall_kerb_foot_col(y)`) seen only on rows 76..146,
-/// above the default ROI (from row 148): plain road below.
+/// On a road of level 55, the left mark of [`right_mark_above_the_roi`] on every row, and on
+/// the right a kerb (`kerb_level`: top edge `right(y)`, foot `tall_kerb_foot_col(y)`) seen only
+/// on rows 76..146, above the default ROI (from row 148): plain road below.
 fn kerb_above_the_roi(w: usize, h: usize) -> GreyFrame {
     let mut pixels = vec![55u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
