@@ -77,6 +77,62 @@ where
     I: IntoIterator + Clone,
     I::Item: PixelPoint,
 {
+    // Every intermediate parabola is accepted, so the result is always there (the error is
+    // unreachable).
+    fit_around_line_checked(points, line, params, |_| true)
+        .and_then(|fit| fit.ok_or(HoughError::NonFiniteResult { what: "fit" }))
+}
+
+/// [`fit_around_line`] on a subset of the points, when the caller can tell that it gives the
+/// same result as on all of them. Each selection of the fit keeps the points within `h` columns
+/// of a curve `c` — the line first (`c(y) = ρ/cos θ − y·tan θ`, `h = band_px / |cos θ|`,
+/// equivalent to its perpendicular band), then each intermediate parabola (`h = band_px`) —
+/// and before each one `complete(&c, h)` is asked whether `points` hold every point of the full
+/// set within `h` of `c` (with a margin for rounding: the test here is on the perpendicular
+/// distance for the line). If it says so each time, the sums run over the same points in the
+/// same order as on the full set (`points` in their order there), and the result is equal bit
+/// for bit; `Ok(None)` as soon as it does not (the caller fits the full set instead).
+///
+/// # Errors
+/// As [`fit_around_line`].
+pub fn fit_around_line_where<I, C>(
+    points: I,
+    line: HoughLine,
+    params: &LaneInitParams,
+    complete: C,
+) -> Result<Option<LaneInit>, HoughError>
+where
+    I: IntoIterator + Clone,
+    I::Item: PixelPoint,
+    C: Fn(&Parabola, f64) -> bool,
+{
+    let (sin_t, cos_t) = line.theta_rad.sin_cos();
+    let line_curve = Parabola {
+        a1: 0.0,
+        a2: -sin_t / cos_t,
+        a3: line.rho_px / cos_t,
+    };
+    let line_half_px = params.band_px / cos_t.abs();
+    let finite = line_half_px.is_finite() && line_curve.a2.is_finite() && line_curve.a3.is_finite();
+    if !(finite && complete(&line_curve, line_half_px)) {
+        return Ok(None);
+    }
+    fit_around_line_checked(points, line, params, |p| complete(p, params.band_px))
+}
+
+/// [`fit_around_line`] with `accept` asked about each intermediate parabola before the pixels
+/// near it are selected: `Ok(None)` as soon as it refuses one.
+fn fit_around_line_checked<I, A>(
+    points: I,
+    line: HoughLine,
+    params: &LaneInitParams,
+    accept: A,
+) -> Result<Option<LaneInit>, HoughError>
+where
+    I: IntoIterator + Clone,
+    I::Item: PixelPoint,
+    A: Fn(&Parabola) -> bool,
+{
     params.validate()?;
     let band_px = params.band_px;
     let (sin_t, cos_t) = line.theta_rad.sin_cos();
@@ -99,6 +155,9 @@ where
         )?
         .parabola()?;
         for _ in 1..params.refit_iterations {
+            if !accept(&p) {
+                return Ok(None);
+            }
             let near = |x: f64, y: f64| (x - p.col_at_row(y)).abs() <= band_px;
             p = fit_normalised(
                 points.clone(),
@@ -108,6 +167,9 @@ where
             )?
             .parabola()?;
         }
+        if !accept(&p) {
+            return Ok(None);
+        }
         fit_impl(
             points.clone(),
             |x, y| (x - p.col_at_row(y)).abs() <= band_px,
@@ -115,13 +177,13 @@ where
             PointSet::NearParabola,
         )?
     };
-    Ok(LaneInit {
+    Ok(Some(LaneInit {
         parabola: fit.parabola,
         line,
         points_used: fit.points_used,
         rms_residual_px: fit.rms_residual_px,
         rows_px: fit.rows_px,
-    })
+    }))
 }
 
 #[cfg(test)]
@@ -161,5 +223,124 @@ mod tests {
             "{fit_b:?}"
         );
         assert_eq!(fit_b.points_used, 80);
+    }
+
+    /// `fit_around_line_where` on the points within a reach of the line, asked about each
+    /// selection against the points left out, equals `fit_around_line` on all points bit for
+    /// bit whenever it gives a result; it gives none when a selection would reach a point left
+    /// out; and with nothing left out it always gives one. Seeded random scenes: a curved mark,
+    /// a second mark, uniform clutter, lines near the mark.
+    #[test]
+    fn a_fit_on_the_points_near_its_line_equals_the_fit_on_all_of_them() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let params = LaneInitParams {
+            refit_iterations: 2,
+            min_points: 10,
+            ..LaneInitParams::default()
+        };
+        let (mut subset_fits, mut refused) = (0, 0);
+        for _ in 0..300 {
+            let (a1, a2, a3) = (
+                rng.random_range(-0.002..0.002),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(60.0..260.0),
+            );
+            let mark = |y: f64| a1 * (y - 190.0) * (y - 190.0) + a2 * (y - 190.0) + a3;
+            let mut pts: Vec<Point> = Vec::new();
+            for y in 140..240 {
+                let y = f64::from(y);
+                if rng.random_bool(0.7) {
+                    pts.push(Point::new(
+                        (mark(y) + rng.random_range(-1.5..1.5)).round(),
+                        y,
+                    ));
+                }
+                if rng.random_bool(0.3) {
+                    pts.push(Point::new((mark(y) + 9.0).round(), y)); // a second edge
+                }
+                for _ in 0..3 {
+                    pts.push(Point::new(f64::from(rng.random_range(0..320u16)), y));
+                }
+            }
+            // A line through the mark at rows 160 and 220, perturbed.
+            let (y0, y1) = (160.0, 220.0);
+            let (x0, x1) = (
+                mark(y0) + rng.random_range(-3.0..3.0),
+                mark(y1) + rng.random_range(-3.0..3.0),
+            );
+            let tan = (x1 - x0) / (y1 - y0); // x = x0 + tan·(y − y0)
+            let theta = (-tan).atan(); // normal angle: x cos θ + y sin θ = ρ
+            let rho = x0 * theta.cos() + y0 * theta.sin();
+            let line = HoughLine {
+                rho_px: rho,
+                theta_rad: theta,
+                votes: 0,
+            };
+            let line_col = |y: f64| (rho - y * theta.sin()) / theta.cos();
+            let reach = params.band_px / theta.cos().abs() + rng.random_range(0.0..30.0);
+            let (near, left_out): (Vec<Point>, Vec<Point>) = pts
+                .iter()
+                .partition(|p| (p.col_px - line_col(p.row_px)).abs() <= reach);
+            let complete = |c: &Parabola, h: f64| {
+                left_out
+                    .iter()
+                    .all(|p| (p.col_px - c.col_at_row(p.row_px)).abs() > h + 0.5)
+            };
+            let full = fit_around_line(&pts, line, &params);
+            match fit_around_line_where(&near, line, &params, complete) {
+                Ok(Some(fit)) => {
+                    assert_eq!(Ok(fit), full);
+                    subset_fits += 1;
+                }
+                Ok(None) => refused += 1,
+                Err(e) => assert_eq!(Err(e), full),
+            }
+            // With nothing left out, every selection is complete.
+            let all = fit_around_line_where(&pts, line, &params, |_, _| true);
+            assert_eq!(all.map(|f| f.ok_or(())), full.map(Ok));
+        }
+        assert!(
+            subset_fits > 100 && refused > 10,
+            "{subset_fits} / {refused}"
+        );
+    }
+
+    /// The completeness test is asked about the line first, with its band in columns, then
+    /// about each intermediate parabola with `band_px`; a refusal at any of them gives no fit.
+    #[test]
+    fn the_completeness_test_is_asked_before_each_selection() {
+        let pts: Vec<Point> = (100..200)
+            .map(|y| Point::new(150.0 - 0.5 * f64::from(y - 100), f64::from(y)))
+            .collect();
+        let theta = 0.5f64.atan(); // x = 150 − 0.5·(y − 100) ⟺ x cos θ + y sin θ = ρ
+        let line = HoughLine {
+            rho_px: 150.0 * theta.cos() + 100.0 * theta.sin(),
+            theta_rad: theta,
+            votes: 0,
+        };
+        let params = LaneInitParams {
+            refit_iterations: 2,
+            ..LaneInitParams::default()
+        };
+        let asked = std::cell::RefCell::new(Vec::new());
+        let fit = fit_around_line_where(&pts, line, &params, |c, h| {
+            asked.borrow_mut().push((c.col_at_row(100.0), h));
+            true
+        });
+        assert!(matches!(fit, Ok(Some(_))));
+        let asked = asked.into_inner();
+        assert_eq!(asked.len(), 1 + params.refit_iterations as usize);
+        assert!((asked[0].0 - 150.0).abs() < 1e-9);
+        assert!((asked[0].1 - params.band_px / theta.cos()).abs() < 1e-12);
+        assert!(asked[1..].iter().all(|&(_, h)| h == params.band_px));
+        for refuse_at in 0..=params.refit_iterations {
+            let calls = std::cell::Cell::new(0);
+            let fit = fit_around_line_where(&pts, line, &params, |_, _| {
+                calls.set(calls.get() + 1);
+                calls.get() <= refuse_at
+            });
+            assert_eq!(fit, Ok(None), "refused at call {refuse_at}");
+        }
     }
 }

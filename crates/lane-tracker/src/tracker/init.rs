@@ -3,10 +3,7 @@
 //! (crate docs: the strongest lines of both bands, the ego pair chosen together), with the sanity
 //! checks that accept a fit.
 
-use hough_init::{
-    Chord, HoughLine, LaneInit, OrientedPoint, Parabola, choose_ego_pair, fit_around_line,
-    init_lane,
-};
+use hough_init::{Chord, HoughLine, LaneInit, OrientedPoint, Parabola, choose_ego_pair, init_lane};
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
 use vision_gradient::{
@@ -140,7 +137,7 @@ impl LaneTracker {
     /// Stages I–II over the rows `self.search_rows`; with the joint initialisation, the Hough
     /// candidates of the bands `vote[k]` only, and with `set_aside_weak` a weak lane the choice
     /// gives nothing to set aside ([`Self::initialise_jointly`]).
-    fn initialise_in_roi(
+    pub(super) fn initialise_in_roi(
         &mut self,
         image: &GreyImage<'_>,
         vote: [bool; 2],
@@ -218,7 +215,7 @@ impl LaneTracker {
     /// `self.candidates` = the edge pixels that count as `class` ([`counts_as`]: those of the
     /// class and the near-vertical ones of either), from the last full-ROI gradient, the
     /// paired ones `gradient.stripe_paired_votes` times.
-    fn fill_candidates(&mut self, class: EdgeClass) {
+    pub(super) fn fill_candidates(&mut self, class: EdgeClass) {
         self.candidates.clear();
         let near_vertical = self.near_vertical_either_class();
         extend_with_class(
@@ -474,8 +471,7 @@ impl LaneTracker {
             if owners[i].is_some() || (replaced && !competes[i]) {
                 continue;
             }
-            self.fill_candidates(classes[j]);
-            if let Ok(init) = fit_around_line(&self.candidates, lines[j], &self.init_params) {
+            if let Ok(init) = self.fit_chosen_line(classes[j], lines[j]) {
                 // The estimate a switch replaces is kept for the crossing gate, which restores
                 // it if it undoes the switch.
                 let lane = &self.lanes[i];

@@ -12,6 +12,7 @@ use crate::error::FilterFailure;
 use crate::wrls_lane::WrlsLane;
 use crate::{GreyFrame, TrackerConfig, TrackerError};
 
+mod chosen_fit;
 mod double_line;
 mod init;
 mod kerb;
@@ -433,6 +434,9 @@ pub struct LaneTracker {
     /// Frames since the last one whose whole ROI went through the gradient (an initialisation
     /// or a re-validation).
     frames_since_full_gradient: u64,
+    /// Per image row, the columns of the nearest candidate pixels on each side that
+    /// `fill_candidates_near` left out (`init::fit_chosen_line`).
+    left_out_cols: Box<[(f32, f32)]>,
 }
 
 impl LaneTracker {
@@ -531,6 +535,7 @@ impl LaneTracker {
             of_class: Vec::with_capacity(capacity + 1),
             scratch: Vec::with_capacity(capacity),
             residual_hist: Box::new([[0; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]),
+            left_out_cols: vec![(f32::NEG_INFINITY, f32::INFINITY); height].into_boxed_slice(),
             kerb_rows: Vec::with_capacity(height),
             row_norm,
             q,

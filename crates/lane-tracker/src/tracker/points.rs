@@ -407,11 +407,15 @@ impl LaneTracker {
             } else {
                 self.scratch.iter().filter(|c| is_inlier(c)).count()
             };
-            let mut decimation = Decimation::new(max_points, total);
-            for c in self.scratch.iter().filter(|c| is_inlier(c)) {
-                if decimation.keep() {
-                    lane.points.push((f32::from(c.col_px), f32::from(c.row_px)));
-                }
+            let inliers = self.scratch.iter().filter(|c| is_inlier(c));
+            let point = |c: &Candidate| (f32::from(c.col_px), f32::from(c.row_px));
+            if total <= max_points {
+                lane.points.extend(inliers.map(point));
+            } else {
+                // (The decimation's test hoisted out of the loop.)
+                let mut decimation = Decimation::new(max_points, total);
+                lane.points
+                    .extend(inliers.filter(|_| decimation.keep()).map(point));
             }
         }
         let mut run: Option<(u16, u16, u16)> = None;

@@ -863,6 +863,80 @@ fn a_lane_on_a_kerbs_top_edge_is_reported_on_its_foot_and_stays_there() {
     }
 }
 
+#[test]
+fn a_chosen_lines_fit_on_the_pixels_near_it_equals_the_fit_on_all_of_them() {
+    // The fit of a chosen line reads only the candidate pixels near the line
+    // (`fit_chosen_line`); it must be the fit on all of them, bit for bit, and leave the same
+    // pixels of the line's band for `install`. Lines swept across frames with clutter (a
+    // crosswalk, a kerb) take both paths: the pixels near the line, and the full set where a
+    // refit reaches a pixel left out.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let frames = [
+        two_marks(320, 240),
+        crosswalk(320, 240, true),
+        kerb_right(320, 240, false, 0.0),
+    ];
+    let (mut near, mut full) = (0, 0);
+    for frame in &frames {
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        tracker.track(frame).expect("a frame");
+        // The buffers hold the last search's pixels; search those rows again.
+        tracker.search_rows = tracker.roi;
+        tracker
+            .initialise_in_roi(&image_of(frame), [true, true], false)
+            .expect("a search");
+        let params = tracker.init_params;
+        let (top, bottom) = tracker.roi;
+        let mid = 0.5 * (top + bottom) as f64;
+        let in_band = |t: &LaneTracker, line: &hough_init::HoughLine| -> Vec<(f32, f32)> {
+            let (s, c) = line.theta_rad.sin_cos();
+            t.candidates
+                .iter()
+                .copied()
+                .filter(|&(x, y)| {
+                    (f64::from(x) * c + f64::from(y) * s - line.rho_px).abs() <= params.band_px
+                })
+                .collect()
+        };
+        for class in [EdgeClass::LeftLane, EdgeClass::RightLane] {
+            for theta_deg in (-60..=60).step_by(4) {
+                for col in (20..320).step_by(12) {
+                    let theta_rad = f64::from(theta_deg).to_radians();
+                    let line = hough_init::HoughLine {
+                        rho_px: f64::from(col) * theta_rad.cos() + mid * theta_rad.sin(),
+                        theta_rad,
+                        votes: 0,
+                    };
+                    let fit = tracker.fit_chosen_line(class, line);
+                    let kept = in_band(&tracker, &line);
+                    let took_near =
+                        matches!(tracker.fit_chosen_line_near(class, line), Ok(Some(_)));
+                    tracker.fill_candidates(class);
+                    let all = hough_init::fit_around_line(&tracker.candidates, line, &params);
+                    assert_eq!(fit, all, "class {class:?}, θ {theta_deg}°, column {col}");
+                    if fit.is_ok() {
+                        assert_eq!(kept, in_band(&tracker, &line));
+                        if took_near {
+                            near += 1;
+                        } else {
+                            full += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        near > 100 && full > 5,
+        "fits on the pixels near the line {near}, on all {full}"
+    );
+}
+
+/// A frame as the tracker's image type.
+fn image_of(f: &GreyFrame) -> GreyImage<'_> {
+    GreyImage::new(f.data(), f.width(), f.height(), f.width()).expect("an image")
+}
+
 /// The branch-free append of one class's pixels keeps exactly those pixels, in their order,
 /// after the points already there, and within the room it documents (`pixels.len() + 1`
 /// beyond the points held) it does not allocate.

@@ -1,0 +1,112 @@
+//! The least-squares fit of a chosen Hough line (`hough_init::fit_around_line`) read from the
+//! candidate pixels near the line instead of all of them: the same fit, bit for bit, at a
+//! fraction of its passes over the pixels.
+
+use hough_init::{
+    HoughError, HoughLine, LaneInit, Parabola, fit_around_line, fit_around_line_where,
+};
+use vision_gradient::EdgeClass;
+
+use super::LaneTracker;
+use super::init::counts_as;
+
+/// How far beyond its own band a chosen line's candidate pixels are gathered for its fit, in
+/// bands of `init.band_half_width_px` (`LaneTracker::fit_chosen_line`): a selection of the fit
+/// that reaches farther, to a pixel left out, has the full set fitted instead.
+const CHOSEN_LINE_REACH_BANDS: f64 = 5.0;
+
+impl LaneTracker {
+    /// `hough_init::fit_around_line` of a chosen `line` on the candidate pixels of `class`,
+    /// leaving in `self.candidates` the pixels it was fitted on (`install` reads them): first on
+    /// those within the line's band plus [`CHOSEN_LINE_REACH_BANDS`] bands of
+    /// `init.band_half_width_px` of its columns, in their order in the full set — the same fit
+    /// bit for bit as long as no selection of the fit reaches a pixel left out
+    /// (`hough_init::fit_around_line_where`, asked row by row against the nearest pixels left
+    /// out on each side), at a fraction of its passes over the pixels — else on the full set.
+    pub(super) fn fit_chosen_line(
+        &mut self,
+        class: EdgeClass,
+        line: HoughLine,
+    ) -> Result<LaneInit, HoughError> {
+        if let Some(init) = self.fit_chosen_line_near(class, line)? {
+            return Ok(init);
+        }
+        self.fill_candidates(class);
+        fit_around_line(&self.candidates, line, &self.init_params)
+    }
+
+    /// [`Self::fit_chosen_line`]'s fit on the pixels near the line, `None` where a selection
+    /// of the fit reaches a pixel left out (or the line is degenerate).
+    pub(super) fn fit_chosen_line_near(
+        &mut self,
+        class: EdgeClass,
+        line: HoughLine,
+    ) -> Result<Option<LaneInit>, HoughError> {
+        let band_px = self.init_params.band_px;
+        let (sin_t, cos_t) = line.theta_rad.sin_cos();
+        let reach_px = band_px / cos_t.abs() + CHOSEN_LINE_REACH_BANDS * band_px;
+        // The line's column at row y: ρ/cos θ − y·tan θ.
+        let (col_at_0, per_row) = (line.rho_px / cos_t, -sin_t / cos_t);
+        if !(reach_px.is_finite() && col_at_0.is_finite() && per_row.is_finite()) {
+            return Ok(None);
+        }
+        self.fill_candidates_near(class, col_at_0, per_row, reach_px);
+        let (top, bottom) = self.search_rows;
+        let left_out = &self.left_out_cols;
+        // Whether no pixel left out lies within `h` (and half a pixel, for rounding) of the
+        // curve `c` on any row: the nearest ones on each side are farther.
+        let complete = |c: &Parabola, h: f64| {
+            (top..bottom).all(|r| {
+                let Some(&(left, right)) = left_out.get(r) else {
+                    return true;
+                };
+                let x = c.col_at_row(r as f64);
+                f64::from(left) < x - h - 0.5 && f64::from(right) > x + h + 0.5
+            })
+        };
+        fit_around_line_where(&self.candidates, line, &self.init_params, complete)
+    }
+
+    /// [`Self::fill_candidates`] restricted to the pixels within `reach_px` columns of the line
+    /// `x = col_at_0 + per_row·y`, in the same order; `self.left_out_cols[r]` = the columns of
+    /// the nearest candidate pixels of row `r` left out on each side (`±∞` without one), over
+    /// the rows searched. No allocation (a subset of what `fill_candidates` holds).
+    fn fill_candidates_near(
+        &mut self,
+        class: EdgeClass,
+        col_at_0: f64,
+        per_row: f64,
+        reach_px: f64,
+    ) {
+        self.candidates.clear();
+        let (top, bottom) = self.search_rows;
+        if let Some(rows) = self.left_out_cols.get_mut(top..bottom) {
+            rows.fill((f32::NEG_INFINITY, f32::INFINITY));
+        }
+        let near_vertical = self.near_vertical_either_class();
+        // The edge pixels, then the paired ones `stripe_paired_votes − 1` more times.
+        let repeats = usize::from(self.cfg.gradient.stripe_paired_votes.max(1)) - 1;
+        for pixels in std::iter::once(self.edges.pixels())
+            .chain(std::iter::repeat_n(self.paired.pixels(), repeats))
+        {
+            for row in pixels.chunk_by(|a, b| a.row_px == b.row_px) {
+                let Some(first) = row.first() else { continue };
+                let centre = col_at_0 + per_row * f64::from(first.row_px);
+                let Some(left_out) = self.left_out_cols.get_mut(usize::from(first.row_px)) else {
+                    continue;
+                };
+                for p in row.iter().filter(|p| counts_as(p, class, near_vertical)) {
+                    let offset = f64::from(p.col_px) - centre;
+                    let col = f32::from(p.col_px);
+                    if offset.abs() <= reach_px {
+                        self.candidates.push((col, f32::from(p.row_px)));
+                    } else if offset < 0.0 {
+                        left_out.0 = left_out.0.max(col);
+                    } else {
+                        left_out.1 = left_out.1.min(col);
+                    }
+                }
+            }
+        }
+    }
+}
