@@ -1,5 +1,7 @@
 //! Stage II: Hough line → pixels near it → least-squares parabola.
 
+use std::convert::Infallible;
+
 use serde::{Deserialize, Serialize};
 
 use crate::parabola::{fit_impl, fit_normalised};
@@ -77,10 +79,11 @@ where
     I: IntoIterator + Clone,
     I::Item: PixelPoint,
 {
-    // Every intermediate parabola is accepted, so the result is always there (the error is
-    // unreachable).
-    fit_around_line_checked(points, line, params, |_| true)
-        .and_then(|fit| fit.ok_or(HoughError::NonFiniteResult { what: "fit" }))
+    // Every intermediate parabola is accepted.
+    match fit_around_line_checked(points, line, params, |_| Ok::<(), Infallible>(()))? {
+        Ok(fit) => Ok(fit),
+        Err(never) => match never {},
+    }
 }
 
 /// [`fit_around_line`] on a subset of the points, when the caller can tell that it gives the
@@ -91,10 +94,13 @@ where
 /// set within `h` of `c` (with a margin for rounding: the test here is on the perpendicular
 /// distance for the line). If it says so each time, the sums run over the same points in the
 /// same order as on the full set (`points` in their order there), and the result is equal bit
-/// for bit; `Ok(None)` as soon as it does not (the caller fits the full set instead).
+/// for bit; `Ok(None)` as soon as it does not (the caller fits the full set instead), and for a
+/// line within [`MIN_WHERE_COS`] of horizontal in its normal's cosine (its columns per row are
+/// too large for the test to be exact).
 ///
 /// # Errors
-/// As [`fit_around_line`].
+/// As [`fit_around_line`] on the full set, but [`HoughError::NonFinitePoint`] is only found
+/// among `points` (and indexed there).
 pub fn fit_around_line_where<I, C>(
     points: I,
     line: HoughLine,
@@ -114,24 +120,30 @@ where
     };
     let line_half_px = params.band_px / cos_t.abs();
     let finite = line_half_px.is_finite() && line_curve.a2.is_finite() && line_curve.a3.is_finite();
-    if !(finite && complete(&line_curve, line_half_px)) {
+    if !(cos_t.abs() >= MIN_WHERE_COS && finite && complete(&line_curve, line_half_px)) {
         return Ok(None);
     }
-    fit_around_line_checked(points, line, params, |p| complete(p, params.band_px))
+    let accept = |p: &Parabola| complete(p, params.band_px).then_some(()).ok_or(());
+    Ok(fit_around_line_checked(points, line, params, accept)?.ok())
 }
 
+/// Least `|cos θ|` of a line [`fit_around_line_where`] fits on a subset: nearer to horizontal,
+/// the line's columns (`ρ/cos θ`, `y·tan θ`) carry rounding errors that the completeness
+/// test's half-pixel margin may not cover.
+pub const MIN_WHERE_COS: f64 = 1e-6;
+
 /// [`fit_around_line`] with `accept` asked about each intermediate parabola before the pixels
-/// near it are selected: `Ok(None)` as soon as it refuses one.
-fn fit_around_line_checked<I, A>(
+/// near it are selected: `Ok(Err(e))` as soon as it refuses one with `e`.
+fn fit_around_line_checked<I, A, E>(
     points: I,
     line: HoughLine,
     params: &LaneInitParams,
     accept: A,
-) -> Result<Option<LaneInit>, HoughError>
+) -> Result<Result<LaneInit, E>, HoughError>
 where
     I: IntoIterator + Clone,
     I::Item: PixelPoint,
-    A: Fn(&Parabola) -> bool,
+    A: Fn(&Parabola) -> Result<(), E>,
 {
     params.validate()?;
     let band_px = params.band_px;
@@ -155,8 +167,8 @@ where
         )?
         .parabola()?;
         for _ in 1..params.refit_iterations {
-            if !accept(&p) {
-                return Ok(None);
+            if let Err(e) = accept(&p) {
+                return Ok(Err(e));
             }
             let near = |x: f64, y: f64| (x - p.col_at_row(y)).abs() <= band_px;
             p = fit_normalised(
@@ -167,8 +179,8 @@ where
             )?
             .parabola()?;
         }
-        if !accept(&p) {
-            return Ok(None);
+        if let Err(e) = accept(&p) {
+            return Ok(Err(e));
         }
         fit_impl(
             points.clone(),
@@ -177,7 +189,7 @@ where
             PointSet::NearParabola,
         )?
     };
-    Ok(Some(LaneInit {
+    Ok(Ok(LaneInit {
         parabola: fit.parabola,
         line,
         points_used: fit.points_used,
@@ -334,6 +346,16 @@ mod tests {
         assert!((asked[0].0 - 150.0).abs() < 1e-9);
         assert!((asked[0].1 - params.band_px / theta.cos()).abs() < 1e-12);
         assert!(asked[1..].iter().all(|&(_, h)| h == params.band_px));
+        // A horizontal line (cos θ = 6e-17): no subset fit, whatever the test says.
+        let flat = HoughLine {
+            rho_px: 150.0,
+            theta_rad: std::f64::consts::FRAC_PI_2,
+            votes: 0,
+        };
+        assert_eq!(
+            fit_around_line_where(&pts, flat, &params, |_, _| true),
+            Ok(None)
+        );
         for refuse_at in 0..=params.refit_iterations {
             let calls = std::cell::Cell::new(0);
             let fit = fit_around_line_where(&pts, line, &params, |_, _| {

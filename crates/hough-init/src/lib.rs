@@ -166,7 +166,7 @@ pub use error::{HoughError, PointSet};
 /// The workspace's one pixel point type (crate `grey-frame`), re-exported.
 pub use grey_frame::PixelPoint;
 pub use hough::{HoughLine, HoughWorkspace, MAX_ACCUMULATOR_CELLS, MAX_IMAGE_SIDE_PX};
-pub use init::{LaneInit, fit_around_line, fit_around_line_where, init_lane};
+pub use init::{LaneInit, MIN_WHERE_COS, fit_around_line, fit_around_line_where, init_lane};
 pub use parabola::{MIN_RELATIVE_PIVOT, Parabola, ParabolaFit, fit_parabola, fit_parabola_where};
 pub use params::{AngleBand, HoughParams, LaneInitParams};
 pub use point::{OrientedPoint, Point};

@@ -266,10 +266,11 @@ pub struct LaneTotals {
 
 /// The predictions a frame, a set or all sets got wrong under TuSimple's rule (`predicted −
 /// matched` of [`LaneTotals`]), by what they lie on: a prediction on a side with no label lane
-/// (a side labelled only in the far field is not scored, nor its prediction); one that meets the rule against another labelled marking of the frame (the other ego
-/// side's label lane or an `Other` one: a neighbour's mark, or the two sides swapped); one with
-/// at least half its label lane's points within the tolerance (the right mark, off by a little:
-/// one edge of a wide mark, a bent end); the rest. The four add up to the unmatched predictions.
+/// (a side labelled only in the far field is not scored, nor its prediction); one that meets
+/// the rule against another labelled marking of the frame (the other ego side's label lane or
+/// an `Other` one: a neighbour's mark, or the two sides swapped); one with at least half its
+/// label lane's points within the tolerance (the right mark, off by a little: one edge of a
+/// wide mark, a bent end); the rest. The four add up to the unmatched predictions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct FalsePositives {
     /// On a side with no label lane.

@@ -1,6 +1,6 @@
 //! The least-squares fit of a chosen Hough line (`hough_init::fit_around_line`) read from the
-//! candidate pixels near the line instead of all of them: the same fit, bit for bit, at a
-//! fraction of its passes over the pixels.
+//! candidate pixels near the line instead of all of them: the same fit, bit for bit, its passes
+//! running over a fraction of the pixels (gathering them is one scan of the edge pixels).
 
 use hough_init::{
     HoughError, HoughLine, LaneInit, Parabola, fit_around_line, fit_around_line_where,
@@ -22,7 +22,7 @@ impl LaneTracker {
     /// `init.band_half_width_px` of its columns, in their order in the full set — the same fit
     /// bit for bit as long as no selection of the fit reaches a pixel left out
     /// (`hough_init::fit_around_line_where`, asked row by row against the nearest pixels left
-    /// out on each side), at a fraction of its passes over the pixels — else on the full set.
+    /// out on each side), its passes running over a fraction of the pixels — else on the full set.
     pub(super) fn fit_chosen_line(
         &mut self,
         class: EdgeClass,

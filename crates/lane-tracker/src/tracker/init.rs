@@ -520,9 +520,10 @@ impl LaneTracker {
     /// Lane `from` becomes lane `to`: its filter, state and buffers move, each slot keeps its
     /// side, edge class and angle band and a lane set aside on this frame (`Lane::set_aside`:
     /// the searches replace it on its side), and a kerb's offset is dropped (it was read
-    /// towards the old side). With `drop_other`, the lane that was at `to` is dropped into slot `from` (no
-    /// estimate, no windows or points: the choice's candidate for that side, if any, is
-    /// installed next); without, the two are swapped. No allocation (the buffers are swapped).
+    /// towards the old side). With `drop_other`, the lane that was at `to` is dropped into slot
+    /// `from` (no estimate, no windows or points: the choice's candidate for that side, if any,
+    /// is installed next); without, the two are swapped. No allocation (the buffers are
+    /// swapped).
     pub(super) fn hand_over(&mut self, from: usize, to: usize, drop_other: bool) {
         if from == to || from > 1 || to > 1 {
             return;

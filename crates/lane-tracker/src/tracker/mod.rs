@@ -435,7 +435,7 @@ pub struct LaneTracker {
     /// or a re-validation).
     frames_since_full_gradient: u64,
     /// Per image row, the columns of the nearest candidate pixels on each side that
-    /// `fill_candidates_near` left out (`init::fit_chosen_line`).
+    /// `fill_candidates_near` left out (`chosen_fit::fit_chosen_line`).
     left_out_cols: Box<[(f32, f32)]>,
 }
 
