@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{AngleBand, HoughError, HoughParams, OrientedPoint, PixelPoint, PointSet};
+use crate::{AngleBand, HoughError, HoughParams, OrientedPoint, Parabola, PixelPoint, PointSet};
 
 /// Largest accepted image side, pixels.
 pub const MAX_IMAGE_SIDE_PX: usize = 1 << 14;
@@ -63,6 +63,21 @@ impl HoughLine {
     pub fn col_at_row(&self, row_px: f64) -> Option<f64> {
         let (s, c) = self.theta_rad.sin_cos();
         (c.abs() >= 1e-12).then(|| (self.rho_px - row_px * s) / c)
+    }
+
+    /// The line as a curve of the column by row, `x = ρ/cos θ − y·tan θ` (a [`Parabola`] with
+    /// `a1 = 0`), with `|cos θ|`; `None` for a line within `min_cos` of horizontal
+    /// (`|cos θ| < min_cos`) or non-finite coefficients.
+    #[must_use]
+    pub fn columns(&self, min_cos: f64) -> Option<(Parabola, f64)> {
+        let (s, c) = self.theta_rad.sin_cos();
+        let curve = Parabola {
+            a1: 0.0,
+            a2: -s / c,
+            a3: self.rho_px / c,
+        };
+        (c.abs() >= min_cos && curve.a2.is_finite() && curve.a3.is_finite())
+            .then_some((curve, c.abs()))
     }
 }
 

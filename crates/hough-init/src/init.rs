@@ -112,15 +112,10 @@ where
     I::Item: PixelPoint,
     C: Fn(&Parabola, f64) -> bool,
 {
-    let (sin_t, cos_t) = line.theta_rad.sin_cos();
-    let line_curve = Parabola {
-        a1: 0.0,
-        a2: -sin_t / cos_t,
-        a3: line.rho_px / cos_t,
+    let Some((line_curve, cos_abs)) = line.columns(MIN_WHERE_COS) else {
+        return Ok(None);
     };
-    let line_half_px = params.band_px / cos_t.abs();
-    let finite = line_half_px.is_finite() && line_curve.a2.is_finite() && line_curve.a3.is_finite();
-    if !(cos_t.abs() >= MIN_WHERE_COS && finite && complete(&line_curve, line_half_px)) {
+    if !complete(&line_curve, params.band_px / cos_abs) {
         return Ok(None);
     }
     let accept = |p: &Parabola| complete(p, params.band_px).then_some(()).ok_or(());

@@ -109,7 +109,9 @@
 //! curve the two boundaries may lean the same way. Without a plausible pair a single line is
 //! reported, with `EgoPairParams::lone_min_lean_deg` not a near-vertical one (alone, it may be a
 //! door frame or a pole). [`fit_around_line`] is the least-squares
-//! half of [`init_lane`] for a chosen line.
+//! half of [`init_lane`] for a chosen line; [`fit_around_line_where`] the same fit on the points
+//! near the line only, when the caller can vouch before each selection that none left out would
+//! be kept (then equal bit for bit).
 //!
 //! [`HoughWorkspace::find_lines_oriented`] restricts the vote by orientation: an
 //! [`OrientedPoint`] carries the normal angle `θ_p` of its edge (its Sobel gradient direction,

@@ -385,9 +385,13 @@ fn scored_points(labels: &LabelFrame, side: LabelSide, y_top: f64) -> Vec<[f64; 
         .lanes
         .iter()
         .filter(|l| l.side == side)
-        .flat_map(|l| l.points.iter().copied())
-        .filter(|p| p[1] >= y_top)
+        .flat_map(|l| lane_scored_points(l, y_top))
         .collect()
+}
+
+/// The points of one label lane at or below row `y_top`.
+fn lane_scored_points(lane: &LabelLane, y_top: f64) -> impl Iterator<Item = [f64; 2]> + '_ {
+    lane.points.iter().copied().filter(move |p| p[1] >= y_top)
 }
 
 /// TuSimple accuracy of prediction `c` on the scored label points `pts` (at least 2), with the
@@ -437,11 +441,7 @@ fn on_another_marking(
             .lanes
             .iter()
             .filter(|l| l.side == LabelSide::Other)
-            .any(|l| {
-                let pts: Vec<[f64; 2]> =
-                    l.points.iter().copied().filter(|p| p[1] >= y_top).collect();
-                meets(&pts)
-            })
+            .any(|l| meets(&lane_scored_points(l, y_top).collect::<Vec<_>>()))
 }
 
 /// Score one frame's ego prediction against its labels under `rules`.

@@ -3,12 +3,13 @@
 //! running over a fraction of the pixels (gathering them is one scan of the edge pixels).
 
 use hough_init::{
-    HoughError, HoughLine, LaneInit, Parabola, fit_around_line, fit_around_line_where,
+    HoughError, HoughLine, LaneInit, MIN_WHERE_COS, Parabola, fit_around_line,
+    fit_around_line_where,
 };
 use vision_gradient::EdgeClass;
 
 use super::LaneTracker;
-use super::init::counts_as;
+use super::init::{candidate_sources, counts_as};
 
 /// How far beyond its own band a chosen line's candidate pixels are gathered for its fit, in
 /// bands of `init.band_half_width_px` (`LaneTracker::fit_chosen_line`): a selection of the fit
@@ -43,14 +44,12 @@ impl LaneTracker {
         line: HoughLine,
     ) -> Result<Option<LaneInit>, HoughError> {
         let band_px = self.init_params.band_px;
-        let (sin_t, cos_t) = line.theta_rad.sin_cos();
-        let reach_px = band_px / cos_t.abs() + CHOSEN_LINE_REACH_BANDS * band_px;
-        // The line's column at row y: ρ/cos θ − y·tan θ.
-        let (col_at_0, per_row) = (line.rho_px / cos_t, -sin_t / cos_t);
-        if !(reach_px.is_finite() && col_at_0.is_finite() && per_row.is_finite()) {
+        // (A line `fit_around_line_where` would not fit on a subset is fitted on the full set.)
+        let Some((line_cols, cos_abs)) = line.columns(MIN_WHERE_COS) else {
             return Ok(None);
-        }
-        self.fill_candidates_near(class, col_at_0, per_row, reach_px);
+        };
+        let reach_px = band_px / cos_abs + CHOSEN_LINE_REACH_BANDS * band_px;
+        self.fill_candidates_near(class, &line_cols, reach_px);
         let (top, bottom) = self.search_rows;
         let left_out = &self.left_out_cols;
         // Whether no pixel left out lies within `h` (and half a pixel, for rounding) of the
@@ -68,30 +67,21 @@ impl LaneTracker {
     }
 
     /// [`Self::fill_candidates`] restricted to the pixels within `reach_px` columns of the line
-    /// `x = col_at_0 + per_row·y`, in the same order; `self.left_out_cols[r]` = the columns of
+    /// `line_cols` (its column by row), in the same order (`init::candidate_sources`); `self.left_out_cols[r]` = the columns of
     /// the nearest candidate pixels of row `r` left out on each side (`±∞` without one), over
     /// the rows searched. No allocation (a subset of what `fill_candidates` holds).
-    fn fill_candidates_near(
-        &mut self,
-        class: EdgeClass,
-        col_at_0: f64,
-        per_row: f64,
-        reach_px: f64,
-    ) {
+    fn fill_candidates_near(&mut self, class: EdgeClass, line_cols: &Parabola, reach_px: f64) {
         self.candidates.clear();
         let (top, bottom) = self.search_rows;
         if let Some(rows) = self.left_out_cols.get_mut(top..bottom) {
             rows.fill((f32::NEG_INFINITY, f32::INFINITY));
         }
         let near_vertical = self.near_vertical_either_class();
-        // The edge pixels, then the paired ones `stripe_paired_votes − 1` more times.
-        let repeats = usize::from(self.cfg.gradient.stripe_paired_votes.max(1)) - 1;
-        for pixels in std::iter::once(self.edges.pixels())
-            .chain(std::iter::repeat_n(self.paired.pixels(), repeats))
-        {
+        let votes = self.cfg.gradient.stripe_paired_votes;
+        for pixels in candidate_sources(&self.edges, &self.paired, votes) {
             for row in pixels.chunk_by(|a, b| a.row_px == b.row_px) {
                 let Some(first) = row.first() else { continue };
-                let centre = col_at_0 + per_row * f64::from(first.row_px);
+                let centre = line_cols.col_at_row(f64::from(first.row_px));
                 let Some(left_out) = self.left_out_cols.get_mut(usize::from(first.row_px)) else {
                     continue;
                 };

@@ -7,8 +7,8 @@ use hough_init::{Chord, HoughLine, LaneInit, OrientedPoint, Parabola, choose_ego
 use info_filter::ParabolaKif;
 use nalgebra::Vector3;
 use vision_gradient::{
-    EdgeClass, EdgePixel, GreyImage, Region, drop_periodic_stripes, gradient_normal_deg,
-    keep_bright_stripes, split_stripes,
+    EdgeBuffer, EdgeClass, EdgePixel, GreyImage, Region, drop_periodic_stripes,
+    gradient_normal_deg, keep_bright_stripes, split_stripes,
 };
 
 use super::points::{NEAR_VERTICAL_SLOPE, fit_profile};
@@ -79,6 +79,19 @@ pub(super) fn extend_with_class(
     extend_with_class_by(points, pixels, class, near_vertical_q14, |_, p| {
         (f32::from(p.col_px), f32::from(p.row_px))
     });
+}
+
+/// Where `LaneTracker::fill_candidates` takes its pixels from, in their order: the edge pixels,
+/// then the paired ones `stripe_paired_votes − 1` more times (weighted stripe pairing: the sides
+/// of bright stripes count `gradient.stripe_paired_votes` times in all, the other edge pixels
+/// once).
+pub(super) fn candidate_sources<'a>(
+    edges: &'a EdgeBuffer,
+    paired: &'a EdgeBuffer,
+    stripe_paired_votes: u8,
+) -> impl Iterator<Item = &'a [EdgePixel]> {
+    let repeats = usize::from(stripe_paired_votes.max(1)) - 1;
+    std::iter::once(edges.pixels()).chain(std::iter::repeat_n(paired.pixels(), repeats))
 }
 
 impl LaneTracker {
@@ -218,23 +231,9 @@ impl LaneTracker {
     pub(super) fn fill_candidates(&mut self, class: EdgeClass) {
         self.candidates.clear();
         let near_vertical = self.near_vertical_either_class();
-        extend_with_class(
-            &mut self.candidates,
-            self.edges.pixels(),
-            class,
-            near_vertical,
-        );
-        // Weighted stripe pairing: the sides of bright stripes count `stripe_paired_votes`
-        // times in all, the other edge pixels once.
-        if self.cfg.gradient.stripe_paired_votes > 0 {
-            for _ in 1..self.cfg.gradient.stripe_paired_votes {
-                extend_with_class(
-                    &mut self.candidates,
-                    self.paired.pixels(),
-                    class,
-                    near_vertical,
-                );
-            }
+        let votes = self.cfg.gradient.stripe_paired_votes;
+        for pixels in candidate_sources(&self.edges, &self.paired, votes) {
+            extend_with_class(&mut self.candidates, pixels, class, near_vertical);
         }
     }
 
