@@ -334,6 +334,14 @@ pub struct TrackConfig {
     /// edge pixels with `R = filter.r_sigma_px²·I`.
     #[serde(default)]
     pub mark_centres: bool,
+    /// `true`: an edge pixel that bounds a bright stripe at most `gradient.stripe_max_width_px`
+    /// wide whose two sides are alike (a mark on the floor, not a kerb's face) measures the
+    /// stripe's middle, not its own column (an addition beyond the paper, crate docs "Stripe
+    /// middles"); `false` (default when absent): the paper's edge pixels. No effect with
+    /// `mark_centres`, which measure the middle themselves, or with
+    /// `gradient.stripe_max_width_px = 0`.
+    #[serde(default)]
+    pub stripe_middles: bool,
     /// Half-width of the window of the windowed refinement that follows an initialisation on
     /// the same frame, px (1..=200; an addition beyond the paper); 0 (default when absent):
     /// `window_half_width_px`.

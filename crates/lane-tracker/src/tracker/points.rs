@@ -6,19 +6,31 @@ use hough_init::Parabola;
 use info_filter::{PowerSums, RowNorm};
 use lane_geometry::{FIT_SAMPLES, FitRows};
 use nalgebra::{Matrix3, Vector3};
-use vision_gradient::{EdgeClass, GreyImage};
+use vision_gradient::{EdgeClass, EdgePixel, GreyImage};
 
 use super::LaneTracker;
 
 /// A window pixel during point selection.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Candidate {
+    /// The measured column rounded down: the pixel's, or its bright stripe's middle
+    /// (`track.stripe_middles`, [`stripe_middle`]).
     col_px: u16,
     row_px: u16,
-    /// Residual `x − x̂(y)` rounded, plus the window half-width (0..=2w).
+    /// Residual `col_px − x̂(y)` rounded, plus the window half-width (0..=2w).
     bin: u16,
     /// Third of the rows searched (0, 1, 2).
     band: u8,
+    /// The measured column is `col_px + ½` (a stripe middle between two columns).
+    half_col: bool,
+}
+
+impl Candidate {
+    /// The measured point `(x, y)`, px.
+    fn point(&self) -> (f32, f32) {
+        let half = if self.half_col { 0.5 } else { 0.0 };
+        (f32::from(self.col_px) + half, f32::from(self.row_px))
+    }
 }
 
 /// Sub-pixel column of a lane mark in one image row: the centroid of its grey level above the
@@ -246,6 +258,48 @@ fn residual_bin(col_px: u16, offset: i32, bin_max: i32) -> usize {
     (i32::from(col_px) + offset).max(0).min(bin_max) as usize
 }
 
+/// The column `row[j]` measures with `track.stripe_middles`: the middle of the bright stripe it
+/// bounds, `None` where it bounds none (it measures its own column then). `row` is one image
+/// row's edge pixels (columns increasing, [`vision_gradient::EdgeBuffer`]), `grey` that row's
+/// grey levels. The stripe is the one [`vision_gradient::split_stripes`] pairs: the nearest
+/// pixel of the same class and the opposite polarity on the pixel's bright side (right of a
+/// rising pixel, left of a falling one) within `max_w` columns; the scan stops `max_w` columns
+/// away. Its middle is taken only where the stripe stands on a floor alike on both sides: the
+/// grey levels two columns outside its edges differ by at most half its contrast (its middle
+/// pixel above their mean), the test [`mark_centre`] uses to tell a mark from a step. A kerb's
+/// face, bright between the road and a pavement of another grey, is a step whose foot the lane
+/// keeps (`init.kerb_foot`); a mark is a stripe whose middle the labels and the lane model mean.
+fn stripe_middle(row: &[EdgePixel], j: usize, grey: &[u8], max_w: u16) -> Option<(u16, bool)> {
+    let p = row.get(j)?;
+    let partner = |q: &&EdgePixel| q.class == p.class && (q.gx > 0) != (p.gx > 0);
+    let (a, b) = if p.gx > 0 {
+        let reach = p.col_px.saturating_add(max_w);
+        let q = row
+            .get(j + 1..)?
+            .iter()
+            .take_while(|q| q.col_px <= reach)
+            .find(partner)?;
+        (p.col_px, q.col_px)
+    } else {
+        let reach = p.col_px.saturating_sub(max_w);
+        let q = row
+            .get(..j)?
+            .iter()
+            .rev()
+            .take_while(|q| q.col_px >= reach)
+            .find(partner)?;
+        (q.col_px, p.col_px)
+    };
+    let (a, b) = (usize::from(a), usize::from(b));
+    let left = f32::from(*grey.get(a.checked_sub(2)?)?);
+    let right = f32::from(*grey.get(b + 2)?);
+    let inside = f32::from(*grey.get((a + b) / 2)?);
+    let contrast = inside - 0.5 * (left + right);
+    // (a + b)/2 ≤ b: a column of the row.
+    (contrast > 0.0 && (left - right).abs() <= 0.5 * contrast)
+        .then(|| (((a + b) / 2) as u16, (a + b) % 2 == 1))
+}
+
 /// Row bands of point selection's outlier rejection (thirds of the rows searched).
 pub(super) const BANDS: usize = 3;
 
@@ -261,6 +315,7 @@ impl LaneTracker {
         image: &GreyImage<'_>,
         coeffs: [f64; 3],
         w: i64,
+        refining: bool,
     ) {
         let (top, bottom) = self.search_rows;
         let max_points = self.cfg.track.max_points_per_lane;
@@ -293,6 +348,21 @@ impl LaneTracker {
         let gate = tolerance_deg > 0.0;
         let tan_tolerance = tolerance_deg.to_radians().tan() as f32;
         let predicted = Parabola::from_coeffs(coeffs);
+        // Stripe middles (`track.stripe_middles`; crate docs, "Stripe middles"): the widest
+        // bright stripe whose edge pixels measure its middle, 0 = each pixel its own column.
+        // Not for a lane on the middle of a double line: its windows hold both lines, whose
+        // four edges measure the middle between them (two middles, one per line, would leave
+        // the band gate a choice between the lines).
+        let on_double_line = lane.pair_half_gap_px > 0.0;
+        let stripe_w = if refining
+            && self.cfg.track.stripe_middles
+            && !self.cfg.track.mark_centres
+            && !on_double_line
+        {
+            self.cfg.gradient.stripe_max_width_px
+        } else {
+            0
+        };
         // The detector stores its pixels row by row: the prediction, its slope and the class
         // test are evaluated once per row, not once per pixel.
         for row_pixels in self.edges.pixels().chunk_by(|a, b| a.row_px == b.row_px) {
@@ -314,12 +384,13 @@ impl LaneTracker {
                 Some(EdgeClass::RightLane)
             };
             let slope_f32 = slope as f32;
+            let grey = if stripe_w > 0 { image.row(row) } else { None };
             let offset = bin_offset(col_pred, w);
             let band = usize::from(row >= band_rows[0]) + usize::from(row >= band_rows[1]);
             let Some(hist) = hist.get_mut(band) else {
                 continue;
             };
-            for p in row_pixels {
+            for (j, p) in row_pixels.iter().enumerate() {
                 if class.is_some_and(|c| p.class != c) {
                     continue;
                 }
@@ -330,16 +401,24 @@ impl LaneTracker {
                         continue;
                     }
                 }
-                let bin = residual_bin(p.col_px, offset, bin_max);
+                // (A middle between two columns is binned by the left one.)
+                let (col_px, half_col) = match grey {
+                    Some(grey) => {
+                        stripe_middle(row_pixels, j, grey, stripe_w).unwrap_or((p.col_px, false))
+                    }
+                    None => (p.col_px, false),
+                };
+                let bin = residual_bin(col_px, offset, bin_max);
                 if let Some(count) = hist.get_mut(bin) {
                     *count += 1;
                 }
                 if self.scratch.len() < self.scratch.capacity() {
                     self.scratch.push(Candidate {
-                        col_px: p.col_px,
+                        col_px,
                         row_px: p.row_px,
                         bin: bin as u16,
                         band: band as u8,
+                        half_col,
                     });
                 }
             }
@@ -408,7 +487,7 @@ impl LaneTracker {
                 self.scratch.iter().filter(|c| is_inlier(c)).count()
             };
             let inliers = self.scratch.iter().filter(|c| is_inlier(c));
-            let point = |c: &Candidate| (f32::from(c.col_px), f32::from(c.row_px));
+            let point = Candidate::point;
             if total <= max_points {
                 lane.points.extend(inliers.map(point));
             } else {
@@ -503,6 +582,63 @@ mod tests {
         let dark: Vec<u8> = row(15.2, 18.9).iter().map(|&p| 255 - p + 35).collect();
         let (x, _) = mark_centre(&dark, 15, 18, 0.0).unwrap();
         assert!((x - 17.05).abs() < 0.04, "{x}");
+    }
+
+    /// An edge pixel of `class` at `col` on row 0, rising (`gx > 0`) or falling.
+    fn edge(col: u16, rising: bool, class: EdgeClass) -> EdgePixel {
+        EdgePixel {
+            col_px: col,
+            row_px: 0,
+            magnitude: 300,
+            class,
+            gx: if rising { 150 } else { -150 },
+        }
+    }
+
+    #[test]
+    fn an_edge_pixel_of_a_bright_stripe_on_an_even_floor_measures_the_stripe_middle() {
+        use EdgeClass::{LeftLane as L, RightLane as R};
+        let measured = |px: &[EdgePixel], grey: &[u8], max_w: u16| -> Vec<f32> {
+            (0..px.len())
+                .map(|j| match stripe_middle(px, j, grey, max_w) {
+                    Some((col, half)) => f32::from(col) + if half { 0.5 } else { 0.0 },
+                    None => f32::from(px[j].col_px),
+                })
+                .collect()
+        };
+        // A mark [15, 25) on a floor of 90 on both sides: edges at 14/15 and 24/25.
+        let mark = row(15.0, 25.0);
+        let px = [
+            edge(14, true, L),
+            edge(15, true, L),
+            edge(24, false, L),
+            edge(25, false, L),
+        ];
+        assert_eq!(measured(&px, &mark, 16), [19.0, 19.5, 19.5, 20.0]);
+        // Wider than the widest stripe: each pixel its own column; the nearest partner counts.
+        assert_eq!(measured(&px, &mark, 9), [14.0, 19.5, 19.5, 25.0]);
+        assert_eq!(measured(&px, &mark, 8), [14.0, 15.0, 24.0, 25.0]);
+        // The partner must be of the pixel's class.
+        let mixed = [edge(15, true, L), edge(24, false, R)];
+        assert_eq!(measured(&mixed, &mark, 16), [15.0, 24.0]);
+        // A dark stripe (falling, then rising) is not a mark.
+        let dark = [edge(15, false, L), edge(24, true, L)];
+        assert_eq!(measured(&dark, &mark, 16), [15.0, 24.0]);
+        // A kerb's face: bright between the road (90) and a pavement of another grey (150 from
+        // column 26 on): a step, whose foot the lane keeps.
+        let mut kerb = mark.clone();
+        for g in &mut kerb[26..] {
+            *g = 150;
+        }
+        assert_eq!(measured(&px, &kerb, 16), [14.0, 15.0, 24.0, 25.0]);
+        // A pavement of almost the floor's grey is still a floor alike on both sides.
+        for g in &mut kerb[26..] {
+            *g = 110;
+        }
+        assert_eq!(measured(&px, &kerb, 16), [19.0, 19.5, 19.5, 20.0]);
+        // A stripe whose outside lies beyond the row is not measured.
+        assert_eq!(measured(&px, &mark[..26], 16), [14.0, 15.0, 24.0, 25.0]);
+        assert_eq!(stripe_middle(&px, 4, &mark, 16), None);
     }
 
     #[test]

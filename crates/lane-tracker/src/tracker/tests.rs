@@ -1764,3 +1764,44 @@ fn the_crossing_gate_undoes_a_switch_by_restoring_the_lane_it_replaced() {
         );
     }
 }
+
+/// `two_marks`' geometry with a wide left mark, as a tape beside a small robot's camera: `2·h(y)`
+/// px wide, 6 px at row 140 growing to 15 px at the bottom row (the default's widest stripe is
+/// 16 px), each pixel the area average of what it covers (grey 60 floor, 200 mark).
+fn wide_left_mark(w: usize, h: usize) -> GreyFrame {
+    let (left, right) = (mark_left, mark_right);
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        let half = 3.0 + 4.5 * (y - 140.0).max(0.0) / 99.0;
+        let (lo, hi) = (left(y) - half, left(y) + half);
+        let cover = ((x + 0.5).min(hi) - (x - 0.5).max(lo)).clamp(0.0, 1.0);
+        let right_cover =
+            ((x + 0.5).min(right(y) + 2.5) - (x - 0.5).max(right(y) - 2.5)).clamp(0.0, 1.0);
+        *p = (60.0 + 140.0 * cover.max(right_cover)).round() as u8;
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn a_wide_mark_is_initialised_on_its_middle_not_on_one_edge() {
+    let frame = wide_left_mark(320, 240);
+    let mut off = [0.0f64; 2];
+    for (k, middles) in [true, false].into_iter().enumerate() {
+        let mut cfg = TrackerConfig::default_preset().expect("the default preset");
+        cfg.track.stripe_middles = middles;
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let (top, bottom) = tracker.roi;
+        // The initialisation and its refinements on the same frame.
+        let report = tracker.track(&frame).expect("a frame");
+        assert!(report.lanes[0].initialised);
+        let c = report.lanes[0].coeffs.expect("a left lane");
+        for y in [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64] {
+            let d = c[0] * y * y + c[1] * y + c[2] - mark_left(y);
+            off[k] = off[k].max(d.abs());
+        }
+    }
+    assert!(off[0] < 1.0, "stripe middles: {} px off the middle", off[0]);
+    // The paper's edge pixels: the refinement keeps the edge the Hough line found.
+    assert!(off[1] > 3.0, "edge pixels: {} px off the middle", off[1]);
+}

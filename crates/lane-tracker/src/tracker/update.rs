@@ -37,7 +37,13 @@ impl LaneTracker {
         };
         let outward = self.outward_col();
         keep_bright_stripes(&mut self.edges, stripe_px, outward);
-        self.select_points(i, image, coeffs, self.window_half_width(i, predict));
+        self.select_points(
+            i,
+            image,
+            coeffs,
+            self.window_half_width(i, predict),
+            !predict,
+        );
         if self.lanes[i].points.len() < self.cfg.track.reinit_min_points {
             Self::miss(&mut self.lanes[i], &self.cfg);
             return Ok(());
