@@ -45,6 +45,36 @@
 //! (σ = 4 grey levels of noise) the points sit 0.01 px from the true centre on average with a
 //! scatter of 0.09 px.
 //!
+//! ## Stripe middles (an addition beyond the paper; `track.stripe_middles`, default on)
+//! The lane model and the labels mean a mark's middle; the paper measures its edge pixels,
+//! whose mean is the middle only while both edges are measured. Point selection keeps the
+//! window pixels within `track.inlier_half_width_px` (`w_in`, 6 px) of their row band's midhinge
+//! residual. A mark at most `w_in` wide has both edges within that band of its middle, and its
+//! edge pixels measure the middle. From one edge of a wider mark (a tape beside a small robot's
+//! camera, 12–19 px at 320 × 180 on `seame`; a road mark near the camera) the other edge lies
+//! beyond the band: the edge pixels hold the lane on the edge the Hough line found, 8–10 px
+//! from the labelled middle, which the scorer counts as a miss (5 px at 320 px width).
+//!
+//! With `track.stripe_middles`, in the windowed refinement that follows an initialisation an
+//! edge pixel that bounds a bright stripe more than `w_in` and at most
+//! `gradient.stripe_max_width_px` wide measures the stripe's middle (half-pixel columns) instead
+//! of its own column. The stripe is the one stripe pairing finds (the nearest pixel of the same
+//! class and the opposite polarity on the pixel's bright side), and it counts only on a floor
+//! alike on both sides: the grey levels two columns outside its edges differ by at most half its
+//! contrast (the test the mark centres use to tell a mark from a step). A kerb's face, bright
+//! between the road and a pavement of another grey, stays a step, whose foot
+//! `init.kerb_foot` keeps. Narrower stripes keep their edge pixels: they need no middle, and the
+//! two lines of a double line, each narrow, go on measuring the middle between them.
+//!
+//! Tracked frames keep the paper's edge pixels. From a mark's middle they hold it while both
+//! edges lie within the band, up to `2·w_in` (12 px); a lane on a wider mark slides back onto one
+//! of its edges within a few frames (a rendered mark 15 px wide at the bottom row: 7–10 px off
+//! its middle there from the fourth tracked frame on). Middles on every tracked frame held it on
+//! the middle but cost 30 % more instructions per tracked frame (447 k against 344 k: about
+//! 27 µs on the development VM, beyond the 25 µs budget) and scored lower on the stress test
+//! (`cargo xtask eval-lanes --one-sequence`: 65.2 % against 66.9 %). How it was measured:
+//! `docs/lane-tracker-history.md`, "Stripe middles".
+//!
 //! ## Measurement noise (an addition beyond the paper; with `track.mark_centres`)
 //! The centroid's variance depends on the mark: `Var(x_i) ≈ σ_grey²·v_i` with
 //! `v_i = Σ_k (k − c)²/S²` over the row's window (`S` the summed excess grey), so a narrow or
@@ -161,6 +191,8 @@
 //! - refines a fresh initialisation `track.refine_passes` times on the same frame in a wider
 //!   window (`track.refine_window_half_width_px`): the Hough line of a thick or curved mark can
 //!   sit several pixels off it;
+//! - **measures stripe middles in that refinement** (`track.stripe_middles`; *Stripe middles*
+//!   below): a lane the Hough line put on one edge of a wide mark is refined onto its middle;
 //! - **votes by orientation** (`init.orientation_tolerance_deg`; `hough_init::HoughWorkspace::
 //!   find_lines_oriented`): each candidate pixel votes only for the lines whose normal lies
 //!   within the tolerance of its own Sobel gradient direction (stored with the pixel,

@@ -334,12 +334,14 @@ pub struct TrackConfig {
     /// edge pixels with `R = filter.r_sigma_px²·I`.
     #[serde(default)]
     pub mark_centres: bool,
-    /// `true`: an edge pixel that bounds a bright stripe at most `gradient.stripe_max_width_px`
-    /// wide whose two sides are alike (a mark on the floor, not a kerb's face) measures the
-    /// stripe's middle, not its own column (an addition beyond the paper, crate docs "Stripe
-    /// middles"); `false` (default when absent): the paper's edge pixels. No effect with
-    /// `mark_centres`, which measure the middle themselves, or with
-    /// `gradient.stripe_max_width_px = 0`.
+    /// `true`: in the windowed refinement that follows an initialisation, an edge pixel that
+    /// bounds a bright stripe more than `inlier_half_width_px` and at most
+    /// `gradient.stripe_max_width_px` wide whose two sides are alike (a mark on the floor, not a
+    /// kerb's face) measures the stripe's middle, not its own column, so a lane whose Hough line
+    /// lay on one edge of a wide mark is refined onto its middle (an addition beyond the paper,
+    /// crate docs "Stripe middles"); tracked frames keep the paper's edge pixels. `false`
+    /// (default when absent): the paper's edge pixels. No effect with `mark_centres`, which
+    /// measure the middle themselves, or with `gradient.stripe_max_width_px = 0`.
     #[serde(default)]
     pub stripe_middles: bool,
     /// Half-width of the window of the windowed refinement that follows an initialisation on

@@ -259,21 +259,29 @@ fn residual_bin(col_px: u16, offset: i32, bin_max: i32) -> usize {
 }
 
 /// The column `row[j]` measures with `track.stripe_middles`: the middle of the bright stripe it
-/// bounds, `None` where it bounds none (it measures its own column then). `row` is one image
-/// row's edge pixels (columns increasing, [`vision_gradient::EdgeBuffer`]), `grey` that row's
-/// grey levels. The stripe is the one [`vision_gradient::split_stripes`] pairs: the nearest
-/// pixel of the same class and the opposite polarity on the pixel's bright side (right of a
-/// rising pixel, left of a falling one) within `max_w` columns; the scan stops `max_w` columns
-/// away. Its middle is taken only where the stripe stands on a floor alike on both sides: the
-/// grey levels two columns outside its edges differ by at most half its contrast (its middle
-/// pixel above their mean), the test [`mark_centre`] uses to tell a mark from a step. A kerb's
-/// face, bright between the road and a pavement of another grey, is a step whose foot the lane
-/// keeps (`init.kerb_foot`); a mark is a stripe whose middle the labels and the lane model mean.
-fn stripe_middle(row: &[EdgePixel], j: usize, grey: &[u8], max_w: u16) -> Option<(u16, bool)> {
+/// bounds, as `(column rounded down, whether it lies half a column further)`; `None` where it
+/// bounds none (it measures its own column then). `row` is one image row's edge pixels
+/// (columns increasing, [`vision_gradient::EdgeBuffer`]), `grey` that row's grey levels.
+///
+/// The stripe is the one [`vision_gradient::split_stripes`] pairs: the nearest pixel of the same
+/// class and the opposite polarity on the pixel's bright side (right of a rising pixel, left of
+/// a falling one) within `max_width_px` columns (the scan stops there). It counts only if the
+/// two are more than `min_width_px` columns apart (narrower stripes need no middle, see
+/// `select_points`) and the stripe stands on a floor alike on both sides: the grey levels two
+/// columns outside its edges differ by at most half its contrast (its middle pixel above their
+/// mean), the test [`mark_centre`] uses to tell a mark from a step. A kerb's face, bright
+/// between the road and a pavement of another grey, is a step whose foot the lane keeps
+/// (`init.kerb_foot`); a mark is a stripe whose middle the labels and the lane model mean.
+fn stripe_middle(
+    row: &[EdgePixel],
+    j: usize,
+    grey: &[u8],
+    (min_width_px, max_width_px): (u16, u16),
+) -> Option<(u16, bool)> {
     let p = row.get(j)?;
     let partner = |q: &&EdgePixel| q.class == p.class && (q.gx > 0) != (p.gx > 0);
     let (a, b) = if p.gx > 0 {
-        let reach = p.col_px.saturating_add(max_w);
+        let reach = p.col_px.saturating_add(max_width_px);
         let q = row
             .get(j + 1..)?
             .iter()
@@ -281,7 +289,7 @@ fn stripe_middle(row: &[EdgePixel], j: usize, grey: &[u8], max_w: u16) -> Option
             .find(partner)?;
         (p.col_px, q.col_px)
     } else {
-        let reach = p.col_px.saturating_sub(max_w);
+        let reach = p.col_px.saturating_sub(max_width_px);
         let q = row
             .get(..j)?
             .iter()
@@ -290,6 +298,10 @@ fn stripe_middle(row: &[EdgePixel], j: usize, grey: &[u8], max_w: u16) -> Option
             .find(partner)?;
         (q.col_px, p.col_px)
     };
+    // (Columns increase along the row: a ≤ b.)
+    if b.saturating_sub(a) <= min_width_px {
+        return None;
+    }
     let (a, b) = (usize::from(a), usize::from(b));
     let left = f32::from(*grey.get(a.checked_sub(2)?)?);
     let right = f32::from(*grey.get(b + 2)?);
@@ -300,6 +312,114 @@ fn stripe_middle(row: &[EdgePixel], j: usize, grey: &[u8], max_w: u16) -> Option
         .then(|| (((a + b) / 2) as u16, (a + b) % 2 == 1))
 }
 
+/// What the pass over one lane's window pixels needs besides them ([`WindowPass::gather`]).
+struct WindowPass<'a> {
+    /// The predicted lane.
+    predicted: Parabola,
+    /// Joint initialisation: each row's class from the predicted slope.
+    joint: bool,
+    /// The lane's class otherwise.
+    lane_class: EdgeClass,
+    /// Orientation gate on (`track.orientation_tolerance_deg > 0`).
+    gate: bool,
+    /// `tan τ` of the gate's tolerance τ.
+    tan_tolerance: f32,
+    /// First rows of the second and third row bands.
+    band_rows: [usize; 2],
+    /// Window half-width, px.
+    w: i64,
+    /// The frame (grey levels for the stripe middles).
+    image: &'a GreyImage<'a>,
+    /// Stripes whose edge pixels measure their middle (`MIDDLES`): more than `.0` and at most
+    /// `.1` px between their edge pixels.
+    stripe_widths_px: (u16, u16),
+}
+
+impl WindowPass<'_> {
+    /// One pass over the window pixels `edges` (the detector's, row by row): each pixel of the
+    /// row's class within the orientation gate is binned by its residual in its row band's
+    /// histogram (`hist`, cleared by the caller) and kept in `scratch` (up to its capacity).
+    /// `MIDDLES`: a pixel measures its bright stripe's middle ([`stripe_middle`]) where it
+    /// bounds one.
+    fn gather<const MIDDLES: bool>(
+        &self,
+        edges: &[EdgePixel],
+        hist: &mut [[u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS],
+        scratch: &mut Vec<Candidate>,
+    ) {
+        let bin_max = (2 * self.w) as i32; // ≤ 2·MAX_WINDOW_HALF_WIDTH (the configuration's range)
+        // The detector stores its pixels row by row: the prediction, its slope and the class
+        // test are evaluated once per row, not once per pixel.
+        for row_pixels in edges.chunk_by(|a, b| a.row_px == b.row_px) {
+            let Some(first) = row_pixels.first() else {
+                continue;
+            };
+            let row = usize::from(first.row_px);
+            let y = f64::from(first.row_px);
+            let slope = self.predicted.slope_at_row(y);
+            let col_pred = self.predicted.col_at_row(y);
+            // The class this row's pixels must have; `None`: either (a near-vertical mark).
+            let class = if !self.joint {
+                Some(self.lane_class)
+            } else if slope.abs() < NEAR_VERTICAL_SLOPE {
+                None
+            } else if slope < 0.0 {
+                Some(EdgeClass::LeftLane)
+            } else {
+                Some(EdgeClass::RightLane)
+            };
+            let slope_f32 = slope as f32;
+            let grey = if MIDDLES { self.image.row(row) } else { None };
+            let offset = bin_offset(col_pred, self.w);
+            let offset_half = if MIDDLES {
+                bin_offset(col_pred - 0.5, self.w)
+            } else {
+                offset
+            };
+            let band =
+                usize::from(row >= self.band_rows[0]) + usize::from(row >= self.band_rows[1]);
+            let Some(hist) = hist.get_mut(band) else {
+                continue;
+            };
+            for (j, p) in row_pixels.iter().enumerate() {
+                if class.is_some_and(|c| p.class != c) {
+                    continue;
+                }
+                if self.gate {
+                    let (gx, gy) = p.gradient();
+                    let (gx, gy) = (f32::from(gx), f32::from(gy));
+                    if (gx * slope_f32 + gy).abs()
+                        > self.tan_tolerance * (gx - gy * slope_f32).abs()
+                    {
+                        continue;
+                    }
+                }
+                let (mut col_px, mut half_col) = (p.col_px, false);
+                if let Some(grey) = grey
+                    && let Some(middle) = stripe_middle(row_pixels, j, grey, self.stripe_widths_px)
+                {
+                    (col_px, half_col) = middle;
+                }
+                // A middle `col_px + ½` is binned as `⌊col_px + ½ − x̂ + w + ½⌋`.
+                let bin =
+                    residual_bin(col_px, if half_col { offset_half } else { offset }, bin_max);
+                if let Some(count) = hist.get_mut(bin) {
+                    *count += 1;
+                }
+                if scratch.len() < scratch.capacity() {
+                    scratch.push(Candidate {
+                        col_px,
+                        row_px: p.row_px,
+                        bin: bin as u16,
+                        band: band as u8,
+                        half_col,
+                    });
+                }
+            }
+        }
+    }
+}
+
 /// Row bands of point selection's outlier rejection (thirds of the rows searched).
 pub(super) const BANDS: usize = 3;
 
@@ -308,7 +428,9 @@ pub(crate) const MAX_WINDOW_HALF_WIDTH: usize = 200;
 
 impl LaneTracker {
     /// Lane `i`'s measurement for this frame from the window pixels in `self.edges` (windows
-    /// `±w` px) about the predicted `coeffs`: fills `lane.points` (and `lane.weights` with mark centres).
+    /// `±w` px) about the predicted `coeffs`: fills `lane.points` (and `lane.weights` with mark
+    /// centres). `refining`: the refinement that follows an initialisation, where wide stripes
+    /// measure their middles (`track.stripe_middles`).
     pub(super) fn select_points(
         &mut self,
         i: usize,
@@ -325,7 +447,6 @@ impl LaneTracker {
         // midhinge residual (mean of the quartiles) are dropped (clutter, noise, the edges of a shadow).
         let band_rows = [top + (bottom - top) / 3, top + 2 * (bottom - top) / 3];
         let w_us = w as usize;
-        let bin_max = (2 * w_us) as i32; // ≤ 2·MAX_WINDOW_HALF_WIDTH (the configuration's range)
         // One pass over the window pixels of the lane's class: residual bin (r + w, rounded;
         // window pixels are within ±w of the prediction) and row band, histogrammed per band.
         // (The tracker's buffer, cleared over the bins this window uses.)
@@ -348,80 +469,42 @@ impl LaneTracker {
         let gate = tolerance_deg > 0.0;
         let tan_tolerance = tolerance_deg.to_radians().tan() as f32;
         let predicted = Parabola::from_coeffs(coeffs);
-        // Stripe middles (`track.stripe_middles`; crate docs, "Stripe middles"): the widest
-        // bright stripe whose edge pixels measure its middle, 0 = each pixel its own column.
-        // Not for a lane on the middle of a double line: its windows hold both lines, whose
-        // four edges measure the middle between them (two middles, one per line, would leave
-        // the band gate a choice between the lines).
-        let on_double_line = lane.pair_half_gap_px > 0.0;
-        let stripe_w = if refining
-            && self.cfg.track.stripe_middles
-            && !self.cfg.track.mark_centres
-            && !on_double_line
+        // Stripe middles (`track.stripe_middles`; crate docs, "Stripe middles"): in the
+        // refinement, the edge pixels of a bright stripe more than the inlier half-width and at
+        // most `gradient.stripe_max_width_px` wide measure its middle. A narrower one needs
+        // none: from its middle both its edges lie within the inlier band, so its edge pixels
+        // already measure the middle (and the lines of a double line, each narrow, keep
+        // measuring the middle between them); from one edge of a wider one the other edge lies
+        // beyond the band, and the edge pixels hold the lane on that edge.
+        let stripe_w = if refining && self.cfg.track.stripe_middles && !self.cfg.track.mark_centres
         {
             self.cfg.gradient.stripe_max_width_px
         } else {
             0
         };
-        // The detector stores its pixels row by row: the prediction, its slope and the class
-        // test are evaluated once per row, not once per pixel.
-        for row_pixels in self.edges.pixels().chunk_by(|a, b| a.row_px == b.row_px) {
-            let Some(first) = row_pixels.first() else {
-                continue;
-            };
-            let row = usize::from(first.row_px);
-            let y = f64::from(first.row_px);
-            let slope = predicted.slope_at_row(y);
-            let col_pred = predicted.col_at_row(y);
-            // The class this row's pixels must have; `None`: either (a near-vertical mark).
-            let class = if !joint {
-                Some(lane.class)
-            } else if slope.abs() < NEAR_VERTICAL_SLOPE {
-                None
-            } else if slope < 0.0 {
-                Some(EdgeClass::LeftLane)
-            } else {
-                Some(EdgeClass::RightLane)
-            };
-            let slope_f32 = slope as f32;
-            let grey = if stripe_w > 0 { image.row(row) } else { None };
-            let offset = bin_offset(col_pred, w);
-            let band = usize::from(row >= band_rows[0]) + usize::from(row >= band_rows[1]);
-            let Some(hist) = hist.get_mut(band) else {
-                continue;
-            };
-            for (j, p) in row_pixels.iter().enumerate() {
-                if class.is_some_and(|c| p.class != c) {
-                    continue;
-                }
-                if gate {
-                    let (gx, gy) = p.gradient();
-                    let (gx, gy) = (f32::from(gx), f32::from(gy));
-                    if (gx * slope_f32 + gy).abs() > tan_tolerance * (gx - gy * slope_f32).abs() {
-                        continue;
-                    }
-                }
-                // (A middle between two columns is binned by the left one.)
-                let (col_px, half_col) = match grey {
-                    Some(grey) => {
-                        stripe_middle(row_pixels, j, grey, stripe_w).unwrap_or((p.col_px, false))
-                    }
-                    None => (p.col_px, false),
-                };
-                let bin = residual_bin(col_px, offset, bin_max);
-                if let Some(count) = hist.get_mut(bin) {
-                    *count += 1;
-                }
-                if self.scratch.len() < self.scratch.capacity() {
-                    self.scratch.push(Candidate {
-                        col_px,
-                        row_px: p.row_px,
-                        bin: bin as u16,
-                        band: band as u8,
-                        half_col,
-                    });
-                }
-            }
+        // (The configuration keeps the half-width finite and > 0.)
+        let stripe_min_w = self
+            .cfg
+            .track
+            .inlier_half_width_px
+            .floor()
+            .min(f64::from(u16::MAX)) as u16;
+        let pass = WindowPass {
+            predicted,
+            joint,
+            lane_class: lane.class,
+            gate,
+            tan_tolerance,
+            band_rows,
+            w,
+            image,
+            stripe_widths_px: (stripe_min_w, stripe_w),
+        };
+        // (Two copies of the pass: tracked frames run the paper's alone.)
+        if stripe_w > 0 {
+            pass.gather::<true>(self.edges.pixels(), hist, &mut self.scratch);
+        } else {
+            pass.gather::<false>(self.edges.pixels(), hist, &mut self.scratch);
         }
         // Band centre = midhinge (mean of the quartiles): with the two edges of a mark it
         // lands between them, where a median would pick one edge.
@@ -598,9 +681,11 @@ mod tests {
     #[test]
     fn an_edge_pixel_of_a_bright_stripe_on_an_even_floor_measures_the_stripe_middle() {
         use EdgeClass::{LeftLane as L, RightLane as R};
-        let measured = |px: &[EdgePixel], grey: &[u8], max_w: u16| -> Vec<f32> {
+        // Each pixel's measured column, for stripes more than `widths.0` and at most
+        // `widths.1` columns wide.
+        let measured = |px: &[EdgePixel], grey: &[u8], widths: (u16, u16)| -> Vec<f32> {
             (0..px.len())
-                .map(|j| match stripe_middle(px, j, grey, max_w) {
+                .map(|j| match stripe_middle(px, j, grey, widths) {
                     Some((col, half)) => f32::from(col) + if half { 0.5 } else { 0.0 },
                     None => f32::from(px[j].col_px),
                 })
@@ -614,31 +699,37 @@ mod tests {
             edge(24, false, L),
             edge(25, false, L),
         ];
-        assert_eq!(measured(&px, &mark, 16), [19.0, 19.5, 19.5, 20.0]);
+        assert_eq!(measured(&px, &mark, (0, 16)), [19.0, 19.5, 19.5, 20.0]);
         // Wider than the widest stripe: each pixel its own column; the nearest partner counts.
-        assert_eq!(measured(&px, &mark, 9), [14.0, 19.5, 19.5, 25.0]);
-        assert_eq!(measured(&px, &mark, 8), [14.0, 15.0, 24.0, 25.0]);
+        assert_eq!(measured(&px, &mark, (0, 9)), [14.0, 19.5, 19.5, 25.0]);
+        assert_eq!(measured(&px, &mark, (0, 8)), [14.0, 15.0, 24.0, 25.0]);
+        // Not wider than the narrowest (14–24 and 15–25 are 10 columns apart, 15–24 nine).
+        assert_eq!(measured(&px, &mark, (9, 16)), [19.0, 15.0, 24.0, 20.0]);
+        assert_eq!(measured(&px, &mark, (10, 16)), [14.0, 15.0, 24.0, 25.0]);
         // The partner must be of the pixel's class.
         let mixed = [edge(15, true, L), edge(24, false, R)];
-        assert_eq!(measured(&mixed, &mark, 16), [15.0, 24.0]);
+        assert_eq!(measured(&mixed, &mark, (0, 16)), [15.0, 24.0]);
         // A dark stripe (falling, then rising) is not a mark.
         let dark = [edge(15, false, L), edge(24, true, L)];
-        assert_eq!(measured(&dark, &mark, 16), [15.0, 24.0]);
+        assert_eq!(measured(&dark, &mark, (0, 16)), [15.0, 24.0]);
         // A kerb's face: bright between the road (90) and a pavement of another grey (150 from
         // column 26 on): a step, whose foot the lane keeps.
         let mut kerb = mark.clone();
         for g in &mut kerb[26..] {
             *g = 150;
         }
-        assert_eq!(measured(&px, &kerb, 16), [14.0, 15.0, 24.0, 25.0]);
+        assert_eq!(measured(&px, &kerb, (0, 16)), [14.0, 15.0, 24.0, 25.0]);
         // A pavement of almost the floor's grey is still a floor alike on both sides.
         for g in &mut kerb[26..] {
             *g = 110;
         }
-        assert_eq!(measured(&px, &kerb, 16), [19.0, 19.5, 19.5, 20.0]);
-        // A stripe whose outside lies beyond the row is not measured.
-        assert_eq!(measured(&px, &mark[..26], 16), [14.0, 15.0, 24.0, 25.0]);
-        assert_eq!(stripe_middle(&px, 4, &mark, 16), None);
+        assert_eq!(measured(&px, &kerb, (0, 16)), [19.0, 19.5, 19.5, 20.0]);
+        // A stripe whose outside lies beyond the row is not measured; nor a pixel not in it.
+        assert_eq!(
+            measured(&px, &mark[..26], (0, 16)),
+            [14.0, 15.0, 24.0, 25.0]
+        );
+        assert_eq!(stripe_middle(&px, 4, &mark, (0, 16)), None);
     }
 
     #[test]

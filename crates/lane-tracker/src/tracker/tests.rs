@@ -1804,4 +1804,13 @@ fn a_wide_mark_is_initialised_on_its_middle_not_on_one_edge() {
     assert!(off[0] < 1.0, "stripe middles: {} px off the middle", off[0]);
     // The paper's edge pixels: the refinement keeps the edge the Hough line found.
     assert!(off[1] > 3.0, "edge pixels: {} px off the middle", off[1]);
+    // With mark centres (which measure the middle themselves) the setting changes nothing.
+    let with_mark_centres = |middles: bool| {
+        let mut cfg = TrackerConfig::default_preset().expect("the default preset");
+        cfg.track.mark_centres = true;
+        cfg.track.stripe_middles = middles;
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        tracker.track(&frame).expect("a frame").lanes[0].coeffs
+    };
+    assert_eq!(with_mark_centres(true), with_mark_centres(false));
 }
