@@ -109,8 +109,10 @@ pub struct HoughWorkspace {
     /// The 3×3-smoothed votes of the band being searched for several peaks, θ-major like
     /// `acc` (`take_peaks`).
     smoothed: Vec<u32>,
-    /// Per θ bin of `smoothed`: its first largest value and that value's ρ bin.
-    row_best: Vec<(u32, usize)>,
+    /// Per θ bin of `smoothed`: its largest value and, once `peak_of_rows` has asked for it,
+    /// that value's first ρ bin (`None` until then: most rows are never a peak's, and the scan
+    /// for the position is the dearer half of finding it).
+    row_best: Vec<(u32, Option<usize>)>,
     /// The oriented vote's runs of θ bins, `(x, y, votes)` of their point, sorted by the run's
     /// first bin (`vote_oriented`), with the runs as `(point index, first bin − base)` in point
     /// order, the index of each first bin's runs and a cursor per bin; `runs` and `run_keys`
@@ -215,7 +217,7 @@ impl HoughWorkspace {
             acc: vec![0; cells],
             ring: vec![0; 4 * rho_bins],
             smoothed: vec![0; cells],
-            row_best: vec![(0, 0); theta_bins],
+            row_best: vec![(0, None); theta_bins],
             runs: Vec::new(),
             run_keys: Vec::new(),
             run_starts: Vec::with_capacity(2 * theta_bins + 2),
@@ -469,7 +471,7 @@ impl HoughWorkspace {
         if nr == 1 {
             out[0] = column[0];
         }
-        self.row_best[k] = first_max(out);
+        self.row_best[k] = (row_max(out), None);
     }
 
     /// Cells `lo..=hi` of row `k` of `smoothed` recomputed after a suppression cleared votes
@@ -487,23 +489,42 @@ impl HoughWorkspace {
             }
             self.smoothed[k * nr + i] = sum;
         }
-        let (_, best) = self.row_best[k];
-        if (lo..=hi).contains(&best) {
-            self.row_best[k] = first_max(&self.smoothed[k * nr..(k + 1) * nr]);
+        // The best cell stays the first largest if it is known to lie outside the lowered
+        // cells; one of unknown position may lie among them.
+        let kept = matches!(self.row_best[k].1, Some(best) if !(lo..=hi).contains(&best));
+        if !kept {
+            self.row_best[k] = (row_max(&self.smoothed[k * nr..(k + 1) * nr]), None);
         }
     }
 
     /// The first largest cell of `smoothed` over the θ bins `k0..=k1` in scan order (θ, then
-    /// ρ), from `row_best`: the cell `peak_smoothed` finds.
-    fn peak_of_rows(&self, k0: usize, k1: usize) -> (usize, usize) {
-        let mut best = (0u32, k0, 0usize);
+    /// ρ), from `row_best`: the cell `peak_smoothed` finds (`(k0, 0)` when every cell is 0).
+    /// The winning row's position is looked for here, once, and kept in `row_best`.
+    fn peak_of_rows(&mut self, k0: usize, k1: usize) -> (usize, usize) {
+        let mut best = (0u32, k0);
         for k in k0..=k1 {
-            let (v, r) = self.row_best[k];
+            let v = self.row_best[k].0;
             if v > best.0 {
-                best = (v, k, r);
+                best = (v, k);
             }
         }
-        (best.1, best.2)
+        let (v, k) = best;
+        if v == 0 {
+            return (k0, 0);
+        }
+        let r = match self.row_best[k].1 {
+            Some(r) => r,
+            None => {
+                let nr = self.rho_bins;
+                let r = self.smoothed[k * nr..(k + 1) * nr]
+                    .iter()
+                    .position(|&c| c == v)
+                    .unwrap_or(0);
+                self.row_best[k].1 = Some(r);
+                r
+            }
+        };
+        (k, r)
     }
 
     /// Validate the points and their number (2 ..= `MAX_VOTES`): the checks of every vote.
@@ -871,15 +892,9 @@ impl HoughWorkspace {
     }
 }
 
-/// The first largest value of `row` and its index (ties to the lower index), `(0, 0)` for a row
-/// of zeros: a scan keeping the first maximum, as two passes that vectorise.
-fn first_max(row: &[u32]) -> (u32, usize) {
-    let max = row.iter().copied().max().unwrap_or(0);
-    if max == 0 {
-        (0, 0)
-    } else {
-        (max, row.iter().position(|&v| v == max).unwrap_or(0))
-    }
+/// The largest value of `row` (0 for an empty row): one pass that vectorises.
+fn row_max(row: &[u32]) -> u32 {
+    row.iter().copied().max().unwrap_or(0)
 }
 
 /// `dst[r] = src[r − 1] + src[r] + src[r + 1]` (missing neighbours count as zero); both
