@@ -49,11 +49,13 @@
 //! The lane model and the labels mean a mark's middle; the paper measures its edge pixels,
 //! whose mean is the middle only while both edges are measured. Point selection keeps the
 //! window pixels within `track.inlier_half_width_px` (`w_in`, 6 px) of their row band's midhinge
-//! residual. A mark at most `w_in` wide has both edges within that band of its middle, and its
-//! edge pixels measure the middle. From one edge of a wider mark (a tape beside a small robot's
-//! camera, 12–19 px at 320 × 180 on `seame`; a road mark near the camera) the other edge lies
-//! beyond the band: the edge pixels hold the lane on the edge the Hough line found, 8–10 px
-//! from the labelled middle, which the scorer counts as a miss (5 px at 320 px width).
+//! residual. On a mark at most `w_in` wide, from either of its edges the other lies within the
+//! band, so the band settles on the middle and the edge pixels measure it. From one edge of a
+//! wider mark (a tape beside a small robot's camera, 12–21 px at 320 × 180 on `seame`; a road
+//! mark near the camera) the other edge lies beyond the band: the edge pixels hold the lane on
+//! the edge the Hough line found, 5.6–12.6 px from the labelled middle on the `seame` frames
+//! looked at, a miss for the scorer (5 px at 320 px width). (Tapes wider than
+//! `gradient.stripe_max_width_px` at their bottom rows are not paired there either.)
 //!
 //! With `track.stripe_middles`, in the windowed refinement that follows an initialisation an
 //! edge pixel that bounds a bright stripe more than `w_in` and at most
@@ -106,7 +108,7 @@
 //!    midhinge of the residuals of their third of the ROI are dropped; the rest are uniformly
 //!    decimated (in row order) to at most `track.max_points_per_lane` (paper: 150), so they
 //!    spread over the rows (with `track.mark_centres`: one sub-pixel mark centre per row
-//!    instead, *Mark centres* below); KIF measurement update (eqs. 6, 12) or WRLS (eqs. 25–27,
+//!    instead, *Mark centres* above); KIF measurement update (eqs. 6, 12) or WRLS (eqs. 25–27,
 //!    λ once per frame). Too few points (`track.reinit_min_points`) or an update moving the
 //!    lane by more than `track.max_jump_px` at the top or bottom ROI row (the *jump gate*) is a miss: the lane
 //!    coasts on its prediction; after `track.lost_after_frames` misses in a row it is
@@ -192,7 +194,7 @@
 //!   window (`track.refine_window_half_width_px`): the Hough line of a thick or curved mark can
 //!   sit several pixels off it;
 //! - **measures stripe middles in that refinement** (`track.stripe_middles`; *Stripe middles*
-//!   below): a lane the Hough line put on one edge of a wide mark is refined onto its middle;
+//!   above): a lane the Hough line put on one edge of a wide mark is refined onto its middle;
 //! - **votes by orientation** (`init.orientation_tolerance_deg`; `hough_init::HoughWorkspace::
 //!   find_lines_oriented`): each candidate pixel votes only for the lines whose normal lies
 //!   within the tolerance of its own Sobel gradient direction (stored with the pixel,

@@ -341,7 +341,8 @@ pub struct TrackConfig {
     /// lay on one edge of a wide mark is refined onto its middle (an addition beyond the paper,
     /// crate docs "Stripe middles"); tracked frames keep the paper's edge pixels. `false`
     /// (default when absent): the paper's edge pixels. No effect with `mark_centres`, which
-    /// measure the middle themselves, or with `gradient.stripe_max_width_px = 0`.
+    /// measure the middle themselves, or with `gradient.stripe_max_width_px` at most
+    /// `inlier_half_width_px` (no stripe both wide enough and paired).
     #[serde(default)]
     pub stripe_middles: bool,
     /// Half-width of the window of the windowed refinement that follows an initialisation on

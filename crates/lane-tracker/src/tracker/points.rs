@@ -17,7 +17,8 @@ pub(super) struct Candidate {
     /// (`track.stripe_middles`, [`stripe_middle`]).
     col_px: u16,
     row_px: u16,
-    /// Residual `col_px − x̂(y)` rounded, plus the window half-width (0..=2w).
+    /// Residual of the measured column (`col_px + ½` with `half_col`) about `x̂(y)`, rounded,
+    /// plus the window half-width (0..=2w).
     bin: u16,
     /// Third of the rows searched (0, 1, 2).
     band: u8,
@@ -472,10 +473,10 @@ impl LaneTracker {
         // Stripe middles (`track.stripe_middles`; crate docs, "Stripe middles"): in the
         // refinement, the edge pixels of a bright stripe more than the inlier half-width and at
         // most `gradient.stripe_max_width_px` wide measure its middle. A narrower one needs
-        // none: from its middle both its edges lie within the inlier band, so its edge pixels
-        // already measure the middle (and the lines of a double line, each narrow, keep
-        // measuring the middle between them); from one edge of a wider one the other edge lies
-        // beyond the band, and the edge pixels hold the lane on that edge.
+        // none: from either of its edges the other lies within the inlier band, so the band
+        // settles on its middle and its edge pixels measure it (and the lines of a double line,
+        // each narrow, keep measuring the middle between them); from one edge of a wider one
+        // the other edge lies beyond the band, and the edge pixels hold the lane on that edge.
         let stripe_w = if refining && self.cfg.track.stripe_middles && !self.cfg.track.mark_centres
         {
             self.cfg.gradient.stripe_max_width_px
@@ -730,6 +731,46 @@ mod tests {
             [14.0, 15.0, 24.0, 25.0]
         );
         assert_eq!(stripe_middle(&px, 4, &mark, (0, 16)), None);
+    }
+
+    #[test]
+    fn a_stripe_middle_between_two_columns_is_binned_by_its_rounded_residual() {
+        use EdgeClass::LeftLane as L;
+        // The mark [15, 25): edge pixels 15 and 24, middle 19.5; predicted at 19.9, the
+        // residual −0.4 rounds to 0 (bin w), where the left column's −0.9 would round to −1.
+        let mark = row(15.0, 25.0);
+        let image = GreyImage::new(&mark, mark.len(), 1, mark.len()).expect("a one-row image");
+        let edges = [edge(15, true, L), edge(24, false, L)];
+        let w = 10;
+        let pass = |widths_px| WindowPass {
+            predicted: Parabola::from_coeffs([0.0, 0.0, 19.9]),
+            joint: false,
+            lane_class: L,
+            gate: false,
+            tan_tolerance: 0.0,
+            band_rows: [1, 1],
+            w,
+            image: &image,
+            stripe_widths_px: widths_px,
+        };
+        let mut hist = Box::new([[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]);
+        let mut scratch = Vec::with_capacity(4);
+        pass((6, 16)).gather::<true>(&edges, &mut hist, &mut scratch);
+        let got: Vec<_> = scratch.iter().map(|c| (c.point(), c.bin, c.band)).collect();
+        assert_eq!(got, [((19.5, 0.0), 10, 0), ((19.5, 0.0), 10, 0)]);
+        assert_eq!(hist[0][10], 2);
+        // Without middles (or narrower than the narrowest): each its own column and bin.
+        for (widths_px, middles) in [((6, 16), false), ((9, 16), true)] {
+            hist[0].fill(0);
+            scratch.clear();
+            if middles {
+                pass(widths_px).gather::<true>(&edges, &mut hist, &mut scratch);
+            } else {
+                pass(widths_px).gather::<false>(&edges, &mut hist, &mut scratch);
+            }
+            let got: Vec<_> = scratch.iter().map(|c| (c.point(), c.bin)).collect();
+            assert_eq!(got, [((15.0, 0.0), 5), ((24.0, 0.0), 14)]);
+        }
     }
 
     #[test]
