@@ -109,10 +109,10 @@ pub struct HoughWorkspace {
     /// The 3×3-smoothed votes of the band being searched for several peaks, θ-major like
     /// `acc` (`take_peaks`).
     smoothed: Vec<u32>,
-    /// Per θ bin of `smoothed`: its largest value and, once `peak_of_rows` has asked for it,
-    /// that value's first ρ bin (`None` until then: most rows are never a peak's, and the scan
-    /// for the position is the dearer half of finding it).
-    row_best: Vec<(u32, Option<usize>)>,
+    /// Per θ bin of `smoothed`: its largest value (its position is looked for only in the row
+    /// that wins, `peak_of_rows`: most rows are never a peak's, and the scan for the position
+    /// was the dearer half of finding it).
+    row_best: Vec<u32>,
     /// The oriented vote's runs of θ bins, `(x, y, votes)` of their point, sorted by the run's
     /// first bin (`vote_oriented`), with the runs as `(point index, first bin − base)` in point
     /// order, the index of each first bin's runs and a cursor per bin; `runs` and `run_keys`
@@ -217,7 +217,7 @@ impl HoughWorkspace {
             acc: vec![0; cells],
             ring: vec![0; 4 * rho_bins],
             smoothed: vec![0; cells],
-            row_best: vec![(0, None); theta_bins],
+            row_best: vec![0; theta_bins],
             runs: Vec::new(),
             run_keys: Vec::new(),
             run_starts: Vec::with_capacity(2 * theta_bins + 2),
@@ -471,39 +471,39 @@ impl HoughWorkspace {
         if nr == 1 {
             out[0] = column[0];
         }
-        self.row_best[k] = (row_max(out), None);
+        self.row_best[k] = row_max(out);
     }
 
     /// Cells `lo..=hi` of row `k` of `smoothed` recomputed after a suppression cleared votes
-    /// under them, and the row's best cell kept up to date: the cleared votes only lower these
-    /// sums, so a best cell outside `lo..=hi` stays the first largest; one inside is looked for
-    /// again over the whole row.
+    /// under them, and the row's largest value kept up to date: the cleared votes only lower
+    /// these sums, so while the largest of their old values stayed below the row's largest, a
+    /// cell outside them holds it still; otherwise it is looked for again over the whole row.
     fn resmooth_cells(&mut self, k: usize, k0: usize, k1: usize, lo: usize, hi: usize) {
         let nr = self.rho_bins;
         let (ka, kb) = (k.saturating_sub(1).max(k0), (k + 1).min(k1));
+        let mut lowered_max = 0u32;
         for i in lo..=hi {
             let (a, b) = (i.saturating_sub(1), (i + 1).min(nr - 1));
             let mut sum = 0u32;
             for kk in ka..=kb {
                 sum += self.acc[kk * nr + a..=kk * nr + b].iter().sum::<u32>();
             }
-            self.smoothed[k * nr + i] = sum;
+            let cell = &mut self.smoothed[k * nr + i];
+            lowered_max = lowered_max.max(*cell);
+            *cell = sum;
         }
-        // The best cell stays the first largest if it is known to lie outside the lowered
-        // cells; one of unknown position may lie among them.
-        let kept = matches!(self.row_best[k].1, Some(best) if !(lo..=hi).contains(&best));
-        if !kept {
-            self.row_best[k] = (row_max(&self.smoothed[k * nr..(k + 1) * nr]), None);
+        if lowered_max >= self.row_best[k] {
+            self.row_best[k] = row_max(&self.smoothed[k * nr..(k + 1) * nr]);
         }
     }
 
     /// The first largest cell of `smoothed` over the θ bins `k0..=k1` in scan order (θ, then
     /// ρ), from `row_best`: the cell `peak_smoothed` finds (`(k0, 0)` when every cell is 0).
-    /// The winning row's position is looked for here, once, and kept in `row_best`.
-    fn peak_of_rows(&mut self, k0: usize, k1: usize) -> (usize, usize) {
+    /// Only the winning row is scanned for the position.
+    fn peak_of_rows(&self, k0: usize, k1: usize) -> (usize, usize) {
         let mut best = (0u32, k0);
         for k in k0..=k1 {
-            let v = self.row_best[k].0;
+            let v = self.row_best[k];
             if v > best.0 {
                 best = (v, k);
             }
@@ -512,18 +512,12 @@ impl HoughWorkspace {
         if v == 0 {
             return (k0, 0);
         }
-        let r = match self.row_best[k].1 {
-            Some(r) => r,
-            None => {
-                let nr = self.rho_bins;
-                let r = self.smoothed[k * nr..(k + 1) * nr]
-                    .iter()
-                    .position(|&c| c == v)
-                    .unwrap_or(0);
-                self.row_best[k].1 = Some(r);
-                r
-            }
-        };
+        let nr = self.rho_bins;
+        // `v` is the row's largest value (`row_best`), so it is found.
+        let r = self.smoothed[k * nr..(k + 1) * nr]
+            .iter()
+            .position(|&c| c == v)
+            .unwrap_or(0);
         (k, r)
     }
 

@@ -1837,10 +1837,10 @@ fn a_double_line_of_narrow_lines_is_initialised_between_them_with_stripe_middles
     let c = report.lanes[0].coeffs.expect("a left lane");
     for y in [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64] {
         let d = c[0] * y * y + c[1] * y + c[2] - mark_left(y);
-        // Within 2.1 px (the middle row: the windows' quartile gate with four edges, as in
-        // `a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle`); with every stripe
-        // measuring its middle the two lines' middles leave the band at the bottom rows and the
-        // lane bends onto one line, 4.3 px off there (tried).
+        // Measured within 2.1 px, bound 3 px (the middle row: the quartile gate with four
+        // edges, as in `a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle`); with
+        // every stripe measuring its middle the two lines' middles leave the band at the bottom
+        // rows and the lane bends onto one line, 4.3 px off there (tried).
         assert!(d.abs() < 3.0, "row {y}: {d} px off the pair's middle");
     }
 }
