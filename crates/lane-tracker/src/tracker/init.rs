@@ -137,9 +137,7 @@ impl LaneTracker {
             return Ok(());
         }
         let without = [!self.lanes[0].has_estimate(), !self.lanes[1].has_estimate()];
-        self.search_rows = tall;
-        let searched = self.initialise_in_roi(image, without, false);
-        self.search_rows = self.roi;
+        let searched = self.over_rows(tall, |t| t.initialise_in_roi(image, without, false));
         // A side found here is refined and tracked over these rows (`install` clears the flag).
         for (lane, was_without) in self.lanes.iter_mut().zip(without) {
             lane.tracked_tall |= was_without && lane.initialised_now;

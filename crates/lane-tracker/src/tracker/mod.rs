@@ -562,6 +562,16 @@ impl LaneTracker {
         }
     }
 
+    /// `stage` run with `search_rows` set to `rows` (`[top, bottom)`, px), which are the ROI's
+    /// again afterwards, whatever `stage` returns: every stage reads its rows from
+    /// `search_rows`, and outside such a call they are the ROI's.
+    fn over_rows<T>(&mut self, rows: (usize, usize), stage: impl FnOnce(&mut Self) -> T) -> T {
+        self.search_rows = rows;
+        let out = stage(self);
+        self.search_rows = self.roi;
+        out
+    }
+
     /// Rows searched, `[top, bottom)`, px.
     pub fn roi_rows(&self) -> (usize, usize) {
         self.roi
@@ -703,10 +713,7 @@ impl LaneTracker {
             lane.replaced = None;
             lane.set_aside = None;
             if lane.has_estimate() {
-                self.search_rows = self.rows_of(i);
-                let tracked = self.track_lane(i, &image, true);
-                self.search_rows = self.roi;
-                tracked?;
+                self.over_rows(self.rows_of(i), |t| t.track_lane(i, &image, true))?;
             } else {
                 lane.spans.fill(ColSpan::EMPTY);
                 lane.points.clear();
@@ -742,22 +749,17 @@ impl LaneTracker {
             for i in 0..2 {
                 if self.lanes[i].initialised_now {
                     // A lane the second search found is refined over the rows it was found in.
-                    self.search_rows = self.rows_of(i);
-                    let mut refined = Ok(());
-                    for _ in 0..self.cfg.track.refine_passes.max(1) {
-                        refined = self.track_lane(i, &image, false);
-                        if refined.is_err() {
-                            break;
+                    self.over_rows(self.rows_of(i), |t| {
+                        for _ in 0..t.cfg.track.refine_passes.max(1) {
+                            t.track_lane(i, &image, false)?;
                         }
-                    }
-                    let doubled = refined.is_ok()
-                        && self.cfg.init.double_line_middle
-                        && self.centre_on_double_line(i, &image);
-                    if refined.is_ok() && !doubled && self.cfg.init.kerb_foot {
-                        self.onto_kerb_foot(i, &image);
-                    }
-                    self.search_rows = self.roi;
-                    refined?;
+                        let doubled =
+                            t.cfg.init.double_line_middle && t.centre_on_double_line(i, &image);
+                        if !doubled && t.cfg.init.kerb_foot {
+                            t.onto_kerb_foot(i, &image);
+                        }
+                        Ok::<(), TrackerError>(())
+                    })?;
                     let lane = &mut self.lanes[i];
                     if lane.state != LaneState::Tracking {
                         // The refinement missed: keep the LS initialisation as it was.
@@ -774,9 +776,7 @@ impl LaneTracker {
         // A lane tracked over the taller rows reads its kerb there, as its refinement did.
         for i in 0..2 {
             if self.lanes[i].has_estimate() && !self.lanes[i].initialised_now {
-                self.search_rows = self.rows_of(i);
-                self.recheck_kerb_foot(i, &image);
-                self.search_rows = self.roi;
+                self.over_rows(self.rows_of(i), |t| t.recheck_kerb_foot(i, &image));
             }
         }
         Ok(TrackReport {
