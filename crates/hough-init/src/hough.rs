@@ -113,11 +113,15 @@ pub struct HoughWorkspace {
     /// that wins, `peak_of_rows`: most rows are never a peak's, and the scan for the position
     /// was the dearer half of finding it).
     row_best: Vec<u32>,
-    /// The oriented vote's runs of θ bins, `(x, y, votes)` of their point, sorted by the run's
-    /// first bin (`vote_oriented`), with the runs as `(point index, first bin − base)` in point
-    /// order, the index of each first bin's runs and a cursor per bin; `runs` and `run_keys`
-    /// reserved by [`HoughWorkspace::reserve_oriented_points`].
-    runs: Vec<(f32, f32, u32)>,
+    /// The oriented vote's runs of θ bins, `x`, `y` and votes of their point in three
+    /// arrays, sorted by the run's first bin (`vote_oriented`), a ρ bin per run for one θ row,
+    /// with the runs as `(point index, first bin − base)` in point order, the index of each
+    /// first bin's runs and a cursor per bin; `run_x`, `run_y`, `run_votes`, `run_bins` and
+    /// `run_keys` reserved by [`HoughWorkspace::reserve_oriented_points`].
+    run_x: Vec<f32>,
+    run_y: Vec<f32>,
+    run_votes: Vec<u32>,
+    run_bins: Vec<u32>,
     run_keys: Vec<(u32, u32)>,
     run_starts: Vec<u32>,
     run_next: Vec<u32>,
@@ -218,7 +222,10 @@ impl HoughWorkspace {
             ring: vec![0; 4 * rho_bins],
             smoothed: vec![0; cells],
             row_best: vec![0; theta_bins],
-            runs: Vec::new(),
+            run_x: Vec::new(),
+            run_y: Vec::new(),
+            run_votes: Vec::new(),
+            run_bins: Vec::new(),
             run_keys: Vec::new(),
             run_starts: Vec::with_capacity(2 * theta_bins + 2),
             run_next: Vec::with_capacity(2 * theta_bins + 1),
@@ -243,7 +250,12 @@ impl HoughWorkspace {
     /// all three can meet a band only if the window covers the half circle, and that case
     /// votes without the buffer.
     pub fn reserve_oriented_points(&mut self, points: usize) {
-        self.runs.reserve(2 * points);
+        for v in [&mut self.run_x, &mut self.run_y] {
+            v.reserve(2 * points);
+        }
+        for v in [&mut self.run_votes, &mut self.run_bins] {
+            v.reserve(2 * points);
+        }
         self.run_keys.reserve(2 * points);
     }
 
@@ -346,7 +358,8 @@ impl HoughWorkspace {
     /// Each point casts [`OrientedPoint::votes`] votes per bin (in the accumulator, the same as
     /// repeating it; the minimum of two points counts points). The vote runs θ-major (each θ
     /// row takes the votes of the points whose window covers it, from one slice of the points
-    /// sorted by their window's first bin); it allocates nothing once
+    /// sorted by their window's first bin; their ρ bins in a loop of their own, which
+    /// vectorises, then the votes); it allocates nothing once
     /// [`Self::reserve_oriented_points`] has reserved room for as many points.
     ///
     /// # Errors
@@ -764,16 +777,23 @@ impl HoughWorkspace {
             counts[i + 1] += counts[i];
         }
         let total = counts[buckets] as usize;
-        let runs = &mut self.runs;
-        runs.clear();
-        runs.resize(total, (0.0, 0.0, 0));
+        let (run_x, run_y, run_votes) = (&mut self.run_x, &mut self.run_y, &mut self.run_votes);
+        for v in [&mut *run_x, &mut *run_y] {
+            v.clear();
+            v.resize(total, 0.0);
+        }
+        run_votes.clear();
+        run_votes.resize(total, 0);
+        self.run_bins.clear();
+        self.run_bins.resize(total, 0);
         let next = &mut self.run_next;
         next.clear();
         next.extend_from_slice(&counts[..buckets]);
         for &(i, bucket) in keys.iter() {
             if let (Some(p), Some(slot)) = (points.get(i as usize), next.get_mut(bucket as usize)) {
                 let (x, y) = centred(p);
-                runs[*slot as usize] = (x, y, u32::from(p.votes));
+                let j = *slot as usize;
+                (run_x[j], run_y[j], run_votes[j]) = (x, y, u32::from(p.votes));
                 *slot += 1;
             }
         }
@@ -783,9 +803,19 @@ impl HoughWorkspace {
             let hi = (k as i64 - base) as usize;
             let (c, s) = (self.cos_over_step[k], self.sin_over_step[k]);
             let row = &mut self.acc[k * nr..(k + 1) * nr];
-            for &(x, y, votes) in &runs[counts[lo] as usize..counts[hi + 1] as usize] {
+            let runs = counts[lo] as usize..counts[hi + 1] as usize;
+            // The bins first, in a loop of their own (it vectorises), then the votes.
+            let bins = &mut self.run_bins[runs.clone()];
+            for ((b, &x), &y) in bins
+                .iter_mut()
+                .zip(&run_x[runs.clone()])
+                .zip(&run_y[runs.clone()])
+            {
+                *b = rho_bin(x, y, c, s, offset);
+            }
+            for (&b, &votes) in bins.iter().zip(&run_votes[runs]) {
                 // In range by construction (as in `vote`); a bad index is skipped.
-                if let Some(cell) = row.get_mut(rho_bin(x, y, c, s, offset) as usize) {
+                if let Some(cell) = row.get_mut(b as usize) {
                     *cell += votes;
                 }
             }
