@@ -237,21 +237,22 @@ impl LaneTracker {
 
     /// Whether [`Self::fill_candidates`] would put at least `min` pixels in `self.candidates`
     /// for `class`, counted without filling it and only until `min` is reached.
-    fn has_candidates(&self, class: EdgeClass, min: usize) -> bool {
-        let votes = usize::from(self.cfg.gradient.stripe_paired_votes);
+    pub(super) fn has_candidates(&self, class: EdgeClass, min: usize) -> bool {
         let near_vertical = self.near_vertical_either_class();
-        // At most `min` of `pixels` that count as `class`.
-        let count = |pixels: &[EdgePixel]| {
-            pixels
+        let votes = self.cfg.gradient.stripe_paired_votes;
+        // `fill_candidates`' sources in its order, each read only for what `min` still lacks.
+        let mut found = 0;
+        for pixels in candidate_sources(&self.edges, &self.paired, votes) {
+            if found >= min {
+                break;
+            }
+            found += pixels
                 .iter()
                 .filter(|p| counts_as(p, class, near_vertical))
-                .take(min)
-                .count()
-        };
-        let edges = count(self.edges.pixels());
-        // With fewer than `min` edge pixels, the paired ones are counted `votes − 1` times more:
-        // `min` of them (capped) already make `min` when `votes > 1`.
-        edges >= min || (votes > 1 && edges + (votes - 1) * count(self.paired.pixels()) >= min)
+                .take(min - found)
+                .count();
+        }
+        found >= min
     }
 
     /// Joint initialisation (`init.candidate_lines > 0`, crate docs): the strongest

@@ -932,6 +932,61 @@ fn a_chosen_lines_fit_on_the_pixels_near_it_equals_the_fit_on_all_of_them() {
     );
 }
 
+/// `has_candidates` says what `fill_candidates` would give — at least `min` pixels that count
+/// as the class — without filling: both classes, `min` on both sides of the filled count, the
+/// paired pixels counted 0–4 times (`gradient.stripe_paired_votes`), on frames with stripes,
+/// a crosswalk and a kerb.
+#[test]
+fn has_candidates_agrees_with_the_candidates_filled() {
+    let frames = [
+        two_marks(320, 240),
+        crosswalk(320, 240, true),
+        kerb_right(320, 240, false, 0.0),
+    ];
+    let mut paired_counted = 0;
+    for votes in 0..=4u8 {
+        let mut cfg = TrackerConfig::default_preset().expect("the default preset");
+        cfg.gradient.stripe_paired_votes = votes;
+        for frame in &frames {
+            let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+            tracker
+                .initialise_in_roi(&image_of(frame), [true, true], false)
+                .expect("a search");
+            for class in [EdgeClass::LeftLane, EdgeClass::RightLane] {
+                tracker.fill_candidates(class);
+                let n = tracker.candidates.len();
+                let edges_alone = tracker
+                    .edges
+                    .pixels()
+                    .iter()
+                    .filter(|p| counts_as(p, class, tracker.near_vertical_either_class()))
+                    .count();
+                paired_counted += usize::from(n > edges_alone);
+                for min in [
+                    0,
+                    1,
+                    edges_alone,
+                    edges_alone + 1,
+                    n - 1,
+                    n,
+                    n + 1,
+                    2 * n + 5,
+                ] {
+                    assert_eq!(
+                        tracker.has_candidates(class, min),
+                        n >= min,
+                        "votes {votes}, {class:?}, {n} candidates, min {min}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(
+        paired_counted >= 12,
+        "paired pixels added candidates {paired_counted} times"
+    );
+}
+
 /// A frame as the tracker's image type.
 fn image_of(f: &GreyFrame) -> GreyImage<'_> {
     GreyImage::new(f.data(), f.width(), f.height(), f.width()).expect("an image")
