@@ -967,7 +967,7 @@ fn has_candidates_agrees_with_the_candidates_filled() {
                     1,
                     edges_alone,
                     edges_alone + 1,
-                    n - 1,
+                    n.saturating_sub(1),
                     n,
                     n + 1,
                     2 * n + 5,
