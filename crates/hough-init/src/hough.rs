@@ -250,13 +250,12 @@ impl HoughWorkspace {
     /// all three can meet a band only if the window covers the half circle, and that case
     /// votes without the buffer.
     pub fn reserve_oriented_points(&mut self, points: usize) {
-        for v in [&mut self.run_x, &mut self.run_y] {
-            v.reserve(2 * points);
-        }
-        for v in [&mut self.run_votes, &mut self.run_bins] {
-            v.reserve(2 * points);
-        }
-        self.run_keys.reserve(2 * points);
+        let runs = 2 * points;
+        self.run_x.reserve(runs);
+        self.run_y.reserve(runs);
+        self.run_votes.reserve(runs);
+        self.run_bins.reserve(runs);
+        self.run_keys.reserve(runs);
     }
 
     /// The parameters the workspace was built with.
@@ -778,10 +777,10 @@ impl HoughWorkspace {
         }
         let total = counts[buckets] as usize;
         let (run_x, run_y, run_votes) = (&mut self.run_x, &mut self.run_y, &mut self.run_votes);
-        for v in [&mut *run_x, &mut *run_y] {
-            v.clear();
-            v.resize(total, 0.0);
-        }
+        run_x.clear();
+        run_x.resize(total, 0.0);
+        run_y.clear();
+        run_y.resize(total, 0.0);
         run_votes.clear();
         run_votes.resize(total, 0);
         self.run_bins.clear();
