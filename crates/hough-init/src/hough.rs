@@ -1139,6 +1139,7 @@ mod tests {
     /// unfused `f32` products): 60 seeded scenes, both bands, several tolerances and
     /// separations. Skipped (and said so) on a CPU without AVX2.
     #[test]
+    #[cfg(target_arch = "x86_64")]
     fn the_avx2_vote_and_peak_search_equal_the_portable_ones() {
         let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
         if !ws.avx2 {
