@@ -451,9 +451,8 @@ impl HoughWorkspace {
 
     /// [`Self::vote_oriented`] then [`Self::take_peaks`]: the work of
     /// [`Self::find_lines_oriented`] once its input is checked. Both are inlined here and into
-    /// [`Self::vote_and_take_peaks_avx2`], which compiles the same code for AVX2: wider integer
-    /// vectors for the smoothing and the maxima of the peak search, and the ρ bins eight at a
-    /// time. The same operations on the same values (integer sums, and `f32` products and sums
+    /// [`Self::vote_and_take_peaks_avx2`], which compiles the same code for AVX2: the loops the compiler
+    /// vectorises (the smoothing, the row maxima, the θ-major ρ bins) on 256-bit vectors. The same operations on the same values (integer sums, and `f32` products and sums
     /// in the same order, never fused): the same votes and peaks on either path.
     #[inline(always)]
     fn vote_and_take_peaks(

@@ -126,8 +126,8 @@
 //!
 //! On a CPU with AVX2 (detected at run time, once per workspace) the oriented vote and its peak
 //! search run as a copy of the same code compiled for AVX2 (`#[target_feature]`, as
-//! `vision-gradient`'s kernel): the 3×3 smoothing and the row maxima of the peak search on
-//! eight cells at a time, the ρ bins eight points at a time. The same integer sums and the
+//! `vision-gradient`'s kernel): the loops the compiler vectorises (the 3×3 smoothing and the
+//! row maxima of the peak search, the ρ bins of the θ-major vote) on 256-bit vectors. The same integer sums and the
 //! same unfused `f32` operations in the same order, so the same votes and peaks on either path.
 //!
 //! # Parameters and units
