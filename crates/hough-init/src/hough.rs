@@ -129,6 +129,9 @@ pub struct HoughWorkspace {
     /// and its peak search then run compiled for it (`vote_and_take_peaks`).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     avx2: bool,
+    /// Runs of [`Self::vote_and_take_peaks_avx2`], for the test that the AVX2 path is taken.
+    #[cfg(test)]
+    avx2_runs: usize,
 }
 
 impl core::fmt::Debug for HoughWorkspace {
@@ -256,6 +259,8 @@ impl HoughWorkspace {
             run_starts: Vec::with_capacity(2 * theta_bins + 2),
             run_next: Vec::with_capacity(2 * theta_bins + 1),
             avx2,
+            #[cfg(test)]
+            avx2_runs: 0,
         })
     }
 
@@ -478,6 +483,10 @@ impl HoughWorkspace {
         separation: (f64, f64),
         out: &mut [HoughLine],
     ) -> usize {
+        #[cfg(test)]
+        {
+            self.avx2_runs += 1;
+        }
         self.vote_and_take_peaks(points, bins, tolerance_deg, separation, out)
     }
 
@@ -1136,65 +1145,89 @@ mod tests {
     /// The AVX2 build of the oriented vote and its peak search finds the same peaks, from the
     /// same accumulator and smoothed votes, as the portable one (the same integer sums and
     /// unfused `f32` products): 60 seeded scenes, both bands, several tolerances and
-    /// separations. Skipped (and said so) on a CPU without AVX2.
+    /// separations, under the default Hough parameters and with peak smoothing, sub-bin
+    /// refinement and other bin sizes changed. Both paths are reached through
+    /// [`HoughWorkspace::find_lines_oriented`], which takes the AVX2 one wherever
+    /// [`HoughWorkspace::new`] detected AVX2 (checked here too). Skipped (and said so) on a CPU
+    /// without AVX2.
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn the_avx2_vote_and_peak_search_equal_the_portable_ones() {
-        let mut ws = HoughWorkspace::new(320, 240, HoughParams::default()).unwrap();
-        if !ws.avx2 {
-            eprintln!("no AVX2 on this CPU: only the portable path exists to test");
-            return;
-        }
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || xorshift(&mut state);
+        let detected = std::arch::is_x86_feature_detected!("avx2");
+        let param_sets = [
+            HoughParams::default(),
+            HoughParams {
+                peak_smoothing: false,
+                ..HoughParams::default()
+            },
+            HoughParams {
+                subbin_refinement: false,
+                ..HoughParams::default()
+            },
+            HoughParams {
+                theta_step_deg: 1.0,
+                rho_step_px: 2.0,
+                peak_smoothing: false,
+                subbin_refinement: false,
+            },
+        ];
         let none = HoughLine {
             rho_px: 0.0,
             theta_rad: 0.0,
             votes: 0,
         };
         let mut compared = 0;
-        for scene in 0..60 {
-            let points = oriented_scene(&mut next, 1 + scene % 4, 50 * (scene % 7));
-            ws.reserve_oriented_points(points.len());
-            for band in [AngleBand::LEFT_LANE, AngleBand::RIGHT_LANE] {
-                let bins = ws.band_bins(&band).unwrap();
-                for (tolerance_deg, separation) in
-                    [(15.0, (3.0, 8.0)), (5.0, (1.0, 2.0)), (90.0, (6.0, 20.0))]
-                {
-                    let (mut portable, mut avx2) = ([none; 8], [none; 8]);
-                    let n = ws.vote_and_take_peaks(
-                        &points,
-                        bins,
-                        tolerance_deg,
-                        separation,
-                        &mut portable,
-                    );
-                    let (acc, smoothed) = (ws.acc.clone(), ws.smoothed.clone());
-                    // SAFETY: `ws.avx2` is true (checked above): the CPU has AVX2.
-                    let m = unsafe {
-                        ws.vote_and_take_peaks_avx2(
-                            &points,
-                            bins,
-                            tolerance_deg,
-                            separation,
-                            &mut avx2,
-                        )
-                    };
-                    assert_eq!(
-                        (n, &portable[..n]),
-                        (m, &avx2[..m]),
-                        "scene {scene}, {band:?}"
-                    );
-                    assert!(
-                        ws.acc == acc && ws.smoothed == smoothed,
-                        "scene {scene}, {band:?}"
-                    );
-                    compared += n;
+        for params in param_sets {
+            let mut ws = HoughWorkspace::new(320, 240, params).unwrap();
+            assert_eq!(ws.avx2, detected, "the path follows the CPU's AVX2");
+            if !detected {
+                eprintln!("no AVX2 on this CPU: only the portable path exists to test");
+                return;
+            }
+            let mut state = 0x2545_f491_4f6c_dd1du64;
+            let mut next = move || xorshift(&mut state);
+            for scene in 0..60 {
+                let points = oriented_scene(&mut next, 1 + scene % 4, 50 * (scene % 7));
+                ws.reserve_oriented_points(points.len());
+                for band in [AngleBand::LEFT_LANE, AngleBand::RIGHT_LANE] {
+                    for (tolerance_deg, (sep_theta_deg, sep_rho_px)) in
+                        [(15.0, (3.0, 8.0)), (5.0, (1.0, 2.0)), (90.0, (6.0, 20.0))]
+                    {
+                        let mut run = |avx2: bool, out: &mut [HoughLine; 8]| {
+                            ws.avx2 = avx2;
+                            let runs = ws.avx2_runs;
+                            let n = ws
+                                .find_lines_oriented(
+                                    &points,
+                                    &band,
+                                    tolerance_deg,
+                                    sep_theta_deg,
+                                    sep_rho_px,
+                                    out,
+                                )
+                                .unwrap();
+                            assert_eq!(ws.avx2_runs, runs + usize::from(avx2), "path taken");
+                            (n, ws.acc.clone(), ws.smoothed.clone())
+                        };
+                        let (mut portable, mut avx2) = ([none; 8], [none; 8]);
+                        let (n, acc, smoothed) = run(false, &mut portable);
+                        let (m, acc_avx2, smoothed_avx2) = run(true, &mut avx2);
+                        assert_eq!(
+                            (n, &portable[..n]),
+                            (m, &avx2[..m]),
+                            "{params:?}, scene {scene}, {band:?}"
+                        );
+                        assert!(
+                            acc == acc_avx2 && smoothed == smoothed_avx2,
+                            "{params:?}, scene {scene}, {band:?}"
+                        );
+                        compared += n;
+                    }
                 }
             }
         }
         // The scenes hold lines: most searches return several peaks.
-        assert!(compared > 60 * 2 * 3 * 4, "{compared} peaks compared");
+        assert!(compared > 4 * 60 * 2 * 3 * 4, "{compared} peaks compared");
     }
 
     /// The one-pass validity test of the oriented points agrees with the checks that name the
