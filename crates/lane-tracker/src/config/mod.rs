@@ -354,6 +354,15 @@ pub struct TrackConfig {
     /// absent; 0 is read as 1).
     #[serde(default)]
     pub refine_passes: u32,
+    /// `true`: after the windowed refinement that follows an initialisation, a lane whose
+    /// parabola turns back below its points — its vertex (vertical image tangent) lies between
+    /// the lowest point's row and the bottom row searched, at a column inside the image — is
+    /// replaced by the least-squares line through those points: nothing was measured there, and
+    /// a lane does not turn back between its evidence and the camera (an addition beyond the
+    /// paper, module `tracker::turn_back`). Tracked frames keep the filter's estimate. `false`
+    /// (default when absent): the refined parabola as it is (the paper).
+    #[serde(default)]
+    pub no_turn_back: bool,
     /// Re-validation (an addition beyond the paper; joint initialisation with
     /// `init.candidate_coverage` only, never otherwise): while both
     /// lanes are tracked, every this many frames the whole ROI goes through the joint

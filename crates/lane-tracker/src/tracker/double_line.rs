@@ -185,19 +185,11 @@ impl LaneTracker {
         };
         let theta = Vector3::new(p.a1, p.a2 + beta, p.a3 + alpha);
         let half_gap = |y: usize| (alpha + beta * y as f64).abs();
-        match self.new_filter(&theta) {
-            Ok(filter) => {
-                let lane = &mut self.lanes[i];
-                lane.filter = Some(filter);
-                lane.pair_half_gap_px = half_gap(top).max(half_gap(bottom - 1));
-                true
-            }
-            Err(e) => {
-                self.counters.filter_failures[i] += 1;
-                self.last_failure[i] = Some(e);
-                false
-            }
+        let moved = self.restart_filter(i, &theta);
+        if moved {
+            self.lanes[i].pair_half_gap_px = half_gap(top).max(half_gap(bottom - 1));
         }
+        moved
     }
 }
 

@@ -805,6 +805,24 @@ impl LaneTracker {
         }
     }
 
+    /// Lane `i`'s filter restarted at `theta` (pixel coefficients) with `filter.p0_sigma_px`,
+    /// after a reading of the image moved its estimate (a double line's middle, no turn back);
+    /// `false`, the lane left as it was and the failure counted and kept, if the filter refuses
+    /// it.
+    pub(super) fn restart_filter(&mut self, i: usize, theta: &Vector3<f64>) -> bool {
+        match self.new_filter(theta) {
+            Ok(filter) => {
+                self.lanes[i].filter = Some(filter);
+                true
+            }
+            Err(e) => {
+                self.counters.filter_failures[i] += 1;
+                self.last_failure[i] = Some(e);
+                false
+            }
+        }
+    }
+
     /// Accept an initialisation of lane `i` (`self.candidates` holds the pixels it was fitted
     /// to): sanity checks, a fresh filter, the lane's state. `false` if refused.
     fn install(&mut self, i: usize, init: &LaneInit) -> bool {

@@ -19,6 +19,7 @@ mod kerb;
 mod points;
 #[cfg(test)]
 mod tests;
+mod turn_back;
 mod update;
 mod windows;
 
@@ -752,6 +753,9 @@ impl LaneTracker {
                     self.over_rows(self.rows_of(i), |t| {
                         for _ in 0..t.cfg.track.refine_passes.max(1) {
                             t.track_lane(i, &image, false)?;
+                        }
+                        if t.cfg.track.no_turn_back {
+                            t.straighten_turn_back(i);
                         }
                         let doubled =
                             t.cfg.init.double_line_middle && t.centre_on_double_line(i, &image);

@@ -1899,3 +1899,71 @@ fn a_double_line_of_narrow_lines_is_initialised_between_them_with_stripe_middles
         assert!(d.abs() < 3.0, "row {y}: {d} px off the pair's middle");
     }
 }
+
+/// The centre of `curved_dash_left`'s dash at row `y`: a parabola whose vertex (vertical
+/// tangent) lies at row 225, px.
+fn curved_dash_col(y: f64) -> f64 {
+    0.01 * (y - 225.0) * (y - 225.0) + 90.0
+}
+
+/// A left dash 5 px wide drawn on rows 150–199 only, along [`curved_dash_col`] (it bends
+/// towards the vertical at its lower end), and `two_marks`' straight right mark.
+fn curved_dash_left(w: usize, h: usize) -> GreyFrame {
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        let dash = (150.0..200.0).contains(&y) && (x - curved_dash_col(y)).abs() < 2.5;
+        if dash || (x - mark_right(y)).abs() < 2.5 {
+            *p = 200;
+        }
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+#[test]
+fn a_lane_turning_back_below_its_evidence_is_reported_as_the_line_through_it() {
+    let frame = curved_dash_left(320, 240);
+    // The least-squares line through the dash's centre, rows 150–199.
+    let rows: Vec<f64> = (150..200).map(f64::from).collect();
+    let n = rows.len() as f64;
+    let (mean_y, mean_x) = (
+        rows.iter().sum::<f64>() / n,
+        rows.iter().map(|&y| curved_dash_col(y)).sum::<f64>() / n,
+    );
+    let slope = rows
+        .iter()
+        .map(|&y| (y - mean_y) * (curved_dash_col(y) - mean_x))
+        .sum::<f64>()
+        / rows
+            .iter()
+            .map(|&y| (y - mean_y) * (y - mean_y))
+            .sum::<f64>();
+    let line = |y: f64| mean_x + slope * (y - mean_y);
+    for no_turn_back in [true, false] {
+        let mut cfg = TrackerConfig::default_preset().expect("the default preset");
+        cfg.track.no_turn_back = no_turn_back;
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let bottom = (tracker.roi.1 - 1) as f64;
+        let report = tracker.track(&frame).expect("a frame");
+        assert!(report.lanes[0].initialised && report.lanes[1].initialised);
+        let c = report.lanes[0].coeffs.expect("a left lane");
+        let col = |y: f64| (c[0] * y + c[1]) * y + c[2];
+        if no_turn_back {
+            // Straight, along the dash's line: at its rows and on below them.
+            assert_eq!(c[0], 0.0, "{c:?}");
+            for y in [150.0, 199.0, bottom] {
+                let d = col(y) - line(y);
+                assert!(d.abs() < 2.0, "row {y}: {d} px off the dash's line");
+            }
+        } else {
+            // The refined parabola turns back between the dash and the bottom row: the case
+            // the setting is for arises here.
+            let vertex = -c[1] / (2.0 * c[0]);
+            assert!(
+                vertex > 199.0 && vertex <= bottom,
+                "vertex at row {vertex}: {c:?}"
+            );
+            assert!(col(bottom) - line(bottom) > 20.0, "{c:?}");
+        }
+    }
+}
