@@ -11,24 +11,36 @@
 //!    darkest level `b` within `3·w_max` px of it (`w_max = gradient.stripe_max_width_px`); a
 //!    row whose contrast `I(x_p) − b` is below [`MIN_CONTRAST`] is skipped. The mark is the
 //!    run `[l, r]` around `x_p` at or above the half level `h = (I(x_p) + b)/2`, of width
-//!    `w = r − l + 1 ≤ w_max`, and the estimate must lie on it (`l − ½ ≤ x̂(y) ≤ r + ½`: an
-//!    estimate already between the two lines stays);
+//!    `w = r − l + 1 ≤ w_max`, and the estimate must lie on it (`l − ½ ≤ x̂(y) ≤ r + ½`; an
+//!    estimate between the two lines is read by step 4);
 //! 2. its partner on each side: after a valley below `h` that starts at the mark's edge, a run
 //!    at or above `h` that starts within `2w + 2` px of that edge, of width in `[w/2, 2w + 1]`,
 //!    whose peak reaches `h + (I(x_p) − h)/2` (about as bright as the mark);
 //! 3. a row whose mark has a partner on exactly one side gives the middle of the pair relative
 //!    to the estimate, `t(y) = (c₁ + c₂)/2 − x̂(y)`, `c₁ = (l + r)/2` and `c₂` the partner's
-//!    centre.
+//!    centre, and its half gap `g(y) = |c₂ − c₁|/2`;
+//! 4. a row whose estimate lies on no mark may lie in the valley between the two lines (the
+//!    refinement's edge pixels of two narrow lines settle between them, and a lane there can
+//!    still lean across the pair): the brightest pixel within `w_max/2` px on each side of
+//!    `x̂(y)`, if both are at least [`MIN_CONTRAST`] above the darkest of the three pixels
+//!    around `x̂(y)` (a valley under the estimate; most rows, a uniform road, end here), is
+//!    read as in steps 1–3; if the left one is a mark whose single partner lies to its right,
+//!    the right one a mark whose single partner lies to its left, and the two middles agree
+//!    within [`VALLEY_AGREEMENT_PX`], the row gives their mean middle `t(y)` and half gap
+//!    `g(y)` as an estimate between the lines.
 //!
-//! The lane is a double line if at least [`MIN_ROW_FRACTION`] of the rows searched give a
-//! partner, on the same side in at least five rows of six. Its estimate then moves to the
-//! middle of the pair: `t(y) ≈ α + β·y` by least squares over the rows of that side (the gap
-//! widens towards the camera, linearly in `y` on a straight road) and
+//! The lane is a double line if at least [`MIN_ROW_FRACTION`] of the rows searched where the
+//! estimate lies inside the image (a lane leaving the image through its side shows the pair
+//! on those rows only) give the pair, and the rows read from one line are on the same side in
+//! at least five of six (those read from between the lines count with the larger side). Its
+//! estimate then moves to the middle of the pair: `t(y) ≈ α + β·y` by least squares over those
+//! rows (the gap widens towards the camera, linearly in `y` on a straight road) and
 //! `x(y) = x̂(y) + α + β·y`, i.e. `(a1, a2 + β, a3 + α)`; the filter restarts from it. Its
-//! tracking windows then reach at least `2·max|α + β·y|` (twice the half gap at the widest
-//! row) to each side, so that they hold both lines: with windows that clip the far edge of one
-//! line the estimate drifts onto the other within a few frames (≈ 6 px off the middle on the
-//! rendered double line with ±10 px windows). No allocation.
+//! tracking windows then reach at least twice the half gap `g(y) ≈ γ + δ·y` (least squares
+//! over the same rows) at the widest row to each side, so that they hold both lines: with
+//! windows that clip the far edge of one line the estimate drifts onto the other within a few
+//! frames (≈ 6 px off the middle on the rendered double line with ±10 px windows). No
+//! allocation.
 
 use hough_init::Parabola;
 use nalgebra::Vector3;
@@ -38,8 +50,12 @@ use super::LaneTracker;
 
 /// Least mark contrast (grey levels) for a row to be read.
 const MIN_CONTRAST: f64 = 20.0;
-/// Least fraction of the rows searched that must show the pair.
+/// Least fraction of the rows searched, where the estimate lies inside the image, that must
+/// show the pair.
 const MIN_ROW_FRACTION: f64 = 0.3;
+/// Read from between the lines, the middles found from the left and from the right line must
+/// agree within this, px (the same pair).
+const VALLEY_AGREEMENT_PX: f64 = 1.5;
 
 /// Least-squares sums of `t(y) = α + β·y` over rows (here those of one side of a double line;
 /// the kerb's feet too).
@@ -61,6 +77,17 @@ impl LineSums {
         self.ty += t * y;
     }
 
+    /// These rows and `other`'s.
+    fn merged(self, other: Self) -> Self {
+        Self {
+            rows: self.rows + other.rows,
+            y: self.y + other.y,
+            yy: self.yy + other.yy,
+            t: self.t + other.t,
+            ty: self.ty + other.ty,
+        }
+    }
+
     /// `(α, β)`, `None` if the rows do not determine them.
     pub(super) fn fit(&self) -> Option<(f64, f64)> {
         let n = self.rows as f64;
@@ -73,10 +100,21 @@ impl LineSums {
     }
 }
 
-/// Row `y`'s mark under column `x_hat` and its partner (steps 1–3 of the module docs): the
-/// middle of the pair minus `x_hat` and the partner's side (`+1` right, `−1` left), `None` if
-/// the row shows no mark or no single partner.
-fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<(f64, i64)> {
+/// A row's reading of a double line (module docs, steps 3 and 4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PairRow {
+    /// The pair's middle minus the estimate's column, px.
+    middle_offset_px: f64,
+    /// Half the distance between the two lines' centres, px.
+    half_gap_px: f64,
+    /// The partner's side of the mark under the estimate (`+1` right, `−1` left); 0 for an
+    /// estimate between the lines.
+    side: i64,
+}
+
+/// Row `y`'s mark under column `x_hat` and its partner (steps 1–3 of the module docs), `None`
+/// if the row shows no mark or no single partner.
+fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<PairRow> {
     let w = row.len() as i64;
     let at = |x: i64| (0..w).contains(&x).then(|| f64::from(row[x as usize]));
     // Far outside any row (or not a number): no mark under it. Within ±1e9 the integer
@@ -103,11 +141,13 @@ fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<(f64, i64)> 
         return None;
     }
     let half = 0.5 * (peak + background);
+    // The run, read no further than one pixel past the widest mark (a wider run is no mark:
+    // a bright area can span the row).
     let (mut l, mut r) = (xp, xp);
-    while at(l - 1).is_some_and(|v| v >= half) {
+    while r - l < max_width_px && at(l - 1).is_some_and(|v| v >= half) {
         l -= 1;
     }
-    while at(r + 1).is_some_and(|v| v >= half) {
+    while r - l < max_width_px && at(r + 1).is_some_and(|v| v >= half) {
         r += 1;
     }
     let width = r - l + 1;
@@ -133,7 +173,10 @@ fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<(f64, i64)> 
         }
         let start = x;
         let mut top = half;
-        while let Some(v) = at(x).filter(|&v| v >= half) {
+        // (Read no further than one pixel past the widest partner.)
+        while (x - start).abs() <= 2 * width + 1
+            && let Some(v) = at(x).filter(|&v| v >= half)
+        {
             top = top.max(v);
             x += dir;
         }
@@ -149,7 +192,56 @@ fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<(f64, i64)> 
         (None, Some(c)) => (c, -1),
         _ => return None,
     };
-    Some((0.5 * (centre + c2) - x_hat, side))
+    Some(PairRow {
+        middle_offset_px: 0.5 * (centre + c2) - x_hat,
+        half_gap_px: 0.5 * (c2 - centre).abs(),
+        side,
+    })
+}
+
+/// Row `y` read from between the two lines of a double line (step 4 of the module docs): the
+/// nearest line on each side of column `x_hat` read as in steps 1–3, `None` unless they are
+/// the same pair.
+fn valley_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<PairRow> {
+    // Far outside any row (or not a number): nothing to read (as in `pair_middle`).
+    if x_hat.is_nan() || x_hat.abs() > 1e9 {
+        return None;
+    }
+    let w = row.len() as i64;
+    let x0 = x_hat.round() as i64;
+    let reach = (max_width_px / 2).max(1);
+    // The brightest pixel of `xs` inside the row (the first of equals).
+    let brightest = |xs: std::ops::RangeInclusive<i64>| {
+        xs.filter(|x| (0..w).contains(x))
+            .map(|x| (x, row[x as usize]))
+            .fold(None, |best: Option<(i64, u8)>, (x, v)| match best {
+                Some((_, b)) if b >= v => best,
+                _ => Some((x, v)),
+            })
+    };
+    let (left, left_peak) = brightest(x0 - reach..=x0 - 1)?;
+    let (right, right_peak) = brightest(x0 + 1..=x0 + reach)?;
+    // A valley under the estimate, below both lines by the least contrast of a mark: else there
+    // is no pair to read from here (most rows: a uniform road), and the two reads below are not
+    // made.
+    let floor = (x0 - 1..=x0 + 1)
+        .filter(|x| (0..w).contains(x))
+        .map(|x| row[x as usize])
+        .min()?;
+    if f64::from(left_peak.min(right_peak)) - f64::from(floor) < MIN_CONTRAST {
+        return None;
+    }
+    let from_left = pair_middle(row, left as f64, max_width_px).filter(|p| p.side == 1)?;
+    let from_right = pair_middle(row, right as f64, max_width_px).filter(|p| p.side == -1)?;
+    let (middle_left, middle_right) = (
+        left as f64 + from_left.middle_offset_px,
+        right as f64 + from_right.middle_offset_px,
+    );
+    ((middle_left - middle_right).abs() <= VALLEY_AGREEMENT_PX).then_some(PairRow {
+        middle_offset_px: 0.5 * (middle_left + middle_right) - x_hat,
+        half_gap_px: 0.5 * (from_left.half_gap_px + from_right.half_gap_px),
+        side: 0,
+    })
 }
 
 impl LaneTracker {
@@ -162,29 +254,49 @@ impl LaneTracker {
         let p = Parabola::from_coeffs(c);
         let (top, bottom) = self.search_rows;
         let max_width_px = i64::from(self.cfg.gradient.stripe_max_width_px.max(1));
-        let mut sides = [LineSums::default(); 2];
+        let width = self.width as f64;
+        // Middles read from the left line, the right line, between the lines; the half gaps of
+        // each.
+        let mut middles = [LineSums::default(); 3];
+        let mut gaps = [LineSums::default(); 3];
+        let mut inside = 0usize;
         for y in top..bottom {
             let Some(row) = image.row(y) else { continue };
-            let y = y as f64;
-            if let Some((t, side)) = pair_middle(row, p.col_at_row(y), max_width_px) {
-                sides[usize::from(side > 0)].add(y, t);
-            }
+            let x_hat = p.col_at_row(y as f64);
+            inside += usize::from((0.0..width).contains(&x_hat));
+            let Some(read) = pair_middle(row, x_hat, max_width_px)
+                .or_else(|| valley_middle(row, x_hat, max_width_px))
+            else {
+                continue;
+            };
+            let k = match read.side {
+                -1 => 0,
+                1 => 1,
+                _ => 2,
+            };
+            middles[k].add(y as f64, read.middle_offset_px);
+            gaps[k].add(y as f64, read.half_gap_px);
         }
-        let (major, minor) = if sides[1].rows >= sides[0].rows {
-            (sides[1], sides[0])
+        let (major, minor) = if middles[1].rows >= middles[0].rows {
+            (1, 0)
         } else {
-            (sides[0], sides[1])
+            (0, 1)
         };
-        if (major.rows as f64) < MIN_ROW_FRACTION * (bottom - top) as f64
-            || 5 * minor.rows > major.rows
+        let (pair, pair_gaps) = (
+            middles[major].merged(middles[2]),
+            gaps[major].merged(gaps[2]),
+        );
+        if inside == 0
+            || (pair.rows as f64) < MIN_ROW_FRACTION * inside as f64
+            || 5 * middles[minor].rows > pair.rows
         {
             return false;
         }
-        let Some((alpha, beta)) = major.fit() else {
+        let (Some((alpha, beta)), Some((gamma, delta))) = (pair.fit(), pair_gaps.fit()) else {
             return false;
         };
         let theta = Vector3::new(p.a1, p.a2 + beta, p.a3 + alpha);
-        let half_gap = |y: usize| (alpha + beta * y as f64).abs();
+        let half_gap = |y: usize| (gamma + delta * y as f64).abs();
         let moved = self.restart_filter(i, &theta);
         if moved {
             self.lanes[i].pair_half_gap_px = half_gap(top).max(half_gap(bottom - 1));
@@ -195,7 +307,15 @@ impl LaneTracker {
 
 #[cfg(test)]
 mod tests {
-    use super::pair_middle;
+    use super::{PairRow, pair_middle, valley_middle};
+
+    fn read(middle_offset_px: f64, half_gap_px: f64, side: i64) -> Option<PairRow> {
+        Some(PairRow {
+            middle_offset_px,
+            half_gap_px,
+            side,
+        })
+    }
 
     /// A row of grey 60 with bright (200) runs `[start, end)`.
     fn row(runs: &[(usize, usize)]) -> Vec<u8> {
@@ -210,8 +330,8 @@ mod tests {
     fn a_row_reads_the_middle_of_a_pair_and_nothing_else() {
         // A double line: marks on 40..45 and 50..55, centres 42 and 52.
         let double = row(&[(40, 45), (50, 55)]);
-        assert_eq!(pair_middle(&double, 42.0, 12), Some((5.0, 1)));
-        assert_eq!(pair_middle(&double, 52.0, 12), Some((-5.0, -1)));
+        assert_eq!(pair_middle(&double, 42.0, 12), read(5.0, 5.0, 1));
+        assert_eq!(pair_middle(&double, 52.0, 12), read(-5.0, 5.0, -1));
         // A single mark, a mark whose neighbour is a lane away, a mark between two others, a
         // wide bright area, a faint mark: no pair.
         assert_eq!(pair_middle(&row(&[(40, 45)]), 42.0, 12), None);
@@ -250,6 +370,52 @@ mod tests {
         ] {
             assert_eq!(pair_middle(&double, x_hat, 12), None, "{x_hat}");
         }
-        assert_eq!(pair_middle(&double, -0.4, 12), Some((7.4, 1)));
+        assert_eq!(pair_middle(&double, -0.4, 12), read(7.4, 5.0, 1));
+        for x_hat in [1e19, f64::NAN, -1e10] {
+            assert_eq!(valley_middle(&double, x_hat, 12), None, "{x_hat}");
+        }
+    }
+
+    /// From between the two lines of a pair the row reads the pair's middle and half gap, from
+    /// anywhere in the valley; not from beside a single line, between two lines that are not
+    /// one pair (too far apart, or one of three), or on a line (step 1 reads that).
+    #[test]
+    fn a_row_reads_a_pair_from_between_its_lines() {
+        // Marks on 40..45 and 50..55, centres 42 and 52: middle 47, half gap 5.
+        let double = row(&[(40, 45), (50, 55)]);
+        for x_hat in [45.6, 46.0, 47.0, 48.3, 49.0] {
+            assert_eq!(
+                valley_middle(&double, x_hat, 12),
+                read(47.0 - x_hat, 5.0, 0),
+                "{x_hat}"
+            );
+        }
+        // Unlike widths: each line's middle as `pair_middle` reads it, their mean.
+        let unlike = row(&[(40, 43), (48, 53)]);
+        assert_eq!(
+            valley_middle(&unlike, 45.0, 12),
+            read(0.5 * (41.0 + 50.0) - 45.0, 4.5, 0)
+        );
+        assert_eq!(valley_middle(&row(&[(40, 45)]), 47.0, 12), None);
+        assert_eq!(valley_middle(&row(&[(40, 45), (70, 75)]), 57.0, 12), None);
+        assert_eq!(
+            valley_middle(&row(&[(30, 35), (40, 45), (50, 55)]), 47.0, 12),
+            None
+        );
+        // On a line the brightest pixels on either side are the line itself and the valley or
+        // the other line: they do not read one pair from both sides.
+        assert_eq!(valley_middle(&double, 42.0, 12), None);
+        // A line out of reach (beyond w_max/2 = 6 px of the estimate): nothing.
+        assert_eq!(valley_middle(&row(&[(40, 45), (58, 63)]), 51.0, 12), None);
+        // Lines less than the least mark contrast above the valley: nothing read.
+        let mut faint = double.clone();
+        faint
+            .iter_mut()
+            .filter(|v| **v == 200)
+            .for_each(|v| *v = 79);
+        assert_eq!(valley_middle(&faint, 47.0, 12), None);
+        faint.iter_mut().filter(|v| **v == 79).for_each(|v| *v = 80);
+        assert_eq!(pair_middle(&faint, 42.0, 12), read(5.0, 5.0, 1));
+        assert_eq!(valley_middle(&faint, 47.0, 12), read(0.0, 5.0, 0));
     }
 }

@@ -10,6 +10,7 @@ use super::init::counts_as;
 use super::{Estimator, InitCandidate, LaneFilter, LaneState, LaneTracker, SavedEstimate, Side};
 use crate::{FilterFailure, GreyFrame, TrackerConfig};
 use hough_init::Parabola;
+use nalgebra::Vector3;
 
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator::new();
@@ -615,12 +616,17 @@ fn the_second_search_accepts_a_dash_as_long_as_the_roi_would() {
 /// of `two_marks`' geometry, with its single right mark; `inner_only` paints only the line
 /// `left(y) + s(y)`.
 fn double_line_left(w: usize, h: usize, inner_only: bool) -> GreyFrame {
+    double_line_shifted(w, h, inner_only, 0.0)
+}
+
+/// [`double_line_left`] with the double line `shift_px` further left.
+fn double_line_shifted(w: usize, h: usize, inner_only: bool, shift_px: f64) -> GreyFrame {
     let (left, right) = (mark_left, mark_right);
     let mut pixels = vec![60u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
         let (s, half) = (3.0 + 4.0 * (y - 140.0) / 100.0, 1.5 + (y - 140.0) / 100.0);
-        let d = x - left(y);
+        let d = x - left(y) + shift_px;
         let outer = !inner_only && (d + s).abs() < half;
         if (d - s).abs() < half || outer || (x - right(y)).abs() < 2.5 {
             *p = 200;
@@ -680,6 +686,77 @@ fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
                 "frame {frame}, row {y}: {d} px off the middle"
             );
         }
+    }
+}
+
+#[test]
+fn a_lane_leaning_across_a_double_line_from_between_its_lines_is_moved_to_its_middle() {
+    let left = mark_left;
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let rows = [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64];
+    let double = double_line_left(320, 240, false);
+    tracker.track(&double).expect("a frame");
+    // The lane between the two lines but leaning across them: 1 px left of the middle at the
+    // top row, 3 px right of it at the bottom (the valley is 3.5 px wide at the top, 9 px at
+    // the bottom).
+    let (y0, y1) = (top as f64, (bottom - 1) as f64);
+    let lean = |y: f64| -1.0 + 4.0 * (y - y0) / (y1 - y0);
+    let slope = (left(y1) + lean(y1) - left(y0) - lean(y0)) / (y1 - y0);
+    let theta = Vector3::new(0.0, slope, left(y0) + lean(y0) - slope * y0);
+    tracker.lanes[0].filter = Some(tracker.new_filter(&theta).expect("a filter"));
+    let image = GreyImage::new(double.data(), 320, 240, 320).expect("an image");
+    let (moved, allocations) = allocations_in(|| tracker.centre_on_double_line(0, &image));
+    assert!(moved, "read from between the lines");
+    assert_eq!(allocations, 0);
+    let c = tracker.lanes[0]
+        .filter
+        .as_ref()
+        .map(LaneFilter::coeffs)
+        .expect("a left lane");
+    for y in rows {
+        let d = c[0] * y * y + c[1] * y + c[2] - left(y);
+        assert!(d.abs() < 1.0, "row {y}: {d} px off the middle");
+    }
+    // Its windows reach both lines: at least twice the half gap at the widest row (7 px at the
+    // bottom: s(y) = 3 + 4·(y − 140)/100).
+    let half_gap = tracker.lanes[0].pair_half_gap_px;
+    assert!((half_gap - 6.96).abs() < 1.0, "half gap {half_gap} px");
+}
+
+#[test]
+fn a_double_line_leaving_the_image_is_read_on_the_rows_it_is_inside() {
+    // The double line 128 px further left: its middle leaves the image through its left side
+    // at row 176, so it lies inside on the ROI's top 27 rows of 91, fewer than the 30 % of all
+    // its rows the reading asks for, but most of the rows where it is inside.
+    let shift = 128.0;
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let double = double_line_shifted(320, 240, false, shift);
+    tracker.track(&double).expect("a frame");
+    let middle = |y: f64| mark_left(y) - shift;
+    let inner = |y: f64| middle(y) + 3.0 + 4.0 * (y - 140.0) / 100.0;
+    let (y0, y1) = (top as f64, (bottom - 1) as f64);
+    assert!(middle(y0) > 10.0 && middle(175.0) > 0.0 && middle(177.0) < 0.0);
+    // The lane on the inner line (a straight line through it at the top and bottom rows).
+    let slope = (inner(y1) - inner(y0)) / (y1 - y0);
+    let theta = Vector3::new(0.0, slope, inner(y0) - slope * y0);
+    tracker.lanes[0].filter = Some(tracker.new_filter(&theta).expect("a filter"));
+    let image = GreyImage::new(double.data(), 320, 240, 320).expect("an image");
+    assert!(
+        tracker.centre_on_double_line(0, &image),
+        "not read as a double line"
+    );
+    let c = tracker.lanes[0]
+        .filter
+        .as_ref()
+        .map(LaneFilter::coeffs)
+        .expect("a left lane");
+    for y in [y0, 160.0, 170.0] {
+        let d = c[0] * y * y + c[1] * y + c[2] - middle(y);
+        assert!(d.abs() < 1.0, "row {y}: {d} px off the middle");
     }
 }
 
