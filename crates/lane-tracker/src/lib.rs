@@ -195,7 +195,7 @@
 //!   sit several pixels off it;
 //! - **measures stripe middles in that refinement** (`track.stripe_middles`; *Stripe middles*
 //!   above): a lane the Hough line put on one edge of a wide mark is refined onto its middle;
-//! - **lets no lane turn back below its evidence** (`track.no_turn_back`; module
+//! - **lets no lane turn back below its evidence** (`init.no_turn_back`; module
 //!   `tracker::turn_back`): after that refinement, a parabola whose vertex `−a2/(2·a1)` (its
 //!   vertical image tangent) lies between the lowest row of its points and the bottom row
 //!   searched, at a column inside the image, is replaced by the least-squares line through its

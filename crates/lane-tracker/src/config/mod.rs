@@ -159,9 +159,10 @@ pub struct InitConfig {
     pub ego_pair: EgoPairParams,
     /// An addition beyond the paper: after a fresh initialisation and its refinement, a lane
     /// whose rows show a second bright line beside its own, parallel, a line width or two
-    /// away (a double line) is moved to the middle of the two, where lane labels put such a
-    /// boundary (the image is read across the estimate row by row; `lane_tracker` crate docs).
-    /// Default `false` when absent.
+    /// away (a double line), or that lies between two such lines, is moved to the middle of the
+    /// two, where lane labels put such a boundary (the image is read across the estimate row by
+    /// row; the pair must show on 30 % of the rows where the estimate lies inside the image;
+    /// module `tracker::double_line`). Default `false` when absent.
     #[serde(default)]
     pub double_line_middle: bool,
     /// An addition beyond the paper: after a fresh initialisation and its refinement (and the
@@ -174,6 +175,16 @@ pub struct InitConfig {
     /// estimate row by row; `lane_tracker` crate docs). Default `false` when absent.
     #[serde(default)]
     pub kerb_foot: bool,
+    /// An addition beyond the paper: `true`: after the windowed refinement that follows an
+    /// initialisation (before the double line's middle and the kerb's foot), a lane whose
+    /// parabola turns back below its points — its vertex (vertical image tangent) lies between
+    /// the lowest point's row and the bottom row searched, at a column inside the image — is
+    /// replaced by the least-squares line through those points: nothing was measured there, and
+    /// a lane does not turn back between its evidence and the camera (module
+    /// `tracker::turn_back`). Tracked frames keep the filter's estimate. `false` (default when
+    /// absent): the refined parabola as it is (the paper).
+    #[serde(default)]
+    pub no_turn_back: bool,
 }
 
 fn default_separation_deg() -> f64 {
@@ -354,15 +365,6 @@ pub struct TrackConfig {
     /// absent; 0 is read as 1).
     #[serde(default)]
     pub refine_passes: u32,
-    /// `true`: after the windowed refinement that follows an initialisation, a lane whose
-    /// parabola turns back below its points — its vertex (vertical image tangent) lies between
-    /// the lowest point's row and the bottom row searched, at a column inside the image — is
-    /// replaced by the least-squares line through those points: nothing was measured there, and
-    /// a lane does not turn back between its evidence and the camera (an addition beyond the
-    /// paper, module `tracker::turn_back`). Tracked frames keep the filter's estimate. `false`
-    /// (default when absent): the refined parabola as it is (the paper).
-    #[serde(default)]
-    pub no_turn_back: bool,
     /// Re-validation (an addition beyond the paper; joint initialisation with
     /// `init.candidate_coverage` only, never otherwise): while both
     /// lanes are tracked, every this many frames the whole ROI goes through the joint

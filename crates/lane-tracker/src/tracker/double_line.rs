@@ -22,7 +22,8 @@
 //! 4. a row whose estimate lies on no mark may lie in the valley between the two lines (the
 //!    refinement's edge pixels of two narrow lines settle between them, and a lane there can
 //!    still lean across the pair): the brightest pixel within `w_max/2` px on each side of
-//!    `x̂(y)`, if both are at least [`MIN_CONTRAST`] above the darkest of the three pixels
+//!    `x̂(y)` (the nearest of equals), if both are at least [`MIN_CONTRAST`] above the darkest
+//!    of the three pixels
 //!    around `x̂(y)` (a valley under the estimate; most rows, a uniform road, end here), is
 //!    read as in steps 1–3; if the left one is a mark whose single partner lies to its right,
 //!    the right one a mark whose single partner lies to its left, and the two middles agree
@@ -31,13 +32,14 @@
 //!
 //! The lane is a double line if at least [`MIN_ROW_FRACTION`] of the rows searched where the
 //! estimate lies inside the image (a lane leaving the image through its side shows the pair
-//! on those rows only) give the pair, and the rows read from one line are on the same side in
+//! on those rows only), and at least [`MIN_PAIR_ROWS`], give the pair, and the rows read from
+//! one line are on the same side in
 //! at least five of six (those read from between the lines count with the larger side). Its
 //! estimate then moves to the middle of the pair: `t(y) ≈ α + β·y` by least squares over those
 //! rows (the gap widens towards the camera, linearly in `y` on a straight road) and
 //! `x(y) = x̂(y) + α + β·y`, i.e. `(a1, a2 + β, a3 + α)`; the filter restarts from it. Its
 //! tracking windows then reach at least twice the half gap `g(y) ≈ γ + δ·y` (least squares
-//! over the same rows) at the widest row to each side, so that they hold both lines: with
+//! over the same rows) at its widest row to each side, so that they hold both lines: with
 //! windows that clip the far edge of one line the estimate drifts onto the other within a few
 //! frames (≈ 6 px off the middle on the rendered double line with ±10 px windows). No
 //! allocation.
@@ -53,6 +55,8 @@ const MIN_CONTRAST: f64 = 20.0;
 /// Least fraction of the rows searched, where the estimate lies inside the image, that must
 /// show the pair.
 const MIN_ROW_FRACTION: f64 = 0.3;
+/// Least number of rows that must show the pair (a lane inside the image on a few rows only).
+const MIN_PAIR_ROWS: usize = 8;
 /// Read from between the lines, the middles found from the left and from the right line must
 /// agree within this, px (the same pair).
 const VALLEY_AGREEMENT_PX: f64 = 1.5;
@@ -100,6 +104,17 @@ impl LineSums {
     }
 }
 
+/// Where a row's estimate lies on a double line (module docs, steps 3 and 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum PairSide {
+    /// On one line, its partner to the left.
+    PartnerLeft,
+    /// On one line, its partner to the right.
+    PartnerRight,
+    /// Between the two lines.
+    Between,
+}
+
 /// A row's reading of a double line (module docs, steps 3 and 4).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct PairRow {
@@ -107,9 +122,8 @@ struct PairRow {
     middle_offset_px: f64,
     /// Half the distance between the two lines' centres, px.
     half_gap_px: f64,
-    /// The partner's side of the mark under the estimate (`+1` right, `−1` left); 0 for an
-    /// estimate between the lines.
-    side: i64,
+    /// Where the estimate lies.
+    side: PairSide,
 }
 
 /// Row `y`'s mark under column `x_hat` and its partner (steps 1–3 of the module docs), `None`
@@ -188,8 +202,8 @@ fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<PairRow> {
     };
     let centre = 0.5 * (l + r) as f64;
     let (c2, side) = match (partner(1), partner(-1)) {
-        (Some(c), None) => (c, 1),
-        (None, Some(c)) => (c, -1),
+        (Some(c), None) => (c, PairSide::PartnerRight),
+        (None, Some(c)) => (c, PairSide::PartnerLeft),
         _ => return None,
     };
     Some(PairRow {
@@ -200,8 +214,8 @@ fn pair_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<PairRow> {
 }
 
 /// Row `y` read from between the two lines of a double line (step 4 of the module docs): the
-/// nearest line on each side of column `x_hat` read as in steps 1–3, `None` unless they are
-/// the same pair.
+/// brightest pixel within `max_width_px / 2` on each side of column `x_hat` (the nearest of
+/// equals) read as in steps 1–3, `None` unless they read the same pair.
 fn valley_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<PairRow> {
     // Far outside any row (or not a number): nothing to read (as in `pair_middle`).
     if x_hat.is_nan() || x_hat.abs() > 1e9 {
@@ -209,30 +223,35 @@ fn valley_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<PairRow> {
     }
     let w = row.len() as i64;
     let x0 = x_hat.round() as i64;
-    let reach = (max_width_px / 2).max(1);
-    // The brightest pixel of `xs` inside the row (the first of equals).
-    let brightest = |xs: std::ops::RangeInclusive<i64>| {
-        xs.filter(|x| (0..w).contains(x))
+    let reach_px = (max_width_px / 2).max(1);
+    // The brightest pixel `dir` of the estimate within the reach, inside the row (the nearest
+    // of equals).
+    let brightest = |dir: i64| {
+        (1..=reach_px)
+            .map(|k| x0 + dir * k)
+            .filter(|x| (0..w).contains(x))
             .map(|x| (x, row[x as usize]))
             .fold(None, |best: Option<(i64, u8)>, (x, v)| match best {
                 Some((_, b)) if b >= v => best,
                 _ => Some((x, v)),
             })
     };
-    let (left, left_peak) = brightest(x0 - reach..=x0 - 1)?;
-    let (right, right_peak) = brightest(x0 + 1..=x0 + reach)?;
+    let (left, left_peak) = brightest(-1)?;
+    let (right, right_peak) = brightest(1)?;
     // A valley under the estimate, below both lines by the least contrast of a mark: else there
     // is no pair to read from here (most rows: a uniform road), and the two reads below are not
     // made.
-    let floor = (x0 - 1..=x0 + 1)
+    let valley_floor = (x0 - 1..=x0 + 1)
         .filter(|x| (0..w).contains(x))
         .map(|x| row[x as usize])
         .min()?;
-    if f64::from(left_peak.min(right_peak)) - f64::from(floor) < MIN_CONTRAST {
+    if f64::from(left_peak.min(right_peak)) - f64::from(valley_floor) < MIN_CONTRAST {
         return None;
     }
-    let from_left = pair_middle(row, left as f64, max_width_px).filter(|p| p.side == 1)?;
-    let from_right = pair_middle(row, right as f64, max_width_px).filter(|p| p.side == -1)?;
+    let from_left =
+        pair_middle(row, left as f64, max_width_px).filter(|p| p.side == PairSide::PartnerRight)?;
+    let from_right =
+        pair_middle(row, right as f64, max_width_px).filter(|p| p.side == PairSide::PartnerLeft)?;
     let (middle_left, middle_right) = (
         left as f64 + from_left.middle_offset_px,
         right as f64 + from_right.middle_offset_px,
@@ -240,7 +259,7 @@ fn valley_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<PairRow> {
     ((middle_left - middle_right).abs() <= VALLEY_AGREEMENT_PX).then_some(PairRow {
         middle_offset_px: 0.5 * (middle_left + middle_right) - x_hat,
         half_gap_px: 0.5 * (from_left.half_gap_px + from_right.half_gap_px),
-        side: 0,
+        side: PairSide::Between,
     })
 }
 
@@ -254,25 +273,25 @@ impl LaneTracker {
         let p = Parabola::from_coeffs(c);
         let (top, bottom) = self.search_rows;
         let max_width_px = i64::from(self.cfg.gradient.stripe_max_width_px.max(1));
-        let width = self.width as f64;
-        // Middles read from the left line, the right line, between the lines; the half gaps of
-        // each.
+        let image_width_px = self.width as f64;
+        // Middles read from a line with its partner on the left, on the right, from between
+        // the lines; the half gaps read.
         let mut middles = [LineSums::default(); 3];
         let mut gaps = [LineSums::default(); 3];
         let mut inside = 0usize;
         for y in top..bottom {
             let Some(row) = image.row(y) else { continue };
             let x_hat = p.col_at_row(y as f64);
-            inside += usize::from((0.0..width).contains(&x_hat));
+            inside += usize::from((0.0..image_width_px).contains(&x_hat));
             let Some(read) = pair_middle(row, x_hat, max_width_px)
                 .or_else(|| valley_middle(row, x_hat, max_width_px))
             else {
                 continue;
             };
             let k = match read.side {
-                -1 => 0,
-                1 => 1,
-                _ => 2,
+                PairSide::PartnerLeft => 0,
+                PairSide::PartnerRight => 1,
+                PairSide::Between => 2,
             };
             middles[k].add(y as f64, read.middle_offset_px);
             gaps[k].add(y as f64, read.half_gap_px);
@@ -286,7 +305,7 @@ impl LaneTracker {
             middles[major].merged(middles[2]),
             gaps[major].merged(gaps[2]),
         );
-        if inside == 0
+        if pair.rows < MIN_PAIR_ROWS
             || (pair.rows as f64) < MIN_ROW_FRACTION * inside as f64
             || 5 * middles[minor].rows > pair.rows
         {
@@ -307,9 +326,9 @@ impl LaneTracker {
 
 #[cfg(test)]
 mod tests {
-    use super::{PairRow, pair_middle, valley_middle};
+    use super::{PairRow, PairSide, pair_middle, valley_middle};
 
-    fn read(middle_offset_px: f64, half_gap_px: f64, side: i64) -> Option<PairRow> {
+    fn read(middle_offset_px: f64, half_gap_px: f64, side: PairSide) -> Option<PairRow> {
         Some(PairRow {
             middle_offset_px,
             half_gap_px,
@@ -330,8 +349,14 @@ mod tests {
     fn a_row_reads_the_middle_of_a_pair_and_nothing_else() {
         // A double line: marks on 40..45 and 50..55, centres 42 and 52.
         let double = row(&[(40, 45), (50, 55)]);
-        assert_eq!(pair_middle(&double, 42.0, 12), read(5.0, 5.0, 1));
-        assert_eq!(pair_middle(&double, 52.0, 12), read(-5.0, 5.0, -1));
+        assert_eq!(
+            pair_middle(&double, 42.0, 12),
+            read(5.0, 5.0, PairSide::PartnerRight)
+        );
+        assert_eq!(
+            pair_middle(&double, 52.0, 12),
+            read(-5.0, 5.0, PairSide::PartnerLeft)
+        );
         // A single mark, a mark whose neighbour is a lane away, a mark between two others, a
         // wide bright area, a faint mark: no pair.
         assert_eq!(pair_middle(&row(&[(40, 45)]), 42.0, 12), None);
@@ -370,7 +395,10 @@ mod tests {
         ] {
             assert_eq!(pair_middle(&double, x_hat, 12), None, "{x_hat}");
         }
-        assert_eq!(pair_middle(&double, -0.4, 12), read(7.4, 5.0, 1));
+        assert_eq!(
+            pair_middle(&double, -0.4, 12),
+            read(7.4, 5.0, PairSide::PartnerRight)
+        );
         for x_hat in [1e19, f64::NAN, -1e10] {
             assert_eq!(valley_middle(&double, x_hat, 12), None, "{x_hat}");
         }
@@ -386,7 +414,7 @@ mod tests {
         for x_hat in [45.6, 46.0, 47.0, 48.3, 49.0] {
             assert_eq!(
                 valley_middle(&double, x_hat, 12),
-                read(47.0 - x_hat, 5.0, 0),
+                read(47.0 - x_hat, 5.0, PairSide::Between),
                 "{x_hat}"
             );
         }
@@ -394,7 +422,7 @@ mod tests {
         let unlike = row(&[(40, 43), (48, 53)]);
         assert_eq!(
             valley_middle(&unlike, 45.0, 12),
-            read(0.5 * (41.0 + 50.0) - 45.0, 4.5, 0)
+            read(0.5 * (41.0 + 50.0) - 45.0, 4.5, PairSide::Between)
         );
         assert_eq!(valley_middle(&row(&[(40, 45)]), 47.0, 12), None);
         assert_eq!(valley_middle(&row(&[(40, 45), (70, 75)]), 57.0, 12), None);
@@ -405,17 +433,42 @@ mod tests {
         // On a line the brightest pixels on either side are the line itself and the valley or
         // the other line: they do not read one pair from both sides.
         assert_eq!(valley_middle(&double, 42.0, 12), None);
-        // A line out of reach (beyond w_max/2 = 6 px of the estimate): nothing.
-        assert_eq!(valley_middle(&row(&[(40, 45), (58, 63)]), 51.0, 12), None);
-        // Lines less than the least mark contrast above the valley: nothing read.
-        let mut faint = double.clone();
-        faint
+        // A pair (10 px between its lines, within the partner's reach of 12) whose left line is
+        // beyond w_max/2 = 6 px of the estimate: nothing.
+        let wide = row(&[(40, 45), (55, 60)]);
+        assert!(pair_middle(&wide, 42.0, 12).is_some());
+        assert_eq!(valley_middle(&wide, 51.0, 12), None);
+        // A valley less than the least mark contrast below the lines: the lines (90 on a road
+        // of 60) read as a pair from either line, not from a valley of 72 between them.
+        let mut shallow = row(&[(40, 45), (50, 55)]);
+        shallow
             .iter_mut()
             .filter(|v| **v == 200)
-            .for_each(|v| *v = 79);
-        assert_eq!(valley_middle(&faint, 47.0, 12), None);
-        faint.iter_mut().filter(|v| **v == 79).for_each(|v| *v = 80);
-        assert_eq!(pair_middle(&faint, 42.0, 12), read(5.0, 5.0, 1));
-        assert_eq!(valley_middle(&faint, 47.0, 12), read(0.0, 5.0, 0));
+            .for_each(|v| *v = 90);
+        shallow[45..50].fill(72);
+        assert_eq!(
+            pair_middle(&shallow, 42.0, 12),
+            read(5.0, 5.0, PairSide::PartnerRight)
+        );
+        assert_eq!(valley_middle(&shallow, 47.0, 12), None);
+        shallow[45..50].fill(70);
+        assert_eq!(
+            valley_middle(&shallow, 47.0, 12),
+            read(0.0, 5.0, PairSide::Between)
+        );
+        // The two reads see different pairs: the left line's read (its darkest level a dark
+        // patch at columns 8–12, half level 110) takes a 120 shoulder into the right line
+        // (middle 48.5), the right line's (the road's 60, half level 130) does not (middle
+        // 46.5): 2 px apart, more than the 1.5 px agreement.
+        let mut unlike = row(&[(38, 45), (50, 55)]);
+        unlike[8..13].fill(20);
+        unlike[55..63].fill(120);
+        let (from_left, from_right) = (
+            pair_middle(&unlike, 44.0, 12).expect("the left line's pair"),
+            pair_middle(&unlike, 50.0, 12).expect("the right line's pair"),
+        );
+        assert_eq!(44.0 + from_left.middle_offset_px, 48.5);
+        assert_eq!(50.0 + from_right.middle_offset_px, 46.5);
+        assert_eq!(valley_middle(&unlike, 47.0, 12), None);
     }
 }

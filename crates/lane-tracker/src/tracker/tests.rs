@@ -727,9 +727,10 @@ fn a_lane_leaning_across_a_double_line_from_between_its_lines_is_moved_to_its_mi
 
 #[test]
 fn a_double_line_leaving_the_image_is_read_on_the_rows_it_is_inside() {
-    // The double line 128 px further left: its middle leaves the image through its left side
-    // at row 176, so it lies inside on the ROI's top 27 rows of 91, fewer than the 30 % of all
-    // its rows the reading asks for, but most of the rows where it is inside.
+    // The double line 128 px further left leaves the image through its left side: its middle
+    // at row 176; the lane, on its inner line, is inside on rows 148–187 of the ROI's 148–239,
+    // its outer line only down to about row 164. The pair shows on about 17 rows: more than
+    // 30 % of the 40 rows where the lane is inside the image, fewer than 30 % of the ROI's 92.
     let shift = 128.0;
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
@@ -2018,7 +2019,7 @@ fn a_lane_turning_back_below_its_evidence_is_reported_as_the_line_through_it() {
     let line = |y: f64| mean_x + slope * (y - mean_y);
     for no_turn_back in [true, false] {
         let mut cfg = TrackerConfig::default_preset().expect("the default preset");
-        cfg.track.no_turn_back = no_turn_back;
+        cfg.init.no_turn_back = no_turn_back;
         let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
         let bottom = (tracker.roi.1 - 1) as f64;
         let report = tracker.track(&frame).expect("a frame");

@@ -1,5 +1,5 @@
 //! No turn back between a lane's evidence and the camera (an addition beyond the paper;
-//! `track.no_turn_back`).
+//! `init.no_turn_back`).
 //!
 //! The lane model `x = a1·y² + a2·y + a3` has its vertex — the row where its image tangent is
 //! vertical, `x′(y) = 2·a1·y + a2 = 0` — at
@@ -53,14 +53,17 @@ pub(super) fn turn_back_line(
     if a1 == 0.0 || !a1.is_finite() {
         return None;
     }
-    let lowest = points
+    let lowest_row_px = points
         .iter()
         .map(|p| f64::from(p.1))
         .fold(f64::NEG_INFINITY, f64::max);
-    let row_v = -a2 / (2.0 * a1);
-    let col_v = (a1 * row_v + a2) * row_v + a3;
+    let vertex_row_px = -a2 / (2.0 * a1);
+    let vertex_col_px = (a1 * vertex_row_px + a2) * vertex_row_px + a3;
     // (False for NaN: a non-finite vertex or point leaves the lane as it is.)
-    let turns = row_v > lowest && row_v <= bottom_row_px && col_v >= 0.0 && col_v < width_px;
+    let turns = vertex_row_px > lowest_row_px
+        && vertex_row_px <= bottom_row_px
+        && vertex_col_px >= 0.0
+        && vertex_col_px < width_px;
     if !turns {
         return None;
     }
@@ -86,21 +89,19 @@ pub(super) fn turn_back_line(
 impl LaneTracker {
     /// Lane `i`'s estimate replaced by the least-squares line through its refinement's points
     /// when it turns back below them (module docs); over the rows `self.search_rows`. Returns
-    /// whether it was replaced. Only a lane the refinement updated, with at least
-    /// `track.reinit_min_points` points, is read.
+    /// whether it was replaced. Only a lane whose last refinement pass updated it (tracking:
+    /// a pass that misses leaves it coasting or lost) is read, so its points are that update's.
     pub(super) fn straighten_turn_back(&mut self, i: usize) -> bool {
         let lane = &self.lanes[i];
-        if lane.state != LaneState::Tracking
-            || !lane.updated_now
-            || lane.points.len() < self.cfg.track.reinit_min_points
-        {
+        if lane.state != LaneState::Tracking || !lane.updated_now {
             return false;
         }
         let Some(coeffs) = lane.filter.as_ref().map(|f| f.coeffs()) else {
             return false;
         };
-        let bottom = self.search_rows.1.saturating_sub(1) as f64;
-        let Some((a2, a3)) = turn_back_line(coeffs, &lane.points, bottom, self.width as f64) else {
+        let bottom_row_px = self.search_rows.1.saturating_sub(1) as f64;
+        let Some((a2, a3)) = turn_back_line(coeffs, &lane.points, bottom_row_px, self.width as f64)
+        else {
             return false;
         };
         self.restart_filter(i, &Vector3::new(0.0, a2, a3))
