@@ -161,7 +161,8 @@ pub struct InitConfig {
     /// whose rows show a second bright line beside its own, parallel, a line width or two
     /// away (a double line), or that lies between two such lines, is moved to the middle of the
     /// two, where lane labels put such a boundary (the image is read across the estimate row by
-    /// row; the pair must show on 30 % of the rows where the estimate lies inside the image;
+    /// row; the pair must show on 30 % of the rows where the estimate lies inside the image, and
+    /// on 8 at least;
     /// module `tracker::double_line`). Default `false` when absent.
     #[serde(default)]
     pub double_line_middle: bool,

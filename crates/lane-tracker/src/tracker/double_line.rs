@@ -39,7 +39,8 @@
 //! rows (the gap widens towards the camera, linearly in `y` on a straight road) and
 //! `x(y) = x̂(y) + α + β·y`, i.e. `(a1, a2 + β, a3 + α)`; the filter restarts from it. Its
 //! tracking windows then reach at least twice the half gap `g(y) ≈ γ + δ·y` (least squares
-//! over the same rows) at its widest row to each side, so that they hold both lines: with
+//! over the same rows; the larger of its values at the top and bottom rows searched) to each
+//! side, so that they hold both lines: with
 //! windows that clip the far edge of one line the estimate drifts onto the other within a few
 //! frames (≈ 6 px off the middle on the rendered double line with ±10 px windows). No
 //! allocation.

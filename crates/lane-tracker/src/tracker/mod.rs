@@ -212,8 +212,8 @@ struct Lane {
     /// Tracked frames in a row on which the kerb behind `kerb_offset_px` was not read again.
     kerb_misses: u32,
     /// Half the distance between the two lines of the double line the lane was centred on
-    /// (`init.double_line_middle`: the half gap fitted over the rows read, at its widest row;
-    /// px), 0 otherwise. Its
+    /// (`init.double_line_middle`: the half gap fitted over the rows read, the larger of its
+    /// values at the top and bottom rows searched; px), 0 otherwise. Its
     /// tracking windows reach at least twice as far, so that they hold both lines; cleared by
     /// the next initialisation.
     pair_half_gap_px: f64,

@@ -729,8 +729,9 @@ fn a_lane_leaning_across_a_double_line_from_between_its_lines_is_moved_to_its_mi
 fn a_double_line_leaving_the_image_is_read_on_the_rows_it_is_inside() {
     // The double line 128 px further left leaves the image through its left side: its middle
     // at row 176; the lane, on its inner line, is inside on rows 148–187 of the ROI's 148–239,
-    // its outer line only down to about row 164. The pair shows on about 17 rows: more than
-    // 30 % of the 40 rows where the lane is inside the image, fewer than 30 % of the ROI's 92.
+    // its outer line wholly only down to about row 164, enough of it to be read down to about
+    // row 169. The pair shows on about 22 rows: more than 30 % of the 40 rows where the lane is
+    // inside the image, fewer than 30 % of the ROI's 92.
     let shift = 128.0;
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
