@@ -245,8 +245,8 @@
 //!   line; an estimate between the two lines (where the edge pixels of two narrow lines
 //!   settle) is read from the brightest pixel within `w_max/2` on each side, and the pair is
 //!   asked for on 30 % of the rows where the estimate lies inside the image and on 8 at least
-//!   (development part 74.3 → 74.6 %, held
-//!   out 77.0 → 77.9 %, `f1tenth` held out 79.6 → 81.7 %);
+//!   (development part 74.3 → 74.6 %, held out 77.0 → 77.9 %, `f1tenth` held out 79.6 →
+//!   81.7 %);
 //! - **puts a kerb's boundary on its foot** (`init.kerb_foot`; module `tracker::kerb`): after
 //!   the same refinement (when the double line did not move the lane), the image is read across
 //!   the estimate row by row; where the estimate lies on a step to a pavement wider than twice

@@ -162,8 +162,7 @@ pub struct InitConfig {
     /// away (a double line), or that lies between two such lines, is moved to the middle of the
     /// two, where lane labels put such a boundary (the image is read across the estimate row by
     /// row; the pair must show on 30 % of the rows where the estimate lies inside the image, and
-    /// on 8 at least;
-    /// module `tracker::double_line`). Default `false` when absent.
+    /// on 8 at least; module `tracker::double_line`). Default `false` when absent.
     #[serde(default)]
     pub double_line_middle: bool,
     /// An addition beyond the paper: after a fresh initialisation and its refinement (and the

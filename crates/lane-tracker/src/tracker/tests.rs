@@ -635,13 +635,26 @@ fn double_line_shifted(w: usize, h: usize, inner_only: bool, shift_px: f64) -> G
     GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
 }
 
+/// A default tracker for 320 × 240 frames and its ROI's top, middle and bottom rows.
+fn default_tracker_and_rows() -> (LaneTracker, [f64; 3]) {
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let rows = [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64];
+    (tracker, rows)
+}
+
+/// Lane `i`'s filter set to the straight line through `(row, col)` points `a` and `b`.
+fn set_lane_line(tracker: &mut LaneTracker, i: usize, a: (f64, f64), b: (f64, f64)) {
+    let slope = (b.1 - a.1) / (b.0 - a.0);
+    let theta = Vector3::new(0.0, slope, a.1 - slope * a.0);
+    tracker.lanes[i].filter = Some(tracker.new_filter(&theta).expect("a filter"));
+}
+
 #[test]
 fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
     let left = mark_left;
-    let cfg = TrackerConfig::default_preset().expect("the default preset");
-    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
-    let (top, bottom) = tracker.roi;
-    let rows = [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64];
+    let (mut tracker, rows) = default_tracker_and_rows();
     // The lane on the inner line (the only one painted), then read across the double line.
     let single = double_line_left(320, 240, true);
     tracker.track(&single).expect("a frame");
@@ -692,20 +705,14 @@ fn a_lane_on_one_line_of_a_double_line_is_moved_to_its_middle() {
 #[test]
 fn a_lane_leaning_across_a_double_line_from_between_its_lines_is_moved_to_its_middle() {
     let left = mark_left;
-    let cfg = TrackerConfig::default_preset().expect("the default preset");
-    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
-    let (top, bottom) = tracker.roi;
-    let rows = [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64];
+    let (mut tracker, rows) = default_tracker_and_rows();
     let double = double_line_left(320, 240, false);
     tracker.track(&double).expect("a frame");
     // The lane between the two lines but leaning across them: 1 px left of the middle at the
     // top row, 3 px right of it at the bottom (the valley is 3.5 px wide at the top, 9 px at
     // the bottom).
-    let (y0, y1) = (top as f64, (bottom - 1) as f64);
-    let lean = |y: f64| -1.0 + 4.0 * (y - y0) / (y1 - y0);
-    let slope = (left(y1) + lean(y1) - left(y0) - lean(y0)) / (y1 - y0);
-    let theta = Vector3::new(0.0, slope, left(y0) + lean(y0) - slope * y0);
-    tracker.lanes[0].filter = Some(tracker.new_filter(&theta).expect("a filter"));
+    let (y0, y1) = (rows[0], rows[2]);
+    set_lane_line(&mut tracker, 0, (y0, left(y0) - 1.0), (y1, left(y1) + 3.0));
     let image = GreyImage::new(double.data(), 320, 240, 320).expect("an image");
     let (moved, allocations) = allocations_in(|| tracker.centre_on_double_line(0, &image));
     assert!(moved, "read from between the lines");
@@ -733,19 +740,15 @@ fn a_double_line_leaving_the_image_is_read_on_the_rows_it_is_inside() {
     // row 169. The pair shows on about 22 rows: more than 30 % of the 40 rows where the lane is
     // inside the image, fewer than 30 % of the ROI's 92.
     let shift = 128.0;
-    let cfg = TrackerConfig::default_preset().expect("the default preset");
-    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
-    let (top, bottom) = tracker.roi;
+    let (mut tracker, rows) = default_tracker_and_rows();
     let double = double_line_shifted(320, 240, false, shift);
     tracker.track(&double).expect("a frame");
     let middle = |y: f64| mark_left(y) - shift;
     let inner = |y: f64| middle(y) + 3.0 + 4.0 * (y - 140.0) / 100.0;
-    let (y0, y1) = (top as f64, (bottom - 1) as f64);
+    let (y0, y1) = (rows[0], rows[2]);
     assert!(middle(y0) > 10.0 && middle(175.0) > 0.0 && middle(177.0) < 0.0);
     // The lane on the inner line (a straight line through it at the top and bottom rows).
-    let slope = (inner(y1) - inner(y0)) / (y1 - y0);
-    let theta = Vector3::new(0.0, slope, inner(y0) - slope * y0);
-    tracker.lanes[0].filter = Some(tracker.new_filter(&theta).expect("a filter"));
+    set_lane_line(&mut tracker, 0, (y0, inner(y0)), (y1, inner(y1)));
     let image = GreyImage::new(double.data(), 320, 240, 320).expect("an image");
     assert!(
         tracker.centre_on_double_line(0, &image),

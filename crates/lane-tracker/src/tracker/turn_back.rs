@@ -49,8 +49,9 @@ pub(super) fn turn_back_line(
     width_px: f64,
 ) -> Option<(f64, f64)> {
     let [a1, a2, a3] = coeffs;
-    // A straight estimate (or one too flat for its vertex to be a number) has no vertex.
-    if a1 == 0.0 || !a1.is_finite() {
+    // A straight estimate has no vertex. (A non-finite `a1` needs no test of its own: its
+    // vertex row is 0 or NaN, never below the points' rows.)
+    if a1 == 0.0 {
         return None;
     }
     let lowest_row_px = points
