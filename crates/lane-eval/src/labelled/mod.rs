@@ -151,6 +151,14 @@ impl LabelSet {
         if set.width == 0 || set.height == 0 {
             return Err(bad(format!("zero frame size {}×{}", set.width, set.height)));
         }
+        // Refused here, before anything is sized from it (the census's buffers, the tracker).
+        let side_max = hough_init::MAX_IMAGE_SIDE_PX;
+        if set.width > side_max || set.height > side_max {
+            return Err(bad(format!(
+                "frame size {}×{} above the tracker's {side_max} px a side",
+                set.width, set.height
+            )));
+        }
         let mut last: Option<u64> = None;
         for f in &set.frames {
             if last.is_some_and(|l| f.index <= l) {
@@ -331,7 +339,7 @@ impl LaneTotals {
                 self.predicted_lanes,
             ),
             tusimple_fn: ratio(
-                (self.label_lanes - self.tusimple_matched) as f64,
+                self.label_lanes.saturating_sub(self.tusimple_matched) as f64,
                 self.label_lanes,
             ),
             aly_detection_rate: ratio(self.aly_matched as f64, self.label_lanes),

@@ -217,6 +217,10 @@ fn a_bad_label_file_is_refused_naming_the_problem() {
         (ok.replace("[[1,2],[2,5]]", "[[1,5],[2,2]]"), "not sorted"),
         (ok.replace("\"left\"", "\"middle\""), "unknown variant"),
         (ok.replace("\"clip\"", "\"clap\""), "unknown field"),
+        (
+            ok.replace("\"width\":8", "\"width\":4000000000000"),
+            "above the tracker's 16384 px a side",
+        ),
     ] {
         let e = LabelSet::from_json_str("labels.json", &text)
             .expect_err(needle)

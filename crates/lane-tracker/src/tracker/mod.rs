@@ -456,9 +456,10 @@ impl LaneTracker {
         let detector = GradientDetector::new(cfg.gradient.params())?;
         let roi = cfg.roi_rows(height);
         let fallback_roi = cfg.fallback_roi_rows(height);
+        // (Refuses a side above `hough_init::MAX_IMAGE_SIDE_PX` before anything is sized.)
+        let mut hough = HoughWorkspace::new(width, height, cfg.init.hough_params())?;
         // The buffers hold the pixels of the tallest region searched.
         let capacity = width * (roi.1 - fallback_roi.map_or(roi.0, |r| r.0));
-        let mut hough = HoughWorkspace::new(width, height, cfg.init.hough_params())?;
         if cfg.init.orientation_tolerance_deg > 0.0 {
             // The oriented vote's points: one class of the tallest region's pixels at most.
             hough.reserve_oriented_points(capacity);

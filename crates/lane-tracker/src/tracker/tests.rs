@@ -2133,3 +2133,16 @@ fn tracked_frames_keep_the_filters_estimate_where_it_turns_back() {
         "{c:?}"
     );
 }
+
+#[test]
+fn a_frame_size_beyond_the_limit_is_refused_before_anything_is_sized() {
+    // A width whose region of interest would overflow `width × rows` (a panic in a debug
+    // build when the buffers were sized first) is an error naming the size.
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    for (width, height) in [(usize::MAX / 2, 240), (320, usize::MAX / 2), (16385, 240)] {
+        let e = LaneTracker::new(&cfg, Estimator::Kif, width, height)
+            .err()
+            .expect("refused");
+        assert!(e.to_string().contains(&width.to_string()), "{e}");
+    }
+}
