@@ -139,7 +139,8 @@
 //!    filter, [`TrackerCounters::lane_changes`]): gradient over the
 //!    whole ROI, Hough over the lane's angle band and LS parabola on the band around the line
 //!    (`hough-init`, with `init.refit_iterations` refits); accepted if it spans ≥ 25 % of the
-//!    ROI rows; then refined by one windowed update on the same frame.
+//!    ROI rows; then refined on the same frame by `track.refine_passes` windowed updates (at
+//!    least one; windows `±track.refine_window_half_width_px`).
 //!    With `init.candidate_lines > 0` (the default configuration) the initialisation is
 //!    *joint* instead, see *Joint initialisation* below.
 //! 4. *Crossing gate*: the lanes may not cross at the top ROI row (with
@@ -292,7 +293,7 @@
 //! use lane_tracker::{Estimator, GreyFrame, LaneState, LaneTracker, TrackerConfig};
 //!
 //! let (w, h) = (320usize, 240usize);
-//! // Left mark x = 60 + 0.4·(239 − y)… in image terms a `/`, right mark a `\`.
+//! // Left mark x = 100 + 0.45·(239 − y)… in image terms a `/`, right mark a `\`.
 //! let left = |y: f64| 100.0 - 0.45 * (y - 239.0);
 //! let right = |y: f64| 220.0 + 0.45 * (y - 239.0);
 //! let mut pixels = vec![60u8; w * h];

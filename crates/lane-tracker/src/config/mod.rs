@@ -327,7 +327,8 @@ pub struct TrackConfig {
     /// its prediction is rejected (> 0; counts as a missed frame).
     pub max_jump_px: f64,
     /// Left and right lanes must stay at least this far apart at the middle and bottom ROI rows
-    /// (and in order at the top row), px (≥ 0).
+    /// (and in order at the row `init.ego_pair.meet_top_frac` of the ROI rows down from its
+    /// top: the top row for 0), px (≥ 0).
     pub min_lane_separation_px: f64,
     /// Orientation gate on the window pixels (an addition beyond the paper): a pixel enters the
     /// measurement only if its Sobel gradient (`vision_gradient::EdgePixel::gradient`) lies within
@@ -768,7 +769,8 @@ impl TrackerConfig {
     /// gate, lane separation, Hough band and candidate separation, stripe width and the periodic
     /// stripes' widest (at least 4 px
     /// with `init.kerb_foot`, which reads a kerb's face within it), R, Q and P0 standard
-    /// deviations. Not scaled: the gradient threshold (grey levels), fractions, angles, counts.
+    /// deviations. Not scaled: the gradient threshold (grey levels), the Hough distance
+    /// resolution `init.rho_step_px` (a bin size), fractions, angles, counts.
     pub fn scale_pixels(&mut self, k: f64) {
         let t = &mut self.track;
         t.window_half_width_px = ((t.window_half_width_px as f64 * k).round() as usize).max(1);

@@ -41,7 +41,7 @@
 //! follows the reading, and after `track.lost_after_frames` frames in a row without one (the
 //! kerb has ended) it is dropped; the next initialisation starts without one, and a kerb that
 //! appears while a lane is tracked is not picked up until then. The pixel distances scale with
-//! `w_max` (12 px at 320 px width in the default; `TrackerConfig::scale_pixels` scales it with
+//! `w_max` (16 px at 320 px width in the default; `TrackerConfig::scale_pixels` scales it with
 //! the resolution). No allocation (the rows' offsets go to a buffer of the image's height).
 //!
 //! On the labelled `f1tenth` set (a scale-model city with raised kerbs) the labels of a kerb

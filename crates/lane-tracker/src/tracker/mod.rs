@@ -87,7 +87,9 @@ pub struct LaneReport {
     pub coeffs: Option<[f64; 3]>,
     /// `[y_min, y_max]`, rows (px) of the points behind the estimate (last update or initialisation).
     pub rows: [f64; 2],
-    /// Points used this frame (filter update, or LS fit of an initialisation); 0 when missed.
+    /// Points used this frame (filter update, or LS fit of an initialisation); 0 when missed,
+    /// also for an initialisation whose refinement missed (the LS parabola is kept, reported
+    /// [`LaneState::Tracking`] and `initialised`).
     pub points: usize,
     /// `true` if the lane was (re-)initialised by Hough + LS on this frame.
     pub initialised: bool,
@@ -142,7 +144,9 @@ pub struct TrackerCounters {
     /// Lane changes: a tracked boundary the joint initialisation or a re-validation put on the
     /// other side of the pair (the camera crossed it), handed over to that side.
     pub lane_changes: u64,
-    /// Filter failures (numerical: a non-positive-definite matrix), per lane.
+    /// Filter failures, per lane: any set-up, prediction or update the filter refused (a
+    /// non-positive-definite matrix, or an input it rejects, such as a variance or forgetting
+    /// factor out of range).
     pub filter_failures: [u64; 2],
 }
 
@@ -747,8 +751,9 @@ impl LaneTracker {
         };
         if need_init || revalidate {
             self.initialise(&image)?;
-            // Refine a fresh initialisation on the same frame: one windowed update around the
-            // LS parabola, with the window's outlier rejection (the Hough band keeps clutter).
+            // Refine a fresh initialisation on the same frame: `track.refine_passes` windowed
+            // updates (at least one) from the LS parabola, with the window's outlier rejection
+            // (the Hough band keeps clutter).
             for i in 0..2 {
                 if self.lanes[i].initialised_now {
                     // A lane the second search found is refined over the rows it was found in.
