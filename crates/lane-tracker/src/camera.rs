@@ -121,39 +121,33 @@ fn field_error(field: &'static str, value: impl std::fmt::Display, reason: &str)
     }
 }
 
-/// A `lane-geometry` error about a camera-file field, with the field's dotted name.
+/// A `lane-geometry` error about a camera-file field: the field's dotted name, with the
+/// component's error kept as the source; an error about no field of the file stays the
+/// component's error.
 fn geometry_field_error(e: GeometryError) -> TrackerError {
-    match e {
-        GeometryError::InvalidParameter {
-            field,
-            value,
-            reason,
-        } => {
-            let dotted = match field {
-                "focal_length_px" => "intrinsics.focal_length_px",
-                "principal_point_px[0]" | "principal_point_px[1]" => {
-                    "intrinsics.principal_point_px"
-                }
-                "height_m" => "mounting.height_m",
-                "pitch_down_rad" => "mounting.pitch_down_rad",
-                "roll_rad" => "mounting.roll_rad",
-                "yaw_rad" => "mounting.yaw_rad",
-                "lookahead_near_m" => "lookahead.near_m",
-                "lookahead_far_m" | "rows_px" => "lookahead.far_m",
-                other => other,
-            };
-            field_error(dotted, value, reason)
+    let field = match &e {
+        GeometryError::InvalidParameter { field, .. } => match *field {
+            "focal_length_px" => Some("intrinsics.focal_length_px"),
+            "principal_point_px[0]" | "principal_point_px[1]" => {
+                Some("intrinsics.principal_point_px")
+            }
+            "height_m" => Some("mounting.height_m"),
+            "pitch_down_rad" => Some("mounting.pitch_down_rad"),
+            "roll_rad" => Some("mounting.roll_rad"),
+            "yaw_rad" => Some("mounting.yaw_rad"),
+            "lookahead_near_m" => Some("lookahead.near_m"),
+            "lookahead_far_m" | "rows_px" => Some("lookahead.far_m"),
+            _ => None,
+        },
+        GeometryError::BeyondHorizon { .. } => Some("lookahead.far_m"),
+        GeometryError::DegenerateHomography { .. } | GeometryError::NonFinite { .. } => {
+            Some("homography")
         }
-        GeometryError::BeyondHorizon { what, x, y } => field_error(
-            "lookahead.far_m",
-            format!("({x}, {y})"),
-            &format!("{what} is at or beyond the horizon of this camera"),
-        ),
-        GeometryError::DegenerateHomography { reason } => {
-            field_error("homography", "(point pairs)", reason)
-        }
-        GeometryError::NonFinite { what } => field_error("homography", what, "must be finite"),
-        other => TrackerError::Geometry(other),
+        _ => None,
+    };
+    match field {
+        Some(field) => TrackerError::ConfigGeometry { field, source: e },
+        None => TrackerError::Geometry(e),
     }
 }
 
@@ -183,10 +177,12 @@ impl CameraConfig {
         }
     }
 
-    /// Check every field; the error names the first offending one.
+    /// Check every field; the error names the first offending one
+    /// ([`TrackerError::config_field`]).
     ///
     /// # Errors
-    /// [`TrackerError::ConfigField`].
+    /// [`TrackerError::ConfigField`], or [`TrackerError::ConfigGeometry`] for a value the
+    /// lane geometry refuses (its error as the source).
     pub fn validate(&self) -> Result<(), TrackerError> {
         self.model().map(|_| ())
     }
@@ -319,17 +315,18 @@ impl CameraModel {
     /// Refuses frames of another size than `image_size_px`.
     ///
     /// # Errors
-    /// [`TrackerError::ConfigField`] (`image_size_px`).
+    /// [`TrackerError::CameraFrameSize`].
     pub fn check_frame_size(&self, width: usize, height: usize) -> Result<(), TrackerError> {
         let [w, h] = self.config.image_size_px;
         if (w, h) == (width, height) {
             Ok(())
         } else {
-            Err(field_error(
-                "image_size_px",
-                format!("[{w}, {h}]"),
-                &format!("the camera file is for {w}×{h} frames, the input has {width}×{height}"),
-            ))
+            Err(TrackerError::CameraFrameSize {
+                expected_w: w,
+                expected_h: h,
+                got_w: width,
+                got_h: height,
+            })
         }
     }
 
@@ -455,7 +452,9 @@ mod tests {
             let mut cfg = CameraConfig::preset("robot").unwrap().unwrap();
             edit(&mut cfg);
             match cfg.validate() {
-                Err(TrackerError::ConfigField { field: f, .. }) => assert_eq!(f, *field),
+                Err(e) if e.config_field().is_some() => {
+                    assert_eq!(e.config_field(), Some(*field), "{e}");
+                }
                 other => panic!("{field}: expected a field error, got {other:?}"),
             }
         }
@@ -493,5 +492,42 @@ mod tests {
         // A round trip through TOML keeps it.
         let text = toml::to_string(&cfg).unwrap();
         assert_eq!(CameraConfig::from_toml_str("rt", &text).unwrap(), cfg);
+    }
+
+    #[test]
+    fn a_value_the_geometry_refuses_keeps_its_error_and_a_frame_of_another_size_is_named() {
+        use std::error::Error as _;
+        let mut cfg = CameraConfig::preset("robot").unwrap().unwrap();
+        if let Some(m) = cfg.mounting.as_mut() {
+            m.height_m = -1.0;
+        }
+        let e = cfg.validate().expect_err("refused");
+        assert_eq!(e.config_field(), Some("mounting.height_m"), "{e}");
+        assert!(
+            e.source()
+                .and_then(|s| s.downcast_ref::<GeometryError>())
+                .is_some(),
+            "{e:?}"
+        );
+        let model = CameraConfig::preset("robot")
+            .unwrap()
+            .unwrap()
+            .model()
+            .unwrap();
+        assert!(model.check_frame_size(320, 240).is_ok());
+        let e = model.check_frame_size(640, 480).expect_err("another size");
+        assert!(
+            matches!(
+                e,
+                TrackerError::CameraFrameSize {
+                    expected_w: 320,
+                    expected_h: 240,
+                    got_w: 640,
+                    got_h: 480
+                }
+            ),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains("image_size_px"), "{e}");
     }
 }

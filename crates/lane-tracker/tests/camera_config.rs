@@ -116,7 +116,7 @@ proptest! {
         match CameraConfig::from_toml_str("mutated", &text) {
             Ok(cfg) => { cfg.model().unwrap(); }
             Err(e) => prop_assert!(
-                matches!(e, TrackerError::ConfigFile(_) | TrackerError::ConfigField { .. }),
+                matches!(e, TrackerError::ConfigFile(_)) || e.config_field().is_some(),
                 "{e:?}"
             ),
         }

@@ -256,55 +256,45 @@ impl InitConfig {
     }
 }
 
-/// A `vision-gradient` parameter error as the configuration field it came from.
+/// A `vision-gradient` parameter error as the configuration field it came from (the
+/// component's error kept as the source); a field this configuration does not set stays the
+/// component's error.
 fn gradient_field(e: GradientError) -> TrackerError {
-    match e {
-        GradientError::InvalidParam {
-            field,
-            value,
-            requirement,
-        } => field_err(
-            match field {
-                "min_edge_angle_deg" => "gradient.min_edge_angle_deg",
-                "max_edge_angle_deg" => "gradient.max_edge_angle_deg",
-                "threshold.keep_fraction" => "gradient.adaptive_keep_fraction",
-                _ => "gradient.magnitude_threshold",
-            },
-            value,
-            requirement,
-        ),
-        other => TrackerError::Gradient(other),
+    let field = match &e {
+        GradientError::InvalidParam { field, .. } => match *field {
+            "min_edge_angle_deg" => Some("gradient.min_edge_angle_deg"),
+            "max_edge_angle_deg" => Some("gradient.max_edge_angle_deg"),
+            "threshold.keep_fraction" => Some("gradient.adaptive_keep_fraction"),
+            "threshold.min_magnitude" => Some("gradient.magnitude_threshold"),
+            _ => None,
+        },
+        _ => None,
+    };
+    match field {
+        Some(field) => TrackerError::ConfigGradient { field, source: e },
+        None => TrackerError::Gradient(e),
     }
 }
 
-/// A `hough-init` parameter error as the configuration field it came from.
+/// A `hough-init` parameter error as the configuration field it came from (the component's
+/// error kept as the source); a field this configuration does not set stays the component's
+/// error. The Hough band comes from the edge-angle band.
 fn init_field(e: HoughError) -> TrackerError {
-    match e {
-        HoughError::InvalidParam {
-            field,
-            value,
-            reason,
-        } => field_err(
-            match field {
-                "theta_step_deg" => "init.theta_step_deg",
-                "rho_step_px" => "init.rho_step_px",
-                "band_px" => "init.band_half_width_px",
-                "min_points" => "init.min_points",
-                _ => "init.refit_iterations",
-            },
-            value,
-            reason,
-        ),
-        HoughError::InvalidBand {
-            min_deg,
-            max_deg,
-            reason,
-        } => field_err(
-            "gradient.min_edge_angle_deg",
-            format!("(Hough band [{min_deg}, {max_deg}]°)"),
-            reason,
-        ),
-        other => TrackerError::Hough(other),
+    let field = match &e {
+        HoughError::InvalidParam { field, .. } => match *field {
+            "theta_step_deg" => Some("init.theta_step_deg"),
+            "rho_step_px" => Some("init.rho_step_px"),
+            "band_px" => Some("init.band_half_width_px"),
+            "min_points" => Some("init.min_points"),
+            "refit_iterations" => Some("init.refit_iterations"),
+            _ => None,
+        },
+        HoughError::InvalidBand { .. } => Some("gradient.min_edge_angle_deg"),
+        _ => None,
+    };
+    match field {
+        Some(field) => TrackerError::ConfigHough { field, source: e },
+        None => TrackerError::Hough(e),
     }
 }
 
@@ -504,6 +494,15 @@ pub(crate) fn parse_validated<T: serde::de::DeserializeOwned>(
         } => {
             TrackerError::ConfigFile(doc.error_at(field, format!("`{field}` = {value}: {reason}")))
         }
+        TrackerError::ConfigGradient { field, ref source } => {
+            TrackerError::ConfigFile(doc.error_at(field, format!("`{field}`: {source}")))
+        }
+        TrackerError::ConfigHough { field, ref source } => {
+            TrackerError::ConfigFile(doc.error_at(field, format!("`{field}`: {source}")))
+        }
+        TrackerError::ConfigGeometry { field, ref source } => {
+            TrackerError::ConfigFile(doc.error_at(field, format!("`{field}`: {source}")))
+        }
         other => other,
     })?;
     Ok(cfg)
@@ -584,27 +583,26 @@ impl TrackerConfig {
             i.orientation_tolerance_deg,
             "must be in [0, 90] degrees (0: every pixel votes across its band)",
         )?;
-        i.ego_pair.validate().map_err(|e| match e {
-            HoughError::InvalidParam {
-                field,
-                value,
-                reason,
-            } => field_err(
-                match field {
-                    "min_width_frac" => "init.ego_pair.min_width_frac",
-                    "max_width_frac" => "init.ego_pair.max_width_frac",
-                    "centre_margin_frac" => "init.ego_pair.centre_margin_frac",
-                    "max_top_width_ratio" => "init.ego_pair.max_top_width_ratio",
-                    "centre_weight" => "init.ego_pair.centre_weight",
-                    "width_weight" => "init.ego_pair.width_weight",
-                    "lone_min_lean_deg" => "init.ego_pair.lone_min_lean_deg",
-                    "meet_top_frac" => "init.ego_pair.meet_top_frac",
-                    _ => "init.ego_pair.min_support_frac",
+        i.ego_pair.validate().map_err(|e| {
+            let field = match &e {
+                HoughError::InvalidParam { field, .. } => match *field {
+                    "min_width_frac" => Some("init.ego_pair.min_width_frac"),
+                    "max_width_frac" => Some("init.ego_pair.max_width_frac"),
+                    "centre_margin_frac" => Some("init.ego_pair.centre_margin_frac"),
+                    "max_top_width_ratio" => Some("init.ego_pair.max_top_width_ratio"),
+                    "centre_weight" => Some("init.ego_pair.centre_weight"),
+                    "width_weight" => Some("init.ego_pair.width_weight"),
+                    "lone_min_lean_deg" => Some("init.ego_pair.lone_min_lean_deg"),
+                    "meet_top_frac" => Some("init.ego_pair.meet_top_frac"),
+                    "min_support_frac" => Some("init.ego_pair.min_support_frac"),
+                    _ => None,
                 },
-                value,
-                reason,
-            ),
-            other => TrackerError::Hough(other),
+                _ => None,
+            };
+            match field {
+                Some(field) => TrackerError::ConfigHough { field, source: e },
+                None => TrackerError::Hough(e),
+            }
         })?;
         check(
             g.stripe_max_width_px <= 200,

@@ -168,7 +168,9 @@ fn each_out_of_range_field_is_named() {
         cfg.validate().unwrap();
         edit(&mut cfg);
         match cfg.validate() {
-            Err(TrackerError::ConfigField { field: f, .. }) => assert_eq!(f, *field),
+            Err(e) if e.config_field().is_some() => {
+                assert_eq!(e.config_field(), Some(*field), "{e}");
+            }
             other => panic!("{field}: expected a field error, got {other:?}"),
         }
     }
@@ -308,4 +310,52 @@ fn the_kerb_reading_needs_a_face_range_and_keeps_it_when_scaled() {
     small.gradient.stripe_max_width_px = 12;
     small.scale_pixels(0.2);
     assert_eq!(small.gradient.stripe_max_width_px, 2);
+}
+
+#[test]
+fn a_value_a_component_refuses_names_its_field_and_keeps_the_components_error() {
+    use std::error::Error as _;
+    let mut cfg = TrackerConfig::default_preset().unwrap();
+    cfg.init.ego_pair.min_width_frac = -1.0;
+    let e = cfg.validate().expect_err("refused");
+    assert_eq!(
+        e.config_field(),
+        Some("init.ego_pair.min_width_frac"),
+        "{e}"
+    );
+    let source = e.source().expect("the component's error");
+    assert!(
+        matches!(
+            source.downcast_ref::<hough_init::HoughError>(),
+            Some(hough_init::HoughError::InvalidParam {
+                field: "min_width_frac",
+                ..
+            })
+        ),
+        "{source:?}"
+    );
+    let mut cfg = TrackerConfig::default_preset().unwrap();
+    cfg.gradient.min_edge_angle_deg = 95.0;
+    let e = cfg.validate().expect_err("refused");
+    assert_eq!(e.config_field(), Some("gradient.min_edge_angle_deg"), "{e}");
+    assert!(
+        e.source()
+            .and_then(|s| s.downcast_ref::<vision_gradient::GradientError>())
+            .is_some(),
+        "{e:?}"
+    );
+    // From a file, the same refusal is located at its key.
+    let text = crate::config::DEFAULT_TOML.replace("min_width_frac = 0.2", "min_width_frac = -1.0");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("min_width_frac"))
+        .expect("the key")
+        + 1;
+    match TrackerConfig::from_toml_str("cfg.toml", &text) {
+        Err(TrackerError::ConfigFile(f)) => {
+            assert_eq!(f.line, Some(line), "{f}");
+            assert!(f.message.contains("init.ego_pair.min_width_frac"), "{f}");
+        }
+        other => panic!("expected a located error, got {other:?}"),
+    }
 }
