@@ -276,9 +276,10 @@ fn gradient_field(e: GradientError) -> TrackerError {
     }
 }
 
-/// A `hough-init` parameter error as the configuration field it came from (the component's
-/// error kept as the source); a field this configuration does not set stays the component's
-/// error. The Hough band comes from the edge-angle band.
+/// A `hough-init` parameter error (Hough, least-squares or ego-pair parameters; their field
+/// names differ) as the configuration field it came from (the component's error kept as the
+/// source); a field this configuration does not set stays the component's error. The Hough
+/// band comes from the edge-angle band.
 fn init_field(e: HoughError) -> TrackerError {
     let field = match &e {
         HoughError::InvalidParam { field, .. } => match *field {
@@ -287,6 +288,15 @@ fn init_field(e: HoughError) -> TrackerError {
             "band_px" => Some("init.band_half_width_px"),
             "min_points" => Some("init.min_points"),
             "refit_iterations" => Some("init.refit_iterations"),
+            "min_width_frac" => Some("init.ego_pair.min_width_frac"),
+            "max_width_frac" => Some("init.ego_pair.max_width_frac"),
+            "centre_margin_frac" => Some("init.ego_pair.centre_margin_frac"),
+            "max_top_width_ratio" => Some("init.ego_pair.max_top_width_ratio"),
+            "centre_weight" => Some("init.ego_pair.centre_weight"),
+            "width_weight" => Some("init.ego_pair.width_weight"),
+            "lone_min_lean_deg" => Some("init.ego_pair.lone_min_lean_deg"),
+            "meet_top_frac" => Some("init.ego_pair.meet_top_frac"),
+            "min_support_frac" => Some("init.ego_pair.min_support_frac"),
             _ => None,
         },
         HoughError::InvalidBand { .. } => Some("gradient.min_edge_angle_deg"),
@@ -486,24 +496,18 @@ pub(crate) fn parse_validated<T: serde::de::DeserializeOwned>(
 ) -> Result<T, TrackerError> {
     let doc = TomlDoc::parse(name, text).map_err(TrackerError::ConfigFile)?;
     let cfg: T = doc.deserialize().map_err(TrackerError::ConfigFile)?;
-    validate(&cfg).map_err(|e| match e {
-        TrackerError::ConfigField {
-            field,
-            value,
-            reason,
-        } => {
-            TrackerError::ConfigFile(doc.error_at(field, format!("`{field}` = {value}: {reason}")))
-        }
-        TrackerError::ConfigGradient { field, ref source } => {
-            TrackerError::ConfigFile(doc.error_at(field, format!("`{field}`: {source}")))
-        }
-        TrackerError::ConfigHough { field, ref source } => {
-            TrackerError::ConfigFile(doc.error_at(field, format!("`{field}`: {source}")))
-        }
-        TrackerError::ConfigGeometry { field, ref source } => {
-            TrackerError::ConfigFile(doc.error_at(field, format!("`{field}`: {source}")))
-        }
-        other => other,
+    validate(&cfg).map_err(|e| {
+        // A field error of any kind is located at its key (`TrackerError::config_field`).
+        let Some(field) = e.config_field() else {
+            return e;
+        };
+        let what = match &e {
+            TrackerError::ConfigField { value, reason, .. } => format!(" = {value}: {reason}"),
+            other => {
+                std::error::Error::source(other).map_or_else(String::new, |s| format!(": {s}"))
+            }
+        };
+        TrackerError::ConfigFile(doc.error_at(field, format!("`{field}`{what}")))
     })?;
     Ok(cfg)
 }
@@ -583,27 +587,7 @@ impl TrackerConfig {
             i.orientation_tolerance_deg,
             "must be in [0, 90] degrees (0: every pixel votes across its band)",
         )?;
-        i.ego_pair.validate().map_err(|e| {
-            let field = match &e {
-                HoughError::InvalidParam { field, .. } => match *field {
-                    "min_width_frac" => Some("init.ego_pair.min_width_frac"),
-                    "max_width_frac" => Some("init.ego_pair.max_width_frac"),
-                    "centre_margin_frac" => Some("init.ego_pair.centre_margin_frac"),
-                    "max_top_width_ratio" => Some("init.ego_pair.max_top_width_ratio"),
-                    "centre_weight" => Some("init.ego_pair.centre_weight"),
-                    "width_weight" => Some("init.ego_pair.width_weight"),
-                    "lone_min_lean_deg" => Some("init.ego_pair.lone_min_lean_deg"),
-                    "meet_top_frac" => Some("init.ego_pair.meet_top_frac"),
-                    "min_support_frac" => Some("init.ego_pair.min_support_frac"),
-                    _ => None,
-                },
-                _ => None,
-            };
-            match field {
-                Some(field) => TrackerError::ConfigHough { field, source: e },
-                None => TrackerError::Hough(e),
-            }
-        })?;
+        i.ego_pair.validate().map_err(init_field)?;
         check(
             g.stripe_max_width_px <= 200,
             "gradient.stripe_max_width_px",

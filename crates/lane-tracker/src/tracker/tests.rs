@@ -2104,10 +2104,8 @@ fn tracked_frames_keep_the_filters_estimate_where_it_turns_back() {
     // jump gate refuses the 12+ px bend from the straight start at the bottom row, so the
     // filter is set to the bend rather than left to find it).
     let frame = curved_dash_left(320, 240);
-    let cfg = TrackerConfig::default_preset().expect("the default preset");
-    assert!(cfg.init.no_turn_back);
-    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
-    let bottom_row_px = (tracker.roi.1 - 1) as f64;
+    let (mut tracker, [.., bottom_row_px]) = default_tracker_and_rows();
+    assert!(tracker.cfg.init.no_turn_back);
     let first = tracker.track(&frame).expect("a frame");
     assert!(first.lanes[0].initialised);
     assert_eq!(first.lanes[0].coeffs.map(|c| c[0]), Some(0.0));
