@@ -185,6 +185,18 @@ pub struct InitConfig {
     /// absent): the refined parabola as it is (the paper).
     #[serde(default)]
     pub no_turn_back: bool,
+    /// An addition beyond the paper: `true`: after the windowed refinement that follows an
+    /// initialisation (before no turn back, the double line's middle and the kerb's foot), the
+    /// bright stripe under the lane is followed row by row from the lane's evidence (a rising
+    /// and a falling edge of at least `gradient.magnitude_threshold / 4` grey levels in
+    /// central difference, at most `gradient.stripe_max_width_px` apart, needing at least
+    /// 2 px), and its middles, one a row, are one more update of the lane's KIF (module
+    /// `tracker::stripe_trace`): a lane pulled off a tape by the texture beside it, or held
+    /// on the rows its first fit saw, is brought back onto the stripe where it runs on.
+    /// Tracked frames, WRLS lanes, mark centres and the second search's lanes keep the
+    /// paper's measurement. `false` (default when absent): no trace (the paper).
+    #[serde(default)]
+    pub stripe_trace: bool,
 }
 
 fn default_separation_deg() -> f64 {
@@ -601,6 +613,12 @@ impl TrackerConfig {
             "needs gradient.stripe_max_width_px ≥ 4 px (a kerb's face is read up to it)",
         )?;
         check(
+            !self.init.stripe_trace || g.stripe_max_width_px >= 2,
+            "init.stripe_trace",
+            self.init.stripe_trace,
+            "needs gradient.stripe_max_width_px ≥ 2 px (the widest stripe it follows)",
+        )?;
+        check(
             g.periodic_min_stripes == 0 || (3..=16).contains(&g.periodic_min_stripes),
             "gradient.periodic_min_stripes",
             g.periodic_min_stripes,
@@ -771,6 +789,10 @@ impl TrackerConfig {
         if self.init.kerb_foot {
             // The kerb's reading needs a face range (validated ≥ 4 px).
             g.stripe_max_width_px = g.stripe_max_width_px.max(4);
+        }
+        if self.init.stripe_trace {
+            // The trace needs a stripe with two edges (validated ≥ 2 px).
+            g.stripe_max_width_px = g.stripe_max_width_px.max(2);
         }
         let f = &mut self.filter;
         f.r_sigma_px *= k;

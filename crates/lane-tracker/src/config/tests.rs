@@ -162,6 +162,10 @@ fn each_out_of_range_field_is_named() {
             c.init.kerb_foot = true;
             c.gradient.stripe_max_width_px = 3;
         }),
+        ("init.stripe_trace", |c| {
+            c.init.stripe_trace = true;
+            c.gradient.stripe_max_width_px = 1;
+        }),
     ];
     for (field, edit) in cases {
         let mut cfg = TrackerConfig::outdoor().unwrap();
@@ -310,6 +314,25 @@ fn the_kerb_reading_needs_a_face_range_and_keeps_it_when_scaled() {
     small.gradient.stripe_max_width_px = 12;
     small.scale_pixels(0.2);
     assert_eq!(small.gradient.stripe_max_width_px, 2);
+}
+
+#[test]
+fn the_stripe_trace_needs_a_two_pixel_stripe_and_keeps_it_when_scaled() {
+    let mut cfg = TrackerConfig::default_preset().unwrap();
+    assert!(cfg.init.stripe_trace);
+    cfg.init.kerb_foot = false;
+    cfg.gradient.stripe_max_width_px = 2;
+    cfg.validate().unwrap();
+    // 16 px × 0.05 rounds to 1: with the trace it stays at 2, without it falls to 1.
+    let mut small = TrackerConfig::default_preset().unwrap();
+    small.init.kerb_foot = false;
+    small.scale_pixels(0.05);
+    assert_eq!(small.gradient.stripe_max_width_px, 2);
+    small.validate().unwrap();
+    small.init.stripe_trace = false;
+    small.gradient.stripe_max_width_px = 16;
+    small.scale_pixels(0.05);
+    assert_eq!(small.gradient.stripe_max_width_px, 1);
 }
 
 #[test]

@@ -17,6 +17,7 @@ mod double_line;
 mod init;
 mod kerb;
 mod points;
+mod stripe_trace;
 #[cfg(test)]
 mod tests;
 mod turn_back;
@@ -87,7 +88,9 @@ pub struct LaneReport {
     pub coeffs: Option<[f64; 3]>,
     /// `[y_min, y_max]`, rows (px) of the points behind the estimate (last update or initialisation).
     pub rows: [f64; 2],
-    /// Points used this frame (filter update, or LS fit of an initialisation); 0 when missed,
+    /// Points used this frame (filter update, or LS fit of an initialisation; after an
+    /// initialisation's refinement with `init.stripe_trace`, its points and the traced stripe's
+    /// middles, so beyond `track.max_points_per_lane`); 0 when missed,
     /// also for an initialisation whose refinement missed (the LS parabola is kept, reported
     /// [`LaneState::Tracking`] and `initialised`).
     pub points: usize,
@@ -427,6 +430,9 @@ pub struct LaneTracker {
     /// The rows' kerb feet `(row, offset)` read by `onto_kerb_foot` and `recheck_kerb_foot`
     /// (capacity: the height).
     kerb_rows: Vec<(f64, f64)>,
+    /// The middles of the stripe `stripe_trace::trace_stripe` follows, one a row (capacity:
+    /// the height).
+    traced: Vec<(f32, f32)>,
     row_norm: RowNorm,
     q: ProcessNoise<3>,
     p0: ThetaCov,
@@ -544,6 +550,7 @@ impl LaneTracker {
             residual_hist: Box::new([[0; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]),
             left_out_cols: vec![(f32::NEG_INFINITY, f32::INFINITY); height].into_boxed_slice(),
             kerb_rows: Vec::with_capacity(height),
+            traced: Vec::with_capacity(height),
             row_norm,
             q,
             p0,
@@ -760,6 +767,9 @@ impl LaneTracker {
                     self.over_rows(self.rows_of(i), |t| {
                         for _ in 0..t.cfg.track.refine_passes.max(1) {
                             t.track_lane(i, &image, false)?;
+                        }
+                        if t.cfg.init.stripe_trace {
+                            t.trace_stripe(i, &image);
                         }
                         if t.cfg.init.no_turn_back {
                             t.straighten_turn_back(i);

@@ -1973,6 +1973,8 @@ fn a_wide_mark_is_initialised_on_its_middle_not_on_one_edge() {
     for (k, middles) in [true, false].into_iter().enumerate() {
         let mut cfg = TrackerConfig::default_preset().expect("the default preset");
         cfg.track.stripe_middles = middles;
+        // (The stripe trace, which measures middles too, is the next test's.)
+        cfg.init.stripe_trace = false;
         let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
         let (top, bottom) = tracker.roi;
         // The initialisation and its refinements on the same frame.
@@ -2146,4 +2148,167 @@ fn a_frame_size_beyond_the_limit_is_refused_before_anything_is_sized() {
         };
         assert!(e.to_string().contains(&width.to_string()), "{e}");
     }
+}
+
+/// A frame of grey 60 with `mark_left`'s line drawn 200 bright and `2·half_px` wide (area
+/// average) on the rows `rows`, and, when `step`, the floor right of the line 200 bright as
+/// well (a step, not a stripe).
+fn left_line(rows: std::ops::Range<f64>, half_px: f64, step: bool) -> GreyFrame {
+    let (w, h) = (320, 240);
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if !rows.contains(&y) {
+            continue;
+        }
+        let (lo, hi) = (
+            mark_left(y) - half_px,
+            mark_left(y) + if step { 1e9 } else { half_px },
+        );
+        let cover = ((x + 0.5).min(hi) - (x - 0.5).max(lo)).clamp(0.0, 1.0);
+        *p = (60.0 + 140.0 * cover).round() as u8;
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+/// Lane 0 of a default tracker as a refinement that was pulled off `mark_left` would leave
+/// it: updated on this frame with points on a parabola that follows the line at the ROI's
+/// top row and bends `bend_px` off it at the bottom row.
+fn lane_bent_off_the_line(bend_px: f64) -> LaneTracker {
+    let (mut tracker, _) = default_tracker_and_rows();
+    let (top, bottom) = tracker.roi;
+    let (t, b) = (top as f64, (bottom - 1) as f64);
+    let c = bend_px / ((b - t) * (b - t));
+    // x = mark_left(y) + c·(y − t)²
+    let bent = Vector3::new(c, -0.45 - 2.0 * c * t, 100.0 + 0.45 * 239.0 + c * t * t);
+    tracker.lanes[0].filter = Some(tracker.new_filter(&bent).expect("a filter"));
+    let lane = &mut tracker.lanes[0];
+    lane.points.clear();
+    for r in top..bottom {
+        let y = r as f64;
+        lane.points
+            .push(((mark_left(y) + c * (y - t) * (y - t)) as f32, y as f32));
+    }
+    let Some(LaneFilter::Kif(kif)) = lane.filter.as_mut() else {
+        panic!("a KIF lane")
+    };
+    kif.update(&lane.points, 4.0).expect("an update");
+    lane.state = LaneState::Tracking;
+    lane.updated_now = true;
+    lane.rows = [t, b];
+    tracker
+}
+
+/// The lane's offset from `mark_left` at row `y`, px.
+fn left_offset(tracker: &LaneTracker, y: f64) -> f64 {
+    let c = tracker.lanes[0]
+        .filter
+        .as_ref()
+        .map(LaneFilter::coeffs)
+        .expect("a left lane");
+    c[0] * y * y + c[1] * y + c[2] - mark_left(y)
+}
+
+#[test]
+fn a_lane_bent_off_a_stripe_is_traced_back_onto_it() {
+    // A straight 8-px line over the whole frame; the lane on it at the top row and 12 px off
+    // at the bottom one. The trace starts at the points' middle row (3 px off, within half
+    // the widest stripe), follows the line over every ROI row, and its middles pull the
+    // bottom of the lane back onto it.
+    let frame = left_line(0.0..240.0, 4.0, false);
+    let image = GreyImage::new(frame.data(), 320, 240, 320).expect("an image");
+    let mut tracker = lane_bent_off_the_line(12.0);
+    let (top, bottom) = tracker.roi;
+    let bottom_row = (bottom - 1) as f64;
+    let before = left_offset(&tracker, bottom_row);
+    assert!((before - 12.0).abs() < 0.5, "{before}");
+    let points_before = tracker.lanes[0].points.len();
+    let traced = tracker.trace_stripe(0, &image);
+    assert_eq!(traced, bottom - top, "one middle a row");
+    // Measured 2.4 px: the 92 refined points at σ = 2 px (on the bent parabola) against the 92
+    // middles at σ/2 = 1 px (on the line) weigh 1 : 4, 12/(1 + 4) = 2.4 px.
+    let after = left_offset(&tracker, bottom_row);
+    assert!(after.abs() < 3.0, "{after} px off at the bottom row");
+    let lane = &tracker.lanes[0];
+    assert_eq!(
+        lane.points.len(),
+        points_before + traced,
+        "the middles kept for overlays"
+    );
+    assert!(
+        lane.points[points_before..]
+            .iter()
+            .all(|&(x, y)| (f64::from(x) - mark_left(f64::from(y))).abs() <= 0.5),
+        "the middles lie on the line"
+    );
+}
+
+#[test]
+fn the_trace_ends_with_its_stripe_and_reads_nothing_from_a_step() {
+    // The line ends 30 rows above the bottom row: the trace ends there (3 rows without a
+    // middle are allowed), and the lane moves less than on the whole line.
+    let dash = left_line(0.0..210.0, 4.0, false);
+    let image = GreyImage::new(dash.data(), 320, 240, 320).expect("an image");
+    let mut tracker = lane_bent_off_the_line(12.0);
+    let top = tracker.roi.0;
+    let points_before = tracker.lanes[0].points.len();
+    let traced = tracker.trace_stripe(0, &image);
+    assert_eq!(traced, 210 - top, "the line's rows in the ROI");
+    assert!(
+        tracker.lanes[0].points[points_before..]
+            .iter()
+            .all(|&(_, y)| y < 210.0)
+    );
+    // A step where the line was (the floor right of it as bright): no stripe, no change.
+    let step = left_line(0.0..240.0, 4.0, true);
+    let image = GreyImage::new(step.data(), 320, 240, 320).expect("an image");
+    let mut tracker = lane_bent_off_the_line(12.0);
+    let before = tracker.lanes[0].filter.as_ref().map(LaneFilter::coeffs);
+    assert_eq!(tracker.trace_stripe(0, &image), 0);
+    assert_eq!(
+        tracker.lanes[0].filter.as_ref().map(LaneFilter::coeffs),
+        before
+    );
+    // Nor is a lane traced that its refinement did not update, nor a WRLS lane.
+    let frame = left_line(0.0..240.0, 4.0, false);
+    let image = GreyImage::new(frame.data(), 320, 240, 320).expect("an image");
+    let mut tracker = lane_bent_off_the_line(12.0);
+    tracker.lanes[0].updated_now = false;
+    assert_eq!(tracker.trace_stripe(0, &image), 0);
+    let cfg = TrackerConfig::default_preset().expect("the default preset");
+    let mut wrls = LaneTracker::new(&cfg, Estimator::Wrls, 320, 240).expect("a tracker");
+    wrls.track(&frame).expect("a frame");
+    assert!(wrls.lanes[0].updated_now, "the WRLS lane was refined");
+    assert_eq!(wrls.trace_stripe(0, &image), 0);
+}
+
+#[test]
+fn the_initialisation_of_a_wide_mark_is_traced_onto_its_middle() {
+    // `wide_left_mark` with the paper's edge pixels in the refinement: the lane stays on the
+    // edge the Hough line found (the test above); the trace's middles bring it to the middle.
+    let frame = wide_left_mark(320, 240);
+    let mut off = [0.0f64; 2];
+    for (k, trace) in [false, true].into_iter().enumerate() {
+        let mut cfg = TrackerConfig::default_preset().expect("the default preset");
+        cfg.track.stripe_middles = false;
+        cfg.init.stripe_trace = trace;
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let rows = {
+            let (top, bottom) = tracker.roi;
+            [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64]
+        };
+        let report = tracker.track(&frame).expect("a frame");
+        assert!(report.lanes[0].initialised);
+        for y in rows {
+            off[k] = off[k].max(left_offset(&tracker, y).abs());
+        }
+    }
+    assert!(off[0] > 3.0, "without the trace: {} px off", off[0]);
+    // Measured 4.9 and 1.5 px.
+    assert!(
+        off[1] < off[0] / 2.0,
+        "traced: {} px off (without: {})",
+        off[1],
+        off[0]
+    );
 }

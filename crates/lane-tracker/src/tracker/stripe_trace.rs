@@ -1,0 +1,314 @@
+//! The stripe traced row by row (`init.stripe_trace`), an addition beyond the paper: after the
+//! windowed refinement that follows an initialisation, the bright stripe under the lane is
+//! followed up and down the rows from the lane's own evidence, and the stripe's middles enter
+//! the filter as one more measurement update.
+//!
+//! ## Why
+//! The refinement keeps the window pixels near the predicted parabola (the window, the
+//! orientation gate, the inlier band about each row band's midhinge). Where the first fit was
+//! pulled off the mark over some rows — the texture of a floor beside a tape near the camera, a
+//! tape that runs on straight below the rows the first fit held — those rows measure the
+//! texture, and the parabola leaves the mark there: a near miss, right on most rows and
+//! 10–20 px off at the bottom ones. A mark is a continuous bright stripe; from a row where the
+//! estimate lies on it, it can be followed to the next rows by continuity alone, whatever the
+//! parabola says there.
+//!
+//! ## A stripe on one row
+//! On image row `y` with grey levels `I(x)`, the central difference `d(x) = I(x+1) − I(x−1)`
+//! (columns `1 ..= W−2`). A rising edge is a column `l` with `d(l) ≥ t` and `d` not larger at
+//! `l ± 1`; the stripe it opens closes at the first falling edge `r` after it (`d(r) ≤ −t`, `d`
+//! not smaller at `r ± 1`) with `r − l ≤ w_max`; its middle is `(l + r)/2`. `w_max =
+//! gradient.stripe_max_width_px` (the pairing's widest mark) and `t =
+//! gradient.magnitude_threshold / 4`: a vertical step of `h` grey levels has the Sobel L1
+//! magnitude `4h` and the central difference `h`, so a stripe edge is one the detector would
+//! keep, read without the orientation band (the trace follows the stripe wherever it turns).
+//! Of the stripes whose middle lies within a reach of the column looked for, the nearest is
+//! taken ([`stripe_middle_near`]).
+//!
+//! ## The trace
+//! 1. **Start.** From the row of the refinement's middle point (the points are in row order)
+//!    outwards, up to [`START_ROWS`] rows each way: the first row with a stripe whose middle
+//!    lies within `w_max/2` of the estimate `x̂(y)` (the estimate lies on the stripe, at worst
+//!    on one of its edges). None: nothing is traced (a kerb, a road's edge: a step, no
+//!    stripe).
+//! 2. **Follow**, down to the bottom row searched and up to the top one, from the start's
+//!    middle `m₀` with the estimate's slope `s = x̂′(y₀) = 2·a1·y₀ + a2` (px a row): the
+//!    next row's column is looked for at `x + s` (`x − s` going up) within
+//!    [`FOLLOW_REACH_PX`]; a middle `m` found there becomes `x`, and the slope follows the
+//!    stripe slowly, `s ← (1 − α)·s + α·Δ` with `Δ` the step just measured and
+//!    `α =` [`SLOPE_SMOOTHING`] (a tape's bend is followed, one noisy middle does not turn the
+//!    trace); a row without one carries `x` on by `s`. The trace ends after
+//!    [`MAX_GAP_ROWS`] rows in a row without a middle (the end of a dash, a stripe leaving
+//!    the image, an occlusion).
+//! 3. **Update.** The middles `(mₖ, yₖ)`, one a row, are one more measurement update of the
+//!    lane's KIF with `R = (σ/2)²·I`, `σ = filter.r_sigma_px` (one middle weighs as four
+//!    edge pixels: the two edges a row of a mark gives the window, each one or two pixels
+//!    thick under the 3×3 Sobel). The refinement's estimate is the prior, so a trace that
+//!    only confirms the points changes little, and one that runs on where the points stopped
+//!    or went astray pulls the parabola back onto the stripe there.
+//!
+//! Not traced: a lane found by the second search (its points lie above the ROI and its
+//! parabola is carried down over the ROI's rows; a far stripe's trace would bend that
+//! extrapolation), a lane refined with mark centres (`track.mark_centres`: each row already
+//! measures its mark's middle) and a WRLS lane (the paper's comparison, one update a frame
+//! under its forgetting factor). Tracked frames keep the paper's measurement.
+//!
+//! Measured (development part of the real labelled stills, default configuration otherwise;
+//! `docs/lane-tracker-history.md`, "Stripe traced row by row"): `seame`'s near misses on a
+//! straight tape beside the mats' texture become matched lanes; lanes whose trace ends at the
+//! image's side or runs onto a neighbouring stripe move by a pixel or two.
+
+use vision_gradient::GreyImage;
+
+use super::{LaneFilter, LaneState, LaneTracker};
+use crate::error::FilterFailure;
+
+/// Rows looked at each way from the refinement's middle point for the stripe the trace starts
+/// on.
+pub(super) const START_ROWS: usize = 10;
+/// How far from the column carried on from the row before a stripe's middle may lie, px.
+pub(super) const FOLLOW_REACH_PX: f64 = 2.0;
+/// Weight of each measured step in the trace's slope (module docs, step 2).
+pub(super) const SLOPE_SMOOTHING: f64 = 0.1;
+/// Rows in a row without a middle that end the trace.
+pub(super) const MAX_GAP_ROWS: usize = 3;
+
+/// The middle of the stripe on `row` nearest to column `x` within `reach_px` of it (module
+/// docs, "A stripe on one row"): a rising edge with a central difference of at least
+/// `contrast` grey levels (a local maximum) closed by the first falling one (a local minimum,
+/// at most `-contrast`) at most `max_width_px` columns after it. `None` without one (or for a
+/// row narrower than 3 columns, or a non-finite `x`).
+pub(super) fn stripe_middle_near(
+    row: &[u8],
+    x: f64,
+    reach_px: f64,
+    max_width_px: u16,
+    contrast: i16,
+) -> Option<f64> {
+    if !x.is_finite() || row.len() < 3 {
+        return None;
+    }
+    let last = row.len() as i64 - 2;
+    let w = i64::from(max_width_px);
+    // Columns whose stripe could have its middle within the reach: edges up to `w` beyond it.
+    // (`as` saturates; far-off columns give an empty range.)
+    let lo = ((x - reach_px).floor() as i64).saturating_sub(w).max(1);
+    let hi = ((x + reach_px).ceil() as i64).saturating_add(w).min(last);
+    let d = |c: i64| -> Option<i16> {
+        let (a, b) = (
+            row.get(usize::try_from(c - 1).ok()?)?,
+            row.get(usize::try_from(c + 1).ok()?)?,
+        );
+        Some(i16::from(*b) - i16::from(*a))
+    };
+    // The local extremum test: `d` at `c` beyond both neighbours inside `lo..=hi` (by `sign`).
+    let peak = |c: i64, dc: i16, sign: i16| {
+        [c - 1, c + 1]
+            .iter()
+            .filter(|&&n| (lo..=hi).contains(&n))
+            .all(|&n| d(n).is_none_or(|dn| sign * dn <= sign * dc))
+    };
+    let mut best: Option<(f64, f64)> = None;
+    for l in lo..=hi {
+        let Some(dl) = d(l) else { continue };
+        if dl < contrast || !peak(l, dl, 1) {
+            continue;
+        }
+        let closing = ((l + 1)..=(l + w).min(hi))
+            .find(|&r| d(r).is_some_and(|dr| dr <= -contrast && peak(r, dr, -1)));
+        let Some(r) = closing else { continue };
+        let middle = 0.5 * (l + r) as f64;
+        let off = (middle - x).abs();
+        if off <= reach_px && best.is_none_or(|(_, b)| off < b) {
+            best = Some((middle, off));
+        }
+    }
+    best.map(|(middle, _)| middle)
+}
+
+impl LaneTracker {
+    /// Lane `i`'s stripe traced row by row over the rows searched and its middles one more
+    /// measurement update (module docs). Only a KIF lane updated by its refinement on this
+    /// frame, not found by the second search, with edge pixels as measurements. Returns how
+    /// many middles were traced into it (0: unchanged). A failed update leaves the lane as it
+    /// was and is counted as a filter failure.
+    pub(super) fn trace_stripe(&mut self, i: usize, image: &GreyImage<'_>) -> usize {
+        let (top, bottom) = self.search_rows;
+        let w_max = self.cfg.gradient.stripe_max_width_px;
+        let contrast = (self.cfg.gradient.magnitude_threshold / 4).max(1) as i16;
+        let sigma = 0.5 * self.cfg.filter.r_sigma_px;
+        let lane = &self.lanes[i];
+        if lane.state != LaneState::Tracking
+            || !lane.updated_now
+            || lane.tracked_tall
+            || self.cfg.track.mark_centres
+            || w_max < 2
+        {
+            return 0;
+        }
+        let Some(filter @ LaneFilter::Kif(_)) = lane.filter.as_ref() else {
+            return 0;
+        };
+        let Some(&(_, mid_row)) = lane.points.get(lane.points.len() / 2) else {
+            return 0;
+        };
+        let [a1, a2, a3] = filter.coeffs();
+        let col = |y: f64| (a1 * y + a2) * y + a3;
+        let row_px = |r: usize| image.row(r);
+        // 1. Start: the nearest row to the middle point with a stripe under the estimate.
+        let mid = (mid_row.max(0.0) as usize).clamp(top, bottom.saturating_sub(1));
+        let start = (0..=START_ROWS)
+            .flat_map(|k| [Some(mid + k), mid.checked_sub(k).filter(|_| k > 0)])
+            .flatten()
+            .filter(|r| (top..bottom).contains(r))
+            .find_map(|r| {
+                let x = col(r as f64);
+                stripe_middle_near(row_px(r)?, x, f64::from(w_max) / 2.0, w_max, contrast)
+                    .map(|m| (r, m))
+            });
+        let Some((start_row, start_col)) = start else {
+            return 0;
+        };
+        self.traced.clear();
+        self.traced.push((start_col as f32, start_row as f32));
+        // 2. Follow the stripe down, then up.
+        let slope0 = 2.0 * a1 * start_row as f64 + a2;
+        for step in [1i64, -1] {
+            let (mut x, mut slope, mut gap) = (start_col, slope0, 0);
+            let mut r = start_row as i64;
+            loop {
+                r += step;
+                let Some(row) = usize::try_from(r)
+                    .ok()
+                    .filter(|r| (top..bottom).contains(r))
+                    .and_then(row_px)
+                else {
+                    break;
+                };
+                let from = x;
+                x += slope * step as f64;
+                match stripe_middle_near(row, x, FOLLOW_REACH_PX, w_max, contrast) {
+                    Some(m) => {
+                        let measured = (m - from) * step as f64;
+                        slope = (1.0 - SLOPE_SMOOTHING) * slope + SLOPE_SMOOTHING * measured;
+                        x = m;
+                        gap = 0;
+                        if self.traced.len() < self.traced.capacity() {
+                            self.traced.push((m as f32, r as f32));
+                        }
+                    }
+                    None => {
+                        gap += 1;
+                        if gap > MAX_GAP_ROWS {
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+        // 3. One more measurement update with the middles.
+        let lane = &mut self.lanes[i];
+        let Some(LaneFilter::Kif(kif)) = lane.filter.as_mut() else {
+            return 0;
+        };
+        if let Err(e) = kif.update(&self.traced, sigma * sigma) {
+            self.counters.filter_failures[i] += 1;
+            self.last_failure[i] = Some(FilterFailure::Kif(e));
+            return 0;
+        }
+        let room = lane.points.capacity() - lane.points.len();
+        lane.points.extend(self.traced.iter().take(room).copied());
+        for &(_, y) in &self.traced {
+            let y = f64::from(y);
+            lane.rows = [lane.rows[0].min(y), lane.rows[1].max(y)];
+        }
+        lane.fit = super::points::fit_profile(&lane.points, &lane.weights, lane.rows);
+        lane.points_now += self.traced.len();
+        self.traced.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stripe_middle_near;
+
+    /// A row of grey 40 with bright (200) stripes `[left, right)`.
+    fn row_with(stripes: &[(usize, usize)]) -> Vec<u8> {
+        let mut row = vec![40u8; 80];
+        for &(l, r) in stripes {
+            row[l..r].fill(200);
+        }
+        row
+    }
+
+    /// A stripe's middle is read between its edges: columns `[20, 30)` rise at 19.5–20 and
+    /// fall at 29.5–30, the central difference peaking at 19/20 and 29/30 — the middle at 24.5
+    /// (the pixel centre of the stripe's columns 20..=29), from anywhere within the reach.
+    #[test]
+    fn a_stripe_is_read_at_its_middle_from_within_the_reach() {
+        let row = row_with(&[(20, 30)]);
+        for x in [22.5, 24.5, 26.5] {
+            let m = stripe_middle_near(&row, x, 2.0, 16, 15).expect("found");
+            assert!((m - 24.5).abs() <= 0.5, "from {x}: {m}");
+        }
+        assert_eq!(
+            stripe_middle_near(&row, 21.0, 2.0, 16, 15),
+            None,
+            "beyond the reach"
+        );
+    }
+
+    /// Of two stripes within the reach the nearer is taken; a stripe wider than the limit, a
+    /// step (no falling edge) and a stripe below the contrast are not stripes.
+    #[test]
+    fn the_nearest_stripe_within_the_width_and_contrast_limits_is_taken() {
+        let two = row_with(&[(20, 24), (28, 32)]);
+        let m = stripe_middle_near(&two, 25.0, 5.0, 16, 15).expect("found");
+        assert!((m - 21.5).abs() <= 0.5, "{m}");
+        let m = stripe_middle_near(&two, 27.0, 5.0, 16, 15).expect("found");
+        assert!((m - 29.5).abs() <= 0.5, "{m}");
+        let wide = row_with(&[(20, 40)]);
+        assert_eq!(
+            stripe_middle_near(&wide, 29.5, 4.0, 16, 15),
+            None,
+            "too wide"
+        );
+        assert!(stripe_middle_near(&wide, 29.5, 4.0, 24, 15).is_some());
+        let mut step = vec![40u8; 80];
+        step[30..].fill(200);
+        assert_eq!(stripe_middle_near(&step, 30.0, 4.0, 16, 15), None, "a step");
+        let faint: Vec<u8> = row_with(&[(20, 30)])
+            .iter()
+            .map(|&g| if g > 40 { 50 } else { 40 })
+            .collect();
+        assert_eq!(
+            stripe_middle_near(&faint, 24.5, 2.0, 16, 15),
+            None,
+            "10 levels"
+        );
+        assert!(stripe_middle_near(&faint, 24.5, 2.0, 16, 10).is_some());
+    }
+
+    /// The row's ends, a non-finite column and a row too short to differentiate give `None`
+    /// or a stripe inside the row, never a read outside it.
+    #[test]
+    fn the_rows_ends_and_bad_columns_are_refused() {
+        let at_end = row_with(&[(74, 80)]);
+        assert_eq!(
+            stripe_middle_near(&at_end, 77.0, 4.0, 16, 15),
+            None,
+            "no falling edge"
+        );
+        let at_start = row_with(&[(0, 5)]);
+        assert_eq!(
+            stripe_middle_near(&at_start, 2.0, 4.0, 16, 15),
+            None,
+            "no rising edge"
+        );
+        let row = row_with(&[(20, 30)]);
+        for x in [f64::NAN, f64::INFINITY, -1e12, 1e12] {
+            assert_eq!(stripe_middle_near(&row, x, 2.0, 16, 15), None, "{x}");
+        }
+        assert_eq!(stripe_middle_near(&[200, 40], 0.5, 2.0, 16, 15), None);
+    }
+}
