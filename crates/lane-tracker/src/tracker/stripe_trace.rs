@@ -42,8 +42,9 @@
 //!    the image, an occlusion).
 //! 3. **Update.** The middles `(mₖ, yₖ)`, one a row, are one more measurement update of the
 //!    lane's KIF with `R = (σ/2)²·I`, `σ = filter.r_sigma_px` (one middle weighs as four
-//!    edge pixels: the two edges a row of a mark gives the window, each one or two pixels
-//!    thick under the 3×3 Sobel). The refinement's estimate is the prior, so a trace that
+//!    edge pixels, [`MIDDLE_WEIGHT`]: the two edges a row of a mark gives the window, each one
+//!    or two pixels thick under the 3×3 Sobel; the lane's row profile,
+//!    `LaneTracker::lane_fit_rows`, counts it so too). The refinement's estimate is the prior, so a trace that
 //!    only confirms the points changes little, and one that runs on where the points stopped
 //!    or went astray pulls the parabola back onto the stripe there.
 //!
@@ -72,6 +73,10 @@ pub(super) const FOLLOW_REACH_PX: f64 = 2.0;
 pub(super) const SLOPE_SMOOTHING: f64 = 0.1;
 /// Rows in a row without a middle that end the trace.
 pub(super) const MAX_GAP_ROWS: usize = 3;
+/// How many edge pixels one middle weighs as (module docs, step 3): its `R` is the edge
+/// pixels' `σ²` over this, and the lane's row profile (`LaneTracker::lane_fit_rows`) counts it
+/// this many times.
+pub(super) const MIDDLE_WEIGHT: f64 = 4.0;
 
 /// The middle of the stripe on `row` nearest to column `x` within `reach_px` of it (module
 /// docs, "A stripe on one row"): a rising edge with a central difference of at least
@@ -136,7 +141,7 @@ impl LaneTracker {
         let (top, bottom) = self.search_rows;
         let w_max = self.cfg.gradient.stripe_max_width_px;
         let contrast = (self.cfg.gradient.magnitude_threshold / 4).max(1) as i16;
-        let sigma = 0.5 * self.cfg.filter.r_sigma_px;
+        let r_sigma = self.cfg.filter.r_sigma_px;
         let lane = &self.lanes[i];
         if lane.state != LaneState::Tracking
             || !lane.updated_now
@@ -211,13 +216,18 @@ impl LaneTracker {
         let Some(LaneFilter::Kif(kif)) = lane.filter.as_mut() else {
             return 0;
         };
-        if let Err(e) = kif.update(&self.traced, sigma * sigma) {
+        if let Err(e) = kif.update(&self.traced, r_sigma * r_sigma / MIDDLE_WEIGHT) {
             self.counters.filter_failures[i] += 1;
             self.last_failure[i] = Some(FilterFailure::Kif(e));
             return 0;
         }
-        let room = lane.points.capacity() - lane.points.len();
+        // The row profile weighs the refinement's edge pixels 1 and the middles as in the
+        // update (the weights, empty with edge pixels, hold as many as the points).
+        lane.weights.clear();
+        lane.weights.resize(lane.points.len(), 1.0);
+        let room = lane.points.capacity().min(lane.weights.capacity()) - lane.points.len();
         lane.points.extend(self.traced.iter().take(room).copied());
+        lane.weights.resize(lane.points.len(), MIDDLE_WEIGHT);
         for &(_, y) in &self.traced {
             let y = f64::from(y);
             lane.rows = [lane.rows[0].min(y), lane.rows[1].max(y)];

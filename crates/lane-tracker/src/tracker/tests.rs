@@ -2235,6 +2235,9 @@ fn a_lane_bent_off_a_stripe_is_traced_back_onto_it() {
         points_before + traced,
         "the middles kept for overlays"
     );
+    // The row profile weighs them as the update did: four edge pixels each.
+    let profile: f64 = lane.fit.weights.iter().sum();
+    assert_eq!(profile, (points_before + 4 * traced) as f64);
     assert!(
         lane.points[points_before..]
             .iter()
