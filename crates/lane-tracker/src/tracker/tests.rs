@@ -2278,6 +2278,16 @@ fn the_trace_ends_with_its_stripe_and_reads_nothing_from_a_step() {
     let mut tracker = lane_bent_off_the_line(12.0);
     tracker.lanes[0].updated_now = false;
     assert_eq!(tracker.trace_stripe(0, &image), 0);
+    // Nor one the second search found (its parabola is carried down from above the ROI), nor
+    // one measured by mark centres; the same lane otherwise is traced.
+    let mut tracker = lane_bent_off_the_line(12.0);
+    tracker.lanes[0].tracked_tall = true;
+    assert_eq!(tracker.trace_stripe(0, &image), 0);
+    let mut tracker = lane_bent_off_the_line(12.0);
+    tracker.cfg.track.mark_centres = true;
+    assert_eq!(tracker.trace_stripe(0, &image), 0);
+    let mut tracker = lane_bent_off_the_line(12.0);
+    assert!(tracker.trace_stripe(0, &image) > 0);
     let cfg = TrackerConfig::default_preset().expect("the default preset");
     let mut wrls = LaneTracker::new(&cfg, Estimator::Wrls, 320, 240).expect("a tracker");
     wrls.track(&frame).expect("a frame");
