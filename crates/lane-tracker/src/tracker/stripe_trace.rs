@@ -161,7 +161,9 @@ impl LaneTracker {
         let col = |y: f64| (a1 * y + a2) * y + a3;
         let row_px = |r: usize| image.row(r);
         // 1. Start: the nearest row to the middle point with a stripe under the estimate.
-        let mid = (mid_row.max(0.0) as usize).clamp(top, bottom.saturating_sub(1));
+        let mid = (mid_row.max(0.0) as usize)
+            .min(bottom.saturating_sub(1))
+            .max(top);
         let start = (0..=START_ROWS)
             .flat_map(|k| [Some(mid + k), mid.checked_sub(k).filter(|_| k > 0)])
             .flatten()
