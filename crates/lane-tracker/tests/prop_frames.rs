@@ -1,0 +1,90 @@
+//! Property test of the tracker on arbitrary frames: any size from the smallest the tracker
+//! takes, noise, bright stripes of any width and lean, bars and blank regions — with the
+//! default configuration (every addition beyond the paper, the stripe trace included) and the
+//! paper's (`outdoor`), KIF and WRLS, over a few frames — never panics, and every reported lane
+//! has finite coefficients. (Seeded: `toml_config::mutate::config`.)
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
+use proptest::prelude::*;
+use toml_config::mutate::config;
+
+/// A stripe: its column at the bottom row and at the top row (fractions of the width, may lie
+/// outside), its width (px) and grey level.
+type Stripe = (f64, f64, f64, u8);
+
+/// A `w × h` frame: grey `floor` with `noise` levels of pseudo-random noise (from `seed`), the
+/// stripes drawn over it, and the rows `[blank.0, blank.1)` (fractions of the height) set to 0.
+fn frame(
+    w: usize,
+    h: usize,
+    floor: u8,
+    noise: u8,
+    seed: u64,
+    stripes: &[Stripe],
+    blank: (f64, f64),
+) -> GreyFrame {
+    let mut state = seed | 1;
+    let mut pixels = vec![0u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        // xorshift64
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        let t = if h > 1 { y / (h - 1) as f64 } else { 0.0 };
+        let mut g =
+            i32::from(floor) + (state % (u64::from(noise) + 1)) as i32 - i32::from(noise / 2);
+        for &(bottom, top, width, grey) in stripes {
+            let centre = (top + (bottom - top) * t) * w as f64;
+            if (x - centre).abs() <= width / 2.0 {
+                g = i32::from(grey);
+            }
+        }
+        if (blank.0..blank.1).contains(&t) {
+            g = 0;
+        }
+        *p = g.clamp(0, 255) as u8;
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+proptest! {
+    #![proptest_config(config(96))]
+
+    #[test]
+    fn any_frame_is_tracked_without_a_panic_and_with_finite_lanes(
+        w in prop_oneof![3usize..24, 24usize..200],
+        h in prop_oneof![3usize..24, 24usize..150],
+        floor in any::<u8>(),
+        noise in prop_oneof![Just(0u8), any::<u8>()],
+        seed in any::<u64>(),
+        stripes in prop::collection::vec(
+            (-0.5f64..1.5, -0.5f64..1.5, 0.0f64..40.0, any::<u8>()),
+            0..6,
+        ),
+        blank in (0.0f64..1.0, 0.0f64..1.0),
+        frames in 1usize..5,
+    ) {
+        let image = frame(w, h, floor, noise, seed, &stripes, blank);
+        for cfg in [
+            TrackerConfig::default_preset().expect("the default"),
+            TrackerConfig::outdoor().expect("the outdoor preset"),
+        ] {
+            for estimator in [Estimator::Kif, Estimator::Wrls] {
+                // A size the tracker refuses is an error, not a panic.
+                let Ok(mut tracker) = LaneTracker::new(&cfg, estimator, w, h) else {
+                    continue;
+                };
+                for _ in 0..frames {
+                    let report = tracker.track(&image).expect("a frame of the tracker's size");
+                    for lane in report.lanes {
+                        if let Some(c) = lane.coeffs {
+                            prop_assert!(c.iter().all(|v| v.is_finite()), "{lane:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
