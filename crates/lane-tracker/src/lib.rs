@@ -199,12 +199,12 @@
 //! - **traces the stripe under the lane row by row after that refinement**
 //!   (`init.stripe_trace`; module `tracker::stripe_trace`): from the row of the refinement's
 //!   middle point the bright stripe under the estimate is followed up and down the rows (its
-//!   middle looked for within 2 px of the last one carried on by a slowly following slope; 3
-//!   rows without one end it), and its middles, one a row at `σ/2`, are one more KIF update —
-//!   a lane the texture beside a tape pulled off it, or held on the rows its first fit saw,
-//!   comes back onto the stripe where the stripe runs on (development part 74.6 → 74.8 %, FP
-//!   30.3 → 30.1 %; held out 77.9 → 78.5 %, FP 30.5 → 29.1 %, `seame` 72.6 → 73.9 %, FP
-//!   44.9 → 38.8 %);
+//!   middle looked for within 2 px of the last one carried on by a slowly following slope;
+//!   more than 3 rows in a row without one end it), and its middles, one a row at `σ/2`, are
+//!   one more KIF update — a lane the texture beside a tape pulled off it, or held on the rows
+//!   its first fit saw, comes back onto the stripe where the stripe runs on (development part
+//!   74.6 → 74.8 %, FP 30.3 → 30.1 %; held out 77.9 → 78.5 %, FP 30.5 → 29.1 %, `seame`
+//!   72.6 → 73.9 %, FP 44.9 → 38.8 %);
 //! - **lets no lane turn back below its evidence** (`init.no_turn_back`; module
 //!   `tracker::turn_back`): after that refinement, a parabola whose vertex `−a2/(2·a1)` (its
 //!   vertical image tangent) lies between the lowest row of its points and the bottom row

@@ -37,16 +37,16 @@
 //!    [`FOLLOW_REACH_PX`]; a middle `m` found there becomes `x`, and the slope follows the
 //!    stripe slowly, `s ← (1 − α)·s + α·Δ` with `Δ` the step just measured and
 //!    `α =` [`SLOPE_SMOOTHING`] (a tape's bend is followed, one noisy middle does not turn the
-//!    trace); a row without one carries `x` on by `s`. The trace ends after
-//!    [`MAX_GAP_ROWS`] rows in a row without a middle (the end of a dash, a stripe leaving
-//!    the image, an occlusion).
+//!    trace); a row without one carries `x` on by `s`. Up to [`MAX_GAP_ROWS`] rows in a row
+//!    without a middle are bridged; the next one ends the trace (the end of a dash, a stripe
+//!    leaving the image, an occlusion).
 //! 3. **Update.** The middles `(mₖ, yₖ)`, one a row, are one more measurement update of the
 //!    lane's KIF with `R = (σ/2)²·I`, `σ = filter.r_sigma_px` (one middle weighs as four
 //!    edge pixels, [`MIDDLE_WEIGHT`]: the two edges a row of a mark gives the window, each one
 //!    or two pixels thick under the 3×3 Sobel; the lane's row profile,
-//!    `LaneTracker::lane_fit_rows`, counts it so too). The refinement's estimate is the prior, so a trace that
-//!    only confirms the points changes little, and one that runs on where the points stopped
-//!    or went astray pulls the parabola back onto the stripe there.
+//!    `LaneTracker::lane_fit_rows`, counts it so too). The refinement's estimate is the
+//!    prior, so a trace that only confirms the points changes little, and one that runs on
+//!    where the points stopped or went astray pulls the parabola back onto the stripe there.
 //!
 //! Not traced: a lane found by the second search (its points lie above the ROI and its
 //! parabola is carried down over the ROI's rows; a far stripe's trace would bend that
@@ -71,7 +71,7 @@ pub(super) const START_ROWS: usize = 10;
 pub(super) const FOLLOW_REACH_PX: f64 = 2.0;
 /// Weight of each measured step in the trace's slope (module docs, step 2).
 pub(super) const SLOPE_SMOOTHING: f64 = 0.1;
-/// Rows in a row without a middle that end the trace.
+/// Rows in a row without a middle the trace bridges (one more ends it).
 pub(super) const MAX_GAP_ROWS: usize = 3;
 /// How many edge pixels one middle weighs as (module docs, step 3): its `R` is the edge
 /// pixels' `σ²` over this, and the lane's row profile (`LaneTracker::lane_fit_rows`) counts it
