@@ -199,7 +199,8 @@
 //! - **traces the stripe under the lane row by row after that refinement**
 //!   (`init.stripe_trace`; module `tracker::stripe_trace`): from the row of the refinement's
 //!   middle point the bright stripe under the estimate is followed up and down the rows (its
-//!   middle looked for within 2 px of the last one carried on by a slowly following slope;
+//!   middle placed between its edges to a fraction of a pixel, and looked for within 2 px
+//!   (an eighth of the widest stripe) of the last one carried on by a slowly following slope;
 //!   more than 3 rows in a row without one end it), and its middles, one a row at `σ/2`, are
 //!   one more KIF update — a lane the texture beside a tape pulled off it, or held on the rows
 //!   its first fit saw, comes back onto the stripe where the stripe runs on (development part

@@ -1,8 +1,9 @@
-//! Property test of the tracker on arbitrary frames: any size from the smallest the tracker
-//! takes, noise, bright stripes of any width and lean, bars and blank regions — with the
-//! default configuration (every addition beyond the paper, the stripe trace included) and the
-//! paper's (`outdoor`), KIF and WRLS, over a few frames — never panics, and every reported lane
-//! has finite coefficients. (Seeded: `toml_config::mutate::config`.)
+//! Property test of the tracker on arbitrary frames: any size from 3 × 3 (every one taken),
+//! noise, bright stripes of any width and lean, blank rows — with the default configuration
+//! (every addition beyond the paper, the stripe trace included; also with its widest stripe
+//! and no gradient threshold, and with the narrowest stripe the trace takes and the highest
+//! threshold) and the paper's (`outdoor`), KIF and WRLS, over a few frames — never panics, and
+//! every reported lane has finite coefficients. (Seeded: `toml_config::mutate::config`.)
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
@@ -67,15 +68,27 @@ proptest! {
         frames in 1usize..5,
     ) {
         let image = frame(w, h, floor, noise, seed, &stripes, blank);
+        // The default at the ends of its stripe width and gradient threshold ranges too.
+        let default = TrackerConfig::default_preset().expect("the default");
+        let mut widest = default;
+        widest.gradient.stripe_max_width_px = 200;
+        widest.gradient.magnitude_threshold = 0;
+        let mut narrowest = default;
+        narrowest.init.kerb_foot = false;
+        narrowest.gradient.stripe_max_width_px = 2;
+        narrowest.gradient.magnitude_threshold = 2040;
         for cfg in [
-            TrackerConfig::default_preset().expect("the default"),
+            default,
+            widest,
+            narrowest,
             TrackerConfig::outdoor().expect("the outdoor preset"),
         ] {
+            cfg.validate().expect("a valid configuration");
             for estimator in [Estimator::Kif, Estimator::Wrls] {
-                // A size the tracker refuses is an error, not a panic.
-                let Ok(mut tracker) = LaneTracker::new(&cfg, estimator, w, h) else {
-                    continue;
-                };
+                // Every size from 3 × 3 is taken.
+                let made = LaneTracker::new(&cfg, estimator, w, h);
+                prop_assert!(made.is_ok(), "{w}×{h}: {:?}", made.err());
+                let Ok(mut tracker) = made else { continue };
                 for _ in 0..frames {
                     let report = tracker.track(&image).expect("a frame of the tracker's size");
                     for lane in report.lanes {

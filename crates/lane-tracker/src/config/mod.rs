@@ -41,7 +41,8 @@ pub struct GradientConfig {
     /// opposite polarity within this many columns (rising on the left, falling on the right:
     /// the two sides of a bright mark), px, 0..=200; 0 (default when absent) keeps every edge
     /// pixel (the paper). Also the widest mark and the widest kerb face for `init.kerb_foot`,
-    /// which needs at least 4 px.
+    /// which needs at least 4 px, and the widest stripe `init.stripe_trace` follows, which
+    /// needs at least 2 px.
     #[serde(default)]
     pub stripe_max_width_px: u16,
     /// With stripe pairing that drops unpaired pixels (`stripe_paired_votes = 0`): also keep
@@ -188,9 +189,10 @@ pub struct InitConfig {
     /// An addition beyond the paper: `true`: after the windowed refinement that follows an
     /// initialisation (before no turn back, the double line's middle and the kerb's foot), the
     /// bright stripe under the lane is followed row by row from the lane's evidence (a rising
-    /// and a falling edge of at least `gradient.magnitude_threshold / 4` grey levels in
-    /// central difference, at most `gradient.stripe_max_width_px` apart, needing at least
-    /// 2 px), and its middles, one a row, are one more update of the lane's KIF (module
+    /// and a falling edge of at least `gradient.magnitude_threshold / 4` grey levels, and 1 at
+    /// least, in central difference, at most `gradient.stripe_max_width_px` apart, needing at
+    /// least 2 px; from one row to the next within an eighth of that width, 1 px at least),
+    /// and its middles, one a row, are one more update of the lane's KIF (module
     /// `tracker::stripe_trace`): a lane pulled off a tape by the texture beside it, or held
     /// on the rows its first fit saw, is brought back onto the stripe where it runs on.
     /// Tracked frames, WRLS lanes, mark centres and the second search's lanes keep the
@@ -768,7 +770,9 @@ impl TrackerConfig {
     /// frames, so a 1280-px frame takes `k = 4`. Scaled: window and inlier half-widths, jump
     /// gate, lane separation, Hough band and candidate separation, stripe width and the periodic
     /// stripes' widest (at least 4 px
-    /// with `init.kerb_foot`, which reads a kerb's face within it), R, Q and P0 standard
+    /// with `init.kerb_foot`, which reads a kerb's face within it, and 2 px with
+    /// `init.stripe_trace`: with either on, a width of 0 — no pairing — becomes that floor),
+    /// R, Q and P0 standard
     /// deviations. Not scaled: the gradient threshold (grey levels), the Hough distance
     /// resolution `init.rho_step_px` (a bin size), fractions, angles, counts.
     pub fn scale_pixels(&mut self, k: f64) {

@@ -2132,7 +2132,8 @@ fn tracked_frames_keep_the_filters_estimate_where_it_turns_back() {
     // straightened it.
     assert!(c[0] > 0.005, "{c:?}");
     assert!(
-        super::turn_back::turn_back_line(c, &lane.points, bottom_row_px, 320.0).is_some(),
+        super::turn_back::turn_back_line(c, &lane.points, &lane.weights, bottom_row_px, 320.0)
+            .is_some(),
         "{c:?}"
     );
 }
@@ -2248,8 +2249,7 @@ fn a_lane_bent_off_a_stripe_is_traced_back_onto_it() {
 
 #[test]
 fn the_trace_ends_with_its_stripe_and_reads_nothing_from_a_step() {
-    // The line ends 30 rows above the bottom row: the trace ends there (3 rows without a
-    // middle are allowed), and the lane moves less than on the whole line.
+    // The line ends 30 rows above the bottom row: the trace ends there.
     let dash = left_line(0.0..210.0, 4.0, false);
     let image = GreyImage::new(dash.data(), 320, 240, 320).expect("an image");
     let mut tracker = lane_bent_off_the_line(12.0);
@@ -2323,5 +2323,151 @@ fn the_initialisation_of_a_wide_mark_is_traced_onto_its_middle() {
         "traced: {} px off (without: {})",
         off[1],
         off[0]
+    );
+}
+
+/// A frame of grey 60 with a bright line 6 px wide along each row (its middle at `col(y)`), on
+/// the rows for which `drawn(y)` holds.
+fn line_along(col: impl Fn(f64) -> f64, drawn: impl Fn(f64) -> bool) -> GreyFrame {
+    let (w, h) = (320, 240);
+    let mut pixels = vec![60u8; w * h];
+    for (i, p) in pixels.iter_mut().enumerate() {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        if !drawn(y) {
+            continue;
+        }
+        let cover = ((x + 0.5).min(col(y) + 3.0) - (x - 0.5).max(col(y) - 3.0)).clamp(0.0, 1.0);
+        *p = (60.0 + 140.0 * cover).round() as u8;
+    }
+    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
+}
+
+/// Lane 0 of a default tracker updated on this frame with points on rows `rows` of `col`,
+/// its filter the straight line tangent to `col` at `row`.
+fn lane_tangent_at(
+    col: impl Fn(f64) -> f64,
+    row: f64,
+    rows: std::ops::Range<usize>,
+) -> LaneTracker {
+    let (mut tracker, _) = default_tracker_and_rows();
+    let slope = col(row + 0.5) - col(row - 0.5);
+    set_lane_line(
+        &mut tracker,
+        0,
+        (row, col(row)),
+        (row + 1.0, col(row) + slope),
+    );
+    let lane = &mut tracker.lanes[0];
+    lane.points.clear();
+    for r in rows {
+        lane.points.push((col(r as f64) as f32, r as f32));
+    }
+    lane.state = LaneState::Tracking;
+    lane.updated_now = true;
+    tracker
+}
+
+#[test]
+fn the_trace_follows_a_bending_stripe_with_its_slope() {
+    // x = 160 + 0.03·(y − 194)²: vertical at row 194, 2.8 px a row at the ROI's ends. The
+    // trace starts on the tangent at row 194 (slope 0) and the slope follows the steps
+    // (weight 0.1: it lags by 0.06/0.1 = 0.6 px a row); with a fixed slope the stripe leaves
+    // the 2-px reach after about 34 rows each way, and with the wrong sign for the steps
+    // measured going up it turns away at once.
+    let col = |y: f64| 160.0 + 0.03 * (y - 194.0) * (y - 194.0);
+    let frame = line_along(col, |_| true);
+    let image = GreyImage::new(frame.data(), 320, 240, 320).expect("an image");
+    let mut tracker = lane_tangent_at(col, 194.0, 190..199);
+    let (top, bottom) = tracker.roi;
+    let points_before = tracker.lanes[0].points.len();
+    let traced = tracker.trace_stripe(0, &image);
+    assert_eq!(traced, bottom - top, "every ROI row");
+    let middles = &tracker.lanes[0].points[points_before..];
+    assert!(
+        middles
+            .iter()
+            .all(|&(x, y)| (f64::from(x) - col(f64::from(y))).abs() < 0.5),
+        "on the stripe"
+    );
+}
+
+#[test]
+fn the_trace_bridges_three_rows_without_a_middle_and_ends_at_the_fourth() {
+    // A straight line with its rows 200–202 blank (bridged) and 215–218 blank (the end).
+    let gaps = |y: f64| !(200.0..203.0).contains(&y) && !(215.0..219.0).contains(&y);
+    let frame = line_along(mark_left, gaps);
+    let image = GreyImage::new(frame.data(), 320, 240, 320).expect("an image");
+    let mut tracker = lane_tangent_at(mark_left, 180.0, 170..190);
+    let top = tracker.roi.0;
+    let points_before = tracker.lanes[0].points.len();
+    let traced = tracker.trace_stripe(0, &image);
+    let rows: Vec<f32> = tracker.lanes[0].points[points_before..]
+        .iter()
+        .map(|&(_, y)| y)
+        .collect();
+    assert_eq!(traced, 215 - top - 3, "rows {top}..215 but 200–202");
+    assert_eq!(rows.iter().copied().fold(0.0f32, f32::max), 214.0);
+    assert!(rows.contains(&203.0) && !rows.contains(&201.0));
+}
+
+#[test]
+fn no_turn_back_counts_the_traced_middles_as_evidence() {
+    // A parabola turning back at row 215, below the refinement's points (rows 150–189) and
+    // above the bottom row. Middles traced on down to row 200 are evidence above the vertex:
+    // the lane is straightened, on the line through the points and the middles weighed as
+    // the trace's update weighs them (4 edge pixels each). Traced on to the bottom row, they
+    // reach past the vertex: the parabola is kept.
+    let (mut tracker, _) = default_tracker_and_rows();
+    let vertex = Vector3::new(0.01, -0.02 * 215.0, 0.01 * 215.0 * 215.0 + 60.0);
+    let on_line = |y: f64| 150.0 - 0.5 * y;
+    let set_up = |tracker: &mut LaneTracker, traced_to: u16| {
+        tracker.lanes[0].filter = Some(tracker.new_filter(&vertex).expect("a filter"));
+        let lane = &mut tracker.lanes[0];
+        lane.points.clear();
+        lane.weights.clear();
+        // The refinement's points on one line, the middles on another (1 px to the right).
+        for r in 150..190u16 {
+            lane.points
+                .push((on_line(f64::from(r)) as f32, f32::from(r)));
+            lane.weights.push(1.0);
+        }
+        for r in 190..traced_to {
+            lane.points
+                .push((on_line(f64::from(r)) as f32 + 1.0, f32::from(r)));
+            lane.weights.push(super::stripe_trace::MIDDLE_WEIGHT);
+        }
+        lane.state = LaneState::Tracking;
+        lane.updated_now = true;
+    };
+    set_up(&mut tracker, 200);
+    assert!(
+        tracker.straighten_turn_back(0),
+        "middles to row 199, vertex at 215"
+    );
+    let c = tracker.lanes[0]
+        .filter
+        .as_ref()
+        .map(LaneFilter::coeffs)
+        .expect("a lane");
+    // The same line through the points with each middle repeated 4 times.
+    let mut repeated: Vec<(f32, f32)> = (150..190u16)
+        .map(|r| (on_line(f64::from(r)) as f32, f32::from(r)))
+        .collect();
+    for r in 190..200u16 {
+        for _ in 0..4 {
+            repeated.push((on_line(f64::from(r)) as f32 + 1.0, f32::from(r)));
+        }
+    }
+    let vertex_coeffs = [vertex[0], vertex[1], vertex[2]];
+    let (a2, a3) = super::turn_back::turn_back_line(vertex_coeffs, &repeated, &[], 239.0, 320.0)
+        .expect("turns back");
+    assert!(
+        (c[1] - a2).abs() < 1e-9 && (c[2] - a3).abs() < 1e-6,
+        "{c:?} against {a2} {a3}"
+    );
+    set_up(&mut tracker, 240);
+    assert!(
+        !tracker.straighten_turn_back(0),
+        "middles to the bottom row"
     );
 }

@@ -20,14 +20,16 @@
 //!
 //! After an initialisation's windowed refinement, a lane whose vertex lies in `(y_max, y_b]`
 //! (`y_b` the bottom row searched) at a column inside the image is therefore replaced by the
-//! least-squares line through the refinement's points, which carries the evidence on along
-//! its course:
+//! least-squares line through the refinement's points (and, with `init.stripe_trace`, the
+//! stripe's middles traced after it, each weighing as in the trace's update, `w_i = 4`; the
+//! edge pixels `w_i = 1`; `y_max` their lowest row), which carries the evidence on along its
+//! course:
 //!
 //! ```text
-//!     x = x̄ + β·(y − ȳ),    β = Σ (y_i − ȳ)(x_i − x̄) / Σ (y_i − ȳ)²
+//!     x = x̄ + β·(y − ȳ),    β = Σ w_i (y_i − ȳ)(x_i − x̄) / Σ w_i (y_i − ȳ)²
 //! ```
 //!
-//! (`x̄`, `ȳ` the means of the points), i.e. `(a1, a2, a3) = (0, β, x̄ − β·ȳ)`; the filter
+//! (`x̄`, `ȳ` the weighted means of the points), i.e. `(a1, a2, a3) = (0, β, x̄ − β·ȳ)`; the filter
 //! restarts from it with `P0`, as after the double line's middle. A vertex beyond the bottom
 //! row, outside the image's columns (the lane has left the image before it turns) or at or
 //! above the lowest point leaves the lane as it is. Tracked frames keep the filter's estimate
@@ -37,14 +39,16 @@ use nalgebra::Vector3;
 
 use super::{LaneState, LaneTracker};
 
-/// The least-squares line `(a2, a3)` of `x = a2·y + a3` through `points` (`(col, row)`, px)
+/// The least-squares line `(a2, a3)` of `x = a2·y + a3` through `points` (`(col, row)`, px;
+/// point `i` weighing `weights[i]`, 1 where `weights` has none, as in the lane's row profile)
 /// when the parabola `coeffs = [a1, a2, a3]` turns back below them: its vertex lies below the
 /// lowest point's row and at or above `bottom_row_px`, at a column in `[0, width_px)` (module
 /// docs). `None` when it does not, or when the points span a single row (no line through
-/// them) or are not finite.
+/// them), are not finite or weigh nothing.
 pub(super) fn turn_back_line(
     coeffs: [f64; 3],
     points: &[(f32, f32)],
+    weights: &[f64],
     bottom_row_px: f64,
     width_px: f64,
 ) -> Option<(f64, f64)> {
@@ -68,15 +72,20 @@ pub(super) fn turn_back_line(
     if !turns {
         return None;
     }
-    let n = points.len() as f64;
-    let (mean_x, mean_y) = points.iter().fold((0.0, 0.0), |(sx, sy), p| {
-        (sx + f64::from(p.0) / n, sy + f64::from(p.1) / n)
-    });
+    let weight = |i: usize| weights.get(i).copied().unwrap_or(1.0);
+    let total: f64 = (0..points.len()).map(weight).sum();
+    let (mean_x, mean_y) = points
+        .iter()
+        .enumerate()
+        .fold((0.0, 0.0), |(sx, sy), (i, p)| {
+            let w = weight(i) / total;
+            (sx + w * f64::from(p.0), sy + w * f64::from(p.1))
+        });
     let (mut syy, mut sxy) = (0.0, 0.0);
-    for p in points {
+    for (i, p) in points.iter().enumerate() {
         let (dx, dy) = (f64::from(p.0) - mean_x, f64::from(p.1) - mean_y);
-        syy += dy * dy;
-        sxy += dx * dy;
+        syy += weight(i) * dy * dy;
+        sxy += weight(i) * dx * dy;
     }
     // (False for NaN too: points on one row, or not finite, determine no line.)
     (syy > 0.0)
@@ -89,9 +98,12 @@ pub(super) fn turn_back_line(
 
 impl LaneTracker {
     /// Lane `i`'s estimate replaced by the least-squares line through its refinement's points
+    /// (and traced middles)
     /// when it turns back below them (module docs); over the rows `self.search_rows`. Returns
     /// whether it was replaced. Only a lane whose last refinement pass updated it (tracking:
-    /// a pass that misses leaves it coasting or lost) is read, so its points are that update's.
+    /// a pass that misses leaves it coasting or lost) is read, so its points are that update's
+    /// and, with `init.stripe_trace`, the stripe's middles traced after it, weighing as in
+    /// the trace's update (module `stripe_trace`): evidence as far down as the trace reached.
     pub(super) fn straighten_turn_back(&mut self, i: usize) -> bool {
         let lane = &self.lanes[i];
         if lane.state != LaneState::Tracking || !lane.updated_now {
@@ -101,8 +113,13 @@ impl LaneTracker {
             return false;
         };
         let bottom_row_px = self.search_rows.1.saturating_sub(1) as f64;
-        let Some((a2, a3)) = turn_back_line(coeffs, &lane.points, bottom_row_px, self.width as f64)
-        else {
+        let Some((a2, a3)) = turn_back_line(
+            coeffs,
+            &lane.points,
+            &lane.weights,
+            bottom_row_px,
+            self.width as f64,
+        ) else {
             return false;
         };
         self.restart_filter(i, &Vector3::new(0.0, a2, a3))
@@ -127,7 +144,7 @@ mod tests {
         // x = 0.05·(y − 160)² + 100: vertex (160, 100).
         let coeffs = [0.05, -16.0, 0.05 * 160.0 * 160.0 + 100.0];
         let straight = along(|y| 300.0 - 1.5 * y, 100..140);
-        let (a2, a3) = turn_back_line(coeffs, &straight, 179.0, 320.0).expect("turns back");
+        let (a2, a3) = turn_back_line(coeffs, &straight, &[], 179.0, 320.0).expect("turns back");
         assert!(
             (a2 + 1.5).abs() < 1e-9 && (a3 - 300.0).abs() < 1e-6,
             "{a2} {a3}"
@@ -138,7 +155,7 @@ mod tests {
             .enumerate()
             .map(|(k, &(x, y))| (x + [0.5, -0.5, 1.0, -1.0][k % 4], y))
             .collect();
-        let (a2, a3) = turn_back_line(coeffs, &noisy, 179.0, 320.0).expect("turns back");
+        let (a2, a3) = turn_back_line(coeffs, &noisy, &[], 179.0, 320.0).expect("turns back");
         let n = noisy.len() as f64;
         let (sx, sy, syy, sxy) = noisy.iter().fold((0.0, 0.0, 0.0, 0.0), |s, &(x, y)| {
             let (x, y) = (f64::from(x), f64::from(y));
@@ -165,19 +182,19 @@ mod tests {
             (160.0, 320.0, "right of the image"),
         ] {
             assert_eq!(
-                turn_back_line(vertex_at(row, col), &points, 179.0, 320.0),
+                turn_back_line(vertex_at(row, col), &points, &[], 179.0, 320.0),
                 None,
                 "{why}"
             );
         }
         assert_eq!(
-            turn_back_line([0.0, -1.5, 300.0], &points, 179.0, 320.0),
+            turn_back_line([0.0, -1.5, 300.0], &points, &[], 179.0, 320.0),
             None
         );
         // Just inside each bound, it turns back.
         for (row, col) in [(139.5, 100.0), (179.0, 100.0), (160.0, 0.0), (160.0, 319.9)] {
             assert!(
-                turn_back_line(vertex_at(row, col), &points, 179.0, 320.0).is_some(),
+                turn_back_line(vertex_at(row, col), &points, &[], 179.0, 320.0).is_some(),
                 "vertex ({row}, {col})"
             );
         }
@@ -188,15 +205,18 @@ mod tests {
     fn points_on_one_row_or_not_finite_leave_the_lane_as_it_is() {
         let vertex_160 = [0.05, -16.0, 0.05 * 160.0 * 160.0 + 100.0];
         let one_row: Vec<(f32, f32)> = (0..20).map(|k| (100.0 + k as f32, 120.0)).collect();
-        assert_eq!(turn_back_line(vertex_160, &one_row, 179.0, 320.0), None);
-        let mut bad = along(|y| 300.0 - 1.5 * y, 100..140);
-        bad[3].0 = f32::NAN;
-        assert_eq!(turn_back_line(vertex_160, &bad, 179.0, 320.0), None);
-        let points = along(|y| 300.0 - 1.5 * y, 100..140);
         assert_eq!(
-            turn_back_line([f64::NAN, -16.0, 1380.0], &points, 179.0, 320.0),
+            turn_back_line(vertex_160, &one_row, &[], 179.0, 320.0),
             None
         );
-        assert_eq!(turn_back_line(vertex_160, &[], 179.0, 320.0), None);
+        let mut bad = along(|y| 300.0 - 1.5 * y, 100..140);
+        bad[3].0 = f32::NAN;
+        assert_eq!(turn_back_line(vertex_160, &bad, &[], 179.0, 320.0), None);
+        let points = along(|y| 300.0 - 1.5 * y, 100..140);
+        assert_eq!(
+            turn_back_line([f64::NAN, -16.0, 1380.0], &points, &[], 179.0, 320.0),
+            None
+        );
+        assert_eq!(turn_back_line(vertex_160, &[], &[], 179.0, 320.0), None);
     }
 }
