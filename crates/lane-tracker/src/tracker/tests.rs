@@ -1966,25 +1966,34 @@ fn wide_left_mark(w: usize, h: usize) -> GreyFrame {
     GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
 }
 
+/// A default tracker (with `track.stripe_middles` and `init.stripe_trace` as given) after its
+/// first frame of `wide_left_mark` — the initialisation and its refinements on the same frame
+/// — and the reported left lane's largest offset from the mark's middle at the ROI's top,
+/// middle and bottom rows, px.
+fn initialised_on_wide_mark(frame: &GreyFrame, middles: bool, trace: bool) -> (LaneTracker, f64) {
+    let mut cfg = TrackerConfig::default_preset().expect("the default preset");
+    cfg.track.stripe_middles = middles;
+    cfg.init.stripe_trace = trace;
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+    let (top, bottom) = tracker.roi;
+    let report = tracker.track(frame).expect("a frame");
+    assert!(report.lanes[0].initialised);
+    let c = report.lanes[0].coeffs.expect("a left lane");
+    let off = [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64]
+        .iter()
+        .map(|&y| (c[0] * y * y + c[1] * y + c[2] - mark_left(y)).abs())
+        .fold(0.0, f64::max);
+    (tracker, off)
+}
+
 #[test]
 fn a_wide_mark_is_initialised_on_its_middle_not_on_one_edge() {
     let frame = wide_left_mark(320, 240);
     let mut off = [0.0f64; 2];
     for (k, middles) in [true, false].into_iter().enumerate() {
-        let mut cfg = TrackerConfig::default_preset().expect("the default preset");
-        cfg.track.stripe_middles = middles;
         // (The stripe trace, which measures middles too, is the next test's.)
-        cfg.init.stripe_trace = false;
-        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
-        let (top, bottom) = tracker.roi;
-        // The initialisation and its refinements on the same frame.
-        let report = tracker.track(&frame).expect("a frame");
-        assert!(report.lanes[0].initialised);
-        let c = report.lanes[0].coeffs.expect("a left lane");
-        for y in [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64] {
-            let d = c[0] * y * y + c[1] * y + c[2] - mark_left(y);
-            off[k] = off[k].max(d.abs());
-        }
+        let (mut tracker, lane_off) = initialised_on_wide_mark(&frame, middles, false);
+        off[k] = lane_off;
         // The refinement's points include middles between two columns; a tracked frame's
         // are the paper's edge pixels, whole columns.
         let halves = |t: &LaneTracker| t.lanes[0].points.iter().any(|&(x, _)| x.fract() != 0.0);
@@ -2155,17 +2164,26 @@ fn a_frame_size_beyond_the_limit_is_refused_before_anything_is_sized() {
 /// average) on the rows `rows`, and, when `step`, the floor right of the line 200 bright as
 /// well (a step, not a stripe).
 fn left_line(rows: std::ops::Range<f64>, half_px: f64, step: bool) -> GreyFrame {
+    line_frame(mark_left, half_px, |y| rows.contains(&y), step)
+}
+
+/// A frame of grey 60 with a line 200 bright and `2·half_px` wide (area average) along each
+/// row's `col(y)`, on the rows for which `drawn(y)` holds; when `step`, the floor right of the
+/// line as bright as well (a step, not a stripe).
+fn line_frame(
+    col: impl Fn(f64) -> f64,
+    half_px: f64,
+    drawn: impl Fn(f64) -> bool,
+    step: bool,
+) -> GreyFrame {
     let (w, h) = (320, 240);
     let mut pixels = vec![60u8; w * h];
     for (i, p) in pixels.iter_mut().enumerate() {
         let (x, y) = ((i % w) as f64, (i / w) as f64);
-        if !rows.contains(&y) {
+        if !drawn(y) {
             continue;
         }
-        let (lo, hi) = (
-            mark_left(y) - half_px,
-            mark_left(y) + if step { 1e9 } else { half_px },
-        );
+        let (lo, hi) = (col(y) - half_px, col(y) + if step { 1e9 } else { half_px });
         let cover = ((x + 0.5).min(hi) - (x - 0.5).max(lo)).clamp(0.0, 1.0);
         *p = (60.0 + 140.0 * cover).round() as u8;
     }
@@ -2300,22 +2318,7 @@ fn the_initialisation_of_a_wide_mark_is_traced_onto_its_middle() {
     // `wide_left_mark` with the paper's edge pixels in the refinement: the lane stays on the
     // edge the Hough line found (the test above); the trace's middles bring it to the middle.
     let frame = wide_left_mark(320, 240);
-    let mut off = [0.0f64; 2];
-    for (k, trace) in [false, true].into_iter().enumerate() {
-        let mut cfg = TrackerConfig::default_preset().expect("the default preset");
-        cfg.track.stripe_middles = false;
-        cfg.init.stripe_trace = trace;
-        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
-        let rows = {
-            let (top, bottom) = tracker.roi;
-            [top as f64, 0.5 * (top + bottom) as f64, (bottom - 1) as f64]
-        };
-        let report = tracker.track(&frame).expect("a frame");
-        assert!(report.lanes[0].initialised);
-        for y in rows {
-            off[k] = off[k].max(left_offset(&tracker, y).abs());
-        }
-    }
+    let off = [false, true].map(|trace| initialised_on_wide_mark(&frame, false, trace).1);
     assert!(off[0] > 3.0, "without the trace: {} px off", off[0]);
     // Measured 4.9 and 1.5 px.
     assert!(
@@ -2324,22 +2327,6 @@ fn the_initialisation_of_a_wide_mark_is_traced_onto_its_middle() {
         off[1],
         off[0]
     );
-}
-
-/// A frame of grey 60 with a bright line 6 px wide along each row (its middle at `col(y)`), on
-/// the rows for which `drawn(y)` holds.
-fn line_along(col: impl Fn(f64) -> f64, drawn: impl Fn(f64) -> bool) -> GreyFrame {
-    let (w, h) = (320, 240);
-    let mut pixels = vec![60u8; w * h];
-    for (i, p) in pixels.iter_mut().enumerate() {
-        let (x, y) = ((i % w) as f64, (i / w) as f64);
-        if !drawn(y) {
-            continue;
-        }
-        let cover = ((x + 0.5).min(col(y) + 3.0) - (x - 0.5).max(col(y) - 3.0)).clamp(0.0, 1.0);
-        *p = (60.0 + 140.0 * cover).round() as u8;
-    }
-    GreyFrame::from_vec(w, h, pixels).expect("a whole frame")
 }
 
 /// Lane 0 of a default tracker updated on this frame with points on rows `rows` of `col`,
@@ -2375,7 +2362,7 @@ fn the_trace_follows_a_bending_stripe_with_its_slope() {
     // the 2-px reach after about 34 rows each way, and with the wrong sign for the steps
     // measured going up it turns away at once.
     let col = |y: f64| 160.0 + 0.03 * (y - 194.0) * (y - 194.0);
-    let frame = line_along(col, |_| true);
+    let frame = line_frame(col, 3.0, |_| true, false);
     let image = GreyImage::new(frame.data(), 320, 240, 320).expect("an image");
     let mut tracker = lane_tangent_at(col, 194.0, 190..199);
     let (top, bottom) = tracker.roi;
@@ -2395,7 +2382,7 @@ fn the_trace_follows_a_bending_stripe_with_its_slope() {
 fn the_trace_bridges_three_rows_without_a_middle_and_ends_at_the_fourth() {
     // A straight line with its rows 200–202 blank (bridged) and 215–218 blank (the end).
     let gaps = |y: f64| !(200.0..203.0).contains(&y) && !(215.0..219.0).contains(&y);
-    let frame = line_along(mark_left, gaps);
+    let frame = line_frame(mark_left, 3.0, gaps, false);
     let image = GreyImage::new(frame.data(), 320, 240, 320).expect("an image");
     let mut tracker = lane_tangent_at(mark_left, 180.0, 170..190);
     let top = tracker.roi.0;
