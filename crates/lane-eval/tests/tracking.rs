@@ -15,11 +15,22 @@ fn run_scene(
     w: usize,
     h: usize,
 ) -> (Vec<Option<TrackReport>>, lane_eval::synth::SequenceTruth) {
-    let mut cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
-    // The presets' pixel parameters are for 320-px-wide frames: scale them with the width.
-    cfg.scale_pixels(w as f64 / 320.0);
+    let cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
+    run_scene_with(spec, &cfg, estimator, w, h)
+}
+
+/// [`run_scene`] with a given configuration.
+fn run_scene_with(
+    spec: SceneSpec,
+    cfg: &TrackerConfig,
+    estimator: Estimator,
+    w: usize,
+    h: usize,
+) -> (Vec<Option<TrackReport>>, lane_eval::synth::SequenceTruth) {
+    // The presets' pixel parameters are for 320-px-wide frames: a wider frame is tracked on
+    // its box average near 320 px wide (`frame.working_width_px`), reported in its own pixels.
     let mut renderer = SceneRenderer::new(spec, w, h);
-    let mut tracker = LaneTracker::new(&cfg, estimator, w, h).unwrap();
+    let mut tracker = LaneTracker::new(cfg, estimator, w, h).unwrap();
     let mut frame = GreyFrame::default();
     let reports = (0..spec.frames)
         .map(|i| {
@@ -52,6 +63,140 @@ fn coefficients_are_in_the_input_image_pixel_convention_at_other_sizes() {
     // (tolerance 10 px at 640 px width; a report in 320×240 or normalised units would be off by
     // tens of pixels).
     let (reports, truth) = run_scene(scene("curve_left_dashed"), Estimator::Kif, 640, 480);
+    let s = score_sequence(&truth, &reports);
+    assert!(s.accuracy >= 0.98, "{s:?}");
+    assert!(s.mean_lateral_error_px <= 3.0, "{s:?}");
+}
+
+#[test]
+fn a_wide_frame_is_tracked_at_the_working_width_and_reported_in_its_own_pixels() {
+    // Every rendered scene at 1280×960 (f = 4, worked on at 320×240): the bounds of 320×240
+    // scaled by 4, the coefficients in 1280×960 pixels (the truth's): a report left in working
+    // pixels would be off by hundreds of pixels. (The exact mapping: the next test.)
+    for spec in SCENES {
+        let (reports, truth) = run_scene(*spec, Estimator::Kif, 1280, 960);
+        let s = score_sequence(&truth, &reports);
+        assert!(s.mean_lateral_error_px <= 4.0 * 1.5, "{}: {s:?}", spec.name);
+        assert!(s.accuracy >= 0.98, "{}: {s:?}", spec.name);
+        assert!(s.max_recovery_frames <= 3, "{}: {s:?}", spec.name);
+    }
+}
+
+/// `frame` box-averaged over `f × f` blocks, each mean rounded to the nearest grey level: the
+/// working frame the tracker's module `working` defines, written here independently.
+fn box_average(frame: &GreyFrame, f: usize) -> GreyFrame {
+    let (w, h) = (frame.width() / f, frame.height() / f);
+    let mut out = vec![0u8; w * h];
+    for r in 0..h {
+        for c in 0..w {
+            let mut sum = 0u32;
+            for j in 0..f {
+                for i in 0..f {
+                    sum += u32::from(frame.data()[(f * r + j) * frame.width() + f * c + i]);
+                }
+            }
+            let area = (f * f) as u32;
+            out[r * w + c] = ((sum + area / 2) / area) as u8;
+        }
+    }
+    GreyFrame::from_vec(w, h, out).unwrap()
+}
+
+#[test]
+fn a_wide_frame_reports_the_working_frames_lanes_mapped_to_its_pixels() {
+    // A 1280×960 render tracked directly, and its box average (computed here) tracked by a
+    // 320×240 tracker: the same working frame, so every output of the wide tracker must be the
+    // small one's mapped by `x = 4·x' + 1.5`, `y = 4·y' + 1.5` — columns, points, windows,
+    // candidates and the variance of a lane's column (f² times the small one's). Fails with
+    // the offset 1.5 left out of the mapping, or the factor's power wrong in `a1` (tried).
+    let spec = scene("curve_left_dashed");
+    let cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
+    let (f, o) = (4usize, 1.5f64);
+    let mut renderer = SceneRenderer::new(spec, 1280, 960);
+    let mut wide = LaneTracker::new(&cfg, Estimator::Kif, 1280, 960).unwrap();
+    let mut small = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
+    assert_eq!(wide.working_size(), (320, 240));
+    assert_eq!(wide.frame_size(), (1280, 960));
+    let mut frame = GreyFrame::default();
+    let mut compared = 0;
+    for i in 0..spec.frames.min(40) {
+        renderer.render(i, &mut frame);
+        let rw = wide.track(&frame).unwrap();
+        let rs = small.track(&box_average(&frame, f)).unwrap();
+        for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+            let (a, b) = (rw.lanes[k], rs.lanes[k]);
+            assert_eq!(a.state, b.state, "frame {i}");
+            assert_eq!(a.points, b.points, "frame {i}");
+            let (Some(_), Some(cs)) = (a.coeffs, b.coeffs) else {
+                assert_eq!(a.coeffs.is_some(), b.coeffs.is_some(), "frame {i}");
+                continue;
+            };
+            for y_w in [150.0, 180.5, 239.0] {
+                let want = f as f64 * b.col_at_row(y_w).unwrap() + o;
+                let got = a.col_at_row(f as f64 * y_w + o).unwrap();
+                assert!(
+                    (got - want).abs() < 1e-6,
+                    "frame {i} row {y_w}: {got} vs {want}"
+                );
+                // Var(x(y)) = gᵀ·P·g with g = (y², y, 1): f² times the working one.
+                let g = |y: f64| nalgebra::Vector3::new(y * y, y, 1.0);
+                let (pw, ps) = (
+                    wide.lane_covariance_px(side).unwrap(),
+                    small.lane_covariance_px(side).unwrap(),
+                );
+                let y_in = f as f64 * y_w + o;
+                let var_in = (g(y_in).transpose() * pw * g(y_in))[(0, 0)];
+                let var_w = (g(y_w).transpose() * ps * g(y_w))[(0, 0)];
+                let want_var = (f * f) as f64 * var_w;
+                assert!(
+                    (var_in - want_var).abs() <= 1e-6 * want_var.abs().max(1e-12),
+                    "frame {i}: variance {var_in} vs {want_var}"
+                );
+            }
+            let (vw, vs) = (wide.lane_view(side), small.lane_view(side));
+            assert_eq!(vw.points.len(), vs.points.len());
+            for (&(xw, yw), &(xs, ys)) in vw.points.iter().zip(vs.points) {
+                assert!((f64::from(xw) - (4.0 * f64::from(xs) + o)).abs() < 1e-3);
+                assert!((f64::from(yw) - (4.0 * f64::from(ys) + o)).abs() < 1e-3);
+            }
+            assert_eq!(vw.spans.len(), 960);
+            for (y, span) in vw.spans.iter().enumerate() {
+                let sw = vs.spans[y / f];
+                assert_eq!(
+                    (span.col_start_px, span.col_end_px),
+                    (4 * sw.col_start_px, 4 * sw.col_end_px),
+                    "frame {i} row {y}"
+                );
+            }
+            compared += 1;
+        }
+        assert_eq!(wide.init_candidates().len(), small.init_candidates().len());
+        for (cw, cs) in wide.init_candidates().iter().zip(small.init_candidates()) {
+            let x = |c: [f64; 3], y: f64| c[0] * y * y + c[1] * y + c[2];
+            let want = f as f64 * x(cs.coeffs, 200.0) + o;
+            assert!((x(cw.coeffs, f as f64 * 200.0 + o) - want).abs() < 1e-6);
+            assert_eq!(
+                (cw.support, cw.chosen, cw.band),
+                (cs.support, cs.chosen, cs.band)
+            );
+        }
+    }
+    assert!(compared > 40, "{compared} lanes compared");
+    let (top, bottom) = small.roi_rows();
+    assert_eq!(wide.roi_rows(), (f * top, f * bottom));
+}
+
+#[test]
+fn working_width_zero_tracks_at_the_input_size_with_scaled_pixels() {
+    // `frame.working_width_px = 0`: no resampling, the pixel fields scaled by hand (the way
+    // before the working width): the 640×480 scene still meets its bounds.
+    let spec = scene("curve_left_dashed");
+    let mut cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
+    cfg.frame.working_width_px = 0;
+    cfg.scale_pixels(2.0);
+    let tracker = LaneTracker::new(&cfg, Estimator::Kif, 640, 480).unwrap();
+    assert_eq!(tracker.working_size(), (640, 480));
+    let (reports, truth) = run_scene_with(spec, &cfg, Estimator::Kif, 640, 480);
     let s = score_sequence(&truth, &reports);
     assert!(s.accuracy >= 0.98, "{s:?}");
     assert!(s.mean_lateral_error_px <= 3.0, "{s:?}");

@@ -23,8 +23,10 @@ mod tests;
 mod turn_back;
 mod update;
 mod windows;
+mod working;
 
 use points::{BANDS, Candidate, MAX_WINDOW_HALF_WIDTH};
+use working::WorkingScale;
 
 /// Which lane.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -391,8 +393,27 @@ pub struct LaneView<'a> {
 pub struct LaneTracker {
     cfg: TrackerConfig,
     estimator: Estimator,
+    /// The working frame's size, px (module `working`): the input's own when it is not
+    /// resampled. Every stage works in these pixels.
     width: usize,
     height: usize,
+    /// The input frames' size, px.
+    input_size: (usize, usize),
+    /// Input pixels per working pixel (`frame.working_width_px`).
+    scale: WorkingScale,
+    /// The working frame's pixels, `width` a row (empty when the input is not resampled), and
+    /// the row sums of its box average.
+    work: Vec<u8>,
+    work_sums: Vec<u32>,
+    /// The working rows any stage reads, `[first, end)`: the regions searched and the Sobel's
+    /// row beside them; only these are resampled.
+    work_rows: (usize, usize),
+    /// With a resampled input: the last frame's reports, candidates, windows and points in
+    /// input pixels (what the accessors hand out), refreshed at the end of every frame.
+    out_lanes: [LaneReport; 2],
+    out_candidates: Vec<InitCandidate>,
+    out_spans: [Vec<ColSpan>; 2],
+    out_points: [Vec<(f32, f32)>; 2],
     /// The ROI's rows `[top, bottom)` (`roi.*_row_fraction`), px; fixed.
     roi: (usize, usize),
     /// The rows the current stage reads, `[top, bottom)`, px: [`Self::roi`], or the second
@@ -463,6 +484,23 @@ impl LaneTracker {
         if width < 3 || height < 3 {
             return Err(TrackerError::ZeroSize { width, height });
         }
+        if width > hough_init::MAX_IMAGE_SIDE_PX || height > hough_init::MAX_IMAGE_SIDE_PX {
+            return Err(hough_init::HoughError::InvalidImageSize {
+                width_px: width,
+                height_px: height,
+                reason: "a side exceeds MAX_IMAGE_SIDE_PX (16384 px)",
+            }
+            .into());
+        }
+        let input_size = (width, height);
+        let working = WorkingScale::for_input(width, cfg.frame.working_width_px);
+        let (width, height) = working.working_size(width, height);
+        if width < 3 || height < 3 {
+            return Err(TrackerError::ZeroSize {
+                width: input_size.0,
+                height: input_size.1,
+            });
+        }
         let detector = GradientDetector::new(cfg.gradient.params())?;
         let roi = cfg.roi_rows(height);
         let fallback_roi = cfg.fallback_roi_rows(height);
@@ -518,11 +556,39 @@ impl LaneTracker {
         for lane in &lanes {
             lane.band.validate()?;
         }
+        let resampled = working.resamples();
+        let work_rows = (
+            fallback_roi
+                .map_or(roi.0, |r| r.0.min(roi.0))
+                .saturating_sub(1),
+            (roi.1 + 1).min(height),
+        );
+        let point_capacity = if resampled {
+            lanes[0].points.capacity()
+        } else {
+            0
+        };
+        let empty_report = lanes[0].report();
         Ok(LaneTracker {
             cfg: *cfg,
             estimator,
             width,
             height,
+            input_size,
+            scale: working,
+            work: vec![0; if resampled { width * height } else { 0 }],
+            work_sums: vec![0; if resampled { width } else { 0 }],
+            work_rows,
+            out_lanes: [empty_report, lanes[1].report()],
+            out_candidates: Vec::with_capacity(if resampled {
+                4 * MAX_CANDIDATE_LINES
+            } else {
+                0
+            }),
+            out_spans: std::array::from_fn(|_| {
+                vec![ColSpan::EMPTY; if resampled { input_size.1 } else { 0 }]
+            }),
+            out_points: std::array::from_fn(|_| Vec::with_capacity(point_capacity)),
             roi,
             search_rows: roi,
             fallback_roi,
@@ -562,8 +628,17 @@ impl LaneTracker {
         })
     }
 
-    /// Frame size this tracker takes, px.
+    /// Frame size this tracker takes, px (the input's; it may work on a resampled frame:
+    /// [`LaneTracker::working_size`]).
     pub fn frame_size(&self) -> (usize, usize) {
+        self.input_size
+    }
+
+    /// The size of the frame the stages work on, px: the input box-averaged over `f × f`
+    /// blocks, `f` the whole number nearest the input width over `frame.working_width_px`
+    /// (module `tracker::working`); the input's own size when `f = 1`. The configuration's
+    /// pixel fields are in these pixels; everything the tracker reports is in input pixels.
+    pub fn working_size(&self) -> (usize, usize) {
         (self.width, self.height)
     }
 
@@ -586,9 +661,11 @@ impl LaneTracker {
         out
     }
 
-    /// Rows searched, `[top, bottom)`, px.
+    /// Rows searched, `[top, bottom)`, px of the input (with a resampled input, the input rows
+    /// the working ROI's rows average).
     pub fn roi_rows(&self) -> (usize, usize) {
-        self.roi
+        let f = self.scale.factor();
+        (f * self.roi.0, (f * self.roi.1).min(self.input_size.1))
     }
 
     /// The configuration in use.
@@ -652,13 +729,19 @@ impl LaneTracker {
         if !lane.has_estimate() {
             return None;
         }
-        match lane.filter.as_ref()? {
+        let p = match lane.filter.as_ref()? {
             LaneFilter::Kif(k) => k.covariance().ok(),
             LaneFilter::Wrls(w) => {
                 let r = self.cfg.filter.r_sigma_px;
                 w.covariance_px().map(|p| p * (r * r))
             }
-        }
+        }?;
+        // In input pixels: `T·P·Tᵀ` (module `working`).
+        Some(if self.scale.resamples() {
+            self.scale.cov_to_input(&p)
+        } else {
+            p
+        })
     }
 
     /// How one lane's estimate was fitted on the last update or initialisation: the weighted
@@ -668,7 +751,11 @@ impl LaneTracker {
     /// lane has no estimate.
     pub fn lane_fit_rows(&self, side: Side) -> Option<FitRows> {
         let lane = &self.lanes[side as usize];
-        lane.has_estimate().then_some(lane.fit)
+        let mut fit = lane.fit;
+        for r in &mut fit.rows_px {
+            *r = self.scale.to_input_px(*r);
+        }
+        lane.has_estimate().then_some(fit)
     }
 
     /// The Hough candidate lines of the last frame's joint initialisation or re-validation, both
@@ -677,12 +764,24 @@ impl LaneTracker {
     /// tracked between re-validations, or `init.candidate_lines = 0`, the paper's one line per
     /// band).
     pub fn init_candidates(&self) -> &[InitCandidate] {
-        &self.init_candidates
+        if self.scale.resamples() {
+            &self.out_candidates
+        } else {
+            &self.init_candidates
+        }
     }
 
     /// Windows, points and report of one lane after the last frame (for overlays).
     pub fn lane_view(&self, side: Side) -> LaneView<'_> {
-        let lane = &self.lanes[side as usize];
+        let i = side as usize;
+        if self.scale.resamples() {
+            return LaneView {
+                report: self.out_lanes[i],
+                spans: &self.out_spans[i],
+                points: &self.out_points[i],
+            };
+        }
+        let lane = &self.lanes[i];
         LaneView {
             report: lane.report(),
             spans: &lane.spans,
@@ -707,15 +806,77 @@ impl LaneTracker {
         height: usize,
         stride_px: usize,
     ) -> Result<TrackReport, TrackerError> {
-        if width != self.width || height != self.height {
+        if (width, height) != self.input_size {
             return Err(TrackerError::FrameSize {
-                expected_w: self.width,
-                expected_h: self.height,
+                expected_w: self.input_size.0,
+                expected_h: self.input_size.1,
                 got_w: width,
                 got_h: height,
             });
         }
-        let image = GreyImage::new(data, self.width, self.height, stride_px)?;
+        let input = GreyImage::new(data, width, height, stride_px)?;
+        if !self.scale.resamples() {
+            return self.track_working(&input);
+        }
+        // The working frame (module `working`), in a buffer taken out of `self` for the
+        // frame (no allocation: `take` leaves an empty vector) and put back whatever happens.
+        let mut work = std::mem::take(&mut self.work);
+        self.scale.downscale_rows(
+            &input,
+            &mut work,
+            self.width,
+            self.work_rows,
+            &mut self.work_sums,
+        );
+        let tracked = GreyImage::new(&work, self.width, self.height, self.width)
+            .map_err(TrackerError::from)
+            .and_then(|image| self.track_working(&image));
+        self.work = work;
+        let report = tracked?;
+        Ok(self.publish_in_input_pixels(report))
+    }
+
+    /// With a resampled input: the frame's reports, candidates, windows and points mapped to
+    /// input pixels (module `working`) into the buffers the accessors hand out; the report
+    /// returned likewise.
+    fn publish_in_input_pixels(&mut self, mut report: TrackReport) -> TrackReport {
+        let s = self.scale;
+        for (out, lane) in report.lanes.iter_mut().zip(&mut self.out_lanes) {
+            out.coeffs = out.coeffs.map(|b| s.coeffs_to_input(b));
+            out.rows = out.rows.map(|r| s.to_input_px(r));
+            *lane = *out;
+        }
+        self.out_candidates.clear();
+        // Within capacity: as many as `init_candidates` holds.
+        self.out_candidates
+            .extend(self.init_candidates.iter().map(|c| InitCandidate {
+                coeffs: s.coeffs_to_input(c.coeffs),
+                ..*c
+            }));
+        let f = s.factor();
+        for (i, lane) in self.lanes.iter().enumerate() {
+            for (y, span) in self.out_spans[i].iter_mut().enumerate() {
+                *span = lane
+                    .spans
+                    .get(y / f)
+                    .map_or(ColSpan::EMPTY, |&w| s.span_to_input(w));
+            }
+            let points = &mut self.out_points[i];
+            points.clear();
+            // Within capacity: the lane's own points buffer's.
+            points.extend(lane.points.iter().map(|&(x, y)| {
+                (
+                    s.to_input_px(f64::from(x)) as f32,
+                    s.to_input_px(f64::from(y)) as f32,
+                )
+            }));
+        }
+        report
+    }
+
+    /// [`LaneTracker::track_pixels`] on the working frame.
+    fn track_working(&mut self, image: &GreyImage<'_>) -> Result<TrackReport, TrackerError> {
+        let image = *image;
         self.counters.frames += 1;
         self.init_candidates.clear();
         for i in 0..2 {

@@ -1,0 +1,269 @@
+//! # Working resolution (an addition beyond the paper; `frame.working_width_px`)
+//!
+//! The paper's frames are the BT848's 320×240, and every pixel-valued setting of the default and
+//! the presets (mark widths, windows, gates, noise) is tuned there. A camera or a recording of
+//! another size would meet those settings at another scale: measured on the labelled stills
+//! resampled to 640×360 and 1280×720, the default's pixel settings as they are fall from
+//! 78.8 % to 64.7 % and 43.0 % (held out), and scaled with the width
+//! ([`crate::TrackerConfig::scale_pixels`]) still to 76.1 % and 63.3 % — a 3×3 Sobel on a
+//! frame four times as sharp sees edges four times as soft, and the work grows with the area.
+//! The tracker therefore works on a frame near the working width `W` (320 px by default):
+//!
+//! ```text
+//! f = max(1, round(input width / W)),   working frame: ⌊w/f⌋ × ⌊h/f⌋,
+//! I'(c', r') = (1/f²) · Σ_{i,j < f} I(f·c' + i, f·r' + j)        (rounded to the nearest grey level)
+//! ```
+//!
+//! a box average over `f × f` blocks (the last `w mod f` columns and `h mod f` rows are not
+//! read). Working pixel `c'` averages input columns `f·c' … f·c' + f − 1`, whose centre is
+//! `x = f·x' + o` with `o = (f − 1)/2`, and rows alike. A working-frame parabola
+//! `x' = b1·y'² + b2·y' + b3` is then, substituting `y' = (y − o)/f`,
+//!
+//! ```text
+//! x = (b1/f)·(y − o)² + b2·(y − o) + f·b3 + o
+//!   ⇒ a1 = b1/f,   a2 = b2 − 2·o·b1/f,   a3 = b1·o²/f − b2·o + f·b3 + o,
+//! ```
+//!
+//! the affine map `a = T·b + t` with
+//!
+//! ```text
+//!     ⎡  1/f     0   0 ⎤        ⎡ 0 ⎤
+//! T = ⎢ −2o/f    1   0 ⎥,   t = ⎢ 0 ⎥,   Cov(a) = T·Cov(b)·Tᵀ.
+//!     ⎣  o²/f   −o   f ⎦        ⎣ o ⎦
+//! ```
+//!
+//! Every report, covariance, candidate and overlay leaves the tracker in input pixels by these
+//! maps; with `f = 1` (a frame up to 1.5 W wide, or `working_width_px = 0`) nothing is
+//! resampled or mapped, and the tracker is the one it was.
+
+use nalgebra::Matrix3;
+use vision_gradient::{ColSpan, GreyImage};
+
+/// The integer scale between the input frame and the working frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct WorkingScale {
+    /// Input pixels per working pixel along each axis, ≥ 1.
+    factor: usize,
+}
+
+impl WorkingScale {
+    /// The scale for frames `input_width_px` wide at working width `working_width_px` (0: none).
+    pub(crate) fn for_input(input_width_px: usize, working_width_px: usize) -> Self {
+        let factor = if working_width_px == 0 {
+            1
+        } else {
+            // Round half up: 480 px at 320 → 2, 400 px → 1.
+            ((2 * input_width_px + working_width_px) / (2 * working_width_px)).max(1)
+        };
+        WorkingScale { factor }
+    }
+
+    /// Input pixels per working pixel, ≥ 1.
+    pub(crate) fn factor(self) -> usize {
+        self.factor
+    }
+
+    /// `true` when the input is resampled (`f > 1`).
+    pub(crate) fn resamples(self) -> bool {
+        self.factor > 1
+    }
+
+    /// `o = (f − 1)/2`, px: the input coordinate of working pixel 0's centre.
+    fn offset_px(self) -> f64 {
+        (self.factor as f64 - 1.0) / 2.0
+    }
+
+    /// A working-frame row or column `v'` in input pixels: `f·v' + o`.
+    pub(crate) fn to_input_px(self, working_px: f64) -> f64 {
+        self.factor as f64 * working_px + self.offset_px()
+    }
+
+    /// The working-frame size of a `width × height` input, px.
+    pub(crate) fn working_size(self, width: usize, height: usize) -> (usize, usize) {
+        (width / self.factor, height / self.factor)
+    }
+
+    /// `T` of the module docs.
+    fn coeff_map(self) -> Matrix3<f64> {
+        let f = self.factor as f64;
+        let o = self.offset_px();
+        Matrix3::new(1.0 / f, 0.0, 0.0, -2.0 * o / f, 1.0, 0.0, o * o / f, -o, f)
+    }
+
+    /// Working-frame coefficients `[b1, b2, b3]` as input-pixel `[a1, a2, a3]`: `T·b + t`.
+    pub(crate) fn coeffs_to_input(self, b: [f64; 3]) -> [f64; 3] {
+        let a = self.coeff_map() * nalgebra::Vector3::from(b);
+        [a[0], a[1], a[2] + self.offset_px()]
+    }
+
+    /// A covariance of working-frame coefficients as one of input-pixel coefficients:
+    /// `T·P·Tᵀ`.
+    pub(crate) fn cov_to_input(self, p: &Matrix3<f64>) -> Matrix3<f64> {
+        let t = self.coeff_map();
+        t * p * t.transpose()
+    }
+
+    /// A working-frame window span as the input columns it covers, `[f·start, f·end)`.
+    pub(crate) fn span_to_input(self, s: ColSpan) -> ColSpan {
+        // `end ≤ working width`, so `f·end ≤ input width ≤ u16::MAX` (`MAX_SIDE_PX`).
+        let f = self.factor as u32;
+        let wide = |c: u16| u16::try_from(u32::from(c) * f).unwrap_or(u16::MAX);
+        ColSpan {
+            col_start_px: wide(s.col_start_px),
+            col_end_px: wide(s.col_end_px),
+        }
+    }
+
+    /// Box-average rows `rows = [first, end)` of the working frame from `src` into `dst`
+    /// (`working_width` bytes a row, row `r` at `r · working_width`), summing in `acc`
+    /// (`working_width` entries). Rows outside `rows` are left as they are.
+    ///
+    /// Needs `src` at least `f·working_width` wide and `f·end` high, `dst` and `acc` large
+    /// enough; the tracker sizes all of them in `LaneTracker::new` and checks the frame's size
+    /// before calling.
+    pub(crate) fn downscale_rows(
+        self,
+        src: &GreyImage<'_>,
+        dst: &mut [u8],
+        working_width: usize,
+        rows: (usize, usize),
+        acc: &mut [u32],
+    ) {
+        let f = self.factor;
+        let area = (f * f) as u32;
+        let acc = &mut acc[..working_width];
+        for r in rows.0..rows.1 {
+            acc.fill(0);
+            for j in 0..f {
+                let Some(line) = src.row(f * r + j) else {
+                    continue;
+                };
+                for (a, block) in acc.iter_mut().zip(line.chunks_exact(f)) {
+                    *a += block.iter().map(|&v| u32::from(v)).sum::<u32>();
+                }
+            }
+            let Some(out) = dst.get_mut(r * working_width..(r + 1) * working_width) else {
+                return;
+            };
+            for (o, &a) in out.iter_mut().zip(acc.iter()) {
+                // Rounded to the nearest grey level; ≤ 255 as a mean of bytes.
+                *o = ((a + area / 2) / area).min(255) as u8;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parabola(c: [f64; 3], y: f64) -> f64 {
+        c[0] * y * y + c[1] * y + c[2]
+    }
+
+    #[test]
+    fn the_factor_is_the_nearest_whole_ratio_and_never_below_one() {
+        let f = |w, ww| WorkingScale::for_input(w, ww).factor();
+        assert_eq!(f(320, 320), 1);
+        assert_eq!(f(479, 320), 1);
+        assert_eq!(f(480, 320), 2);
+        assert_eq!(f(640, 320), 2);
+        assert_eq!(f(1280, 320), 4);
+        assert_eq!(f(1640, 320), 5);
+        assert_eq!(f(160, 320), 1);
+        assert_eq!(f(1280, 0), 1);
+    }
+
+    #[test]
+    fn mapped_coefficients_pass_through_the_mapped_points() {
+        // A working-frame parabola's point (x', y') is the input point (f·x' + o, f·y' + o).
+        for factor_px in [2usize, 3, 4, 5] {
+            let s = WorkingScale { factor: factor_px };
+            let b = [0.0031, -0.42, 97.5];
+            let a = s.coeffs_to_input(b);
+            for y_w in [0.0, 17.0, 60.5, 179.0] {
+                let x_in = s.to_input_px(parabola(b, y_w));
+                let y_in = s.to_input_px(y_w);
+                assert!(
+                    (parabola(a, y_in) - x_in).abs() < 1e-9,
+                    "f = {factor_px}, y' = {y_w}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_mapped_covariance_is_the_covariance_of_mapped_samples() {
+        // Cov(T·b + t) = T·Cov(b)·Tᵀ, checked against the sample covariance of coefficients
+        // drawn around a mean and mapped one by one (a fixed lattice: no randomness needed).
+        let s = WorkingScale { factor: 4 };
+        let mean = [0.002, 0.3, 150.0];
+        let steps = [1e-4, 0.05, 2.0];
+        let mut samples = Vec::new();
+        for i in -2i32..=2 {
+            for j in -2i32..=2 {
+                for k in -2i32..=2 {
+                    // Correlated through the sum in the last coordinate.
+                    let d = [
+                        f64::from(i) * steps[0],
+                        f64::from(j) * steps[1],
+                        f64::from(k + i) * steps[2],
+                    ];
+                    samples.push([mean[0] + d[0], mean[1] + d[1], mean[2] + d[2]]);
+                }
+            }
+        }
+        let cov = |pts: &[[f64; 3]]| {
+            let n = pts.len() as f64;
+            let m: [f64; 3] = std::array::from_fn(|r| pts.iter().map(|p| p[r]).sum::<f64>() / n);
+            Matrix3::from_fn(|r, c| {
+                pts.iter()
+                    .map(|p| (p[r] - m[r]) * (p[c] - m[c]))
+                    .sum::<f64>()
+                    / n
+            })
+        };
+        let mapped: Vec<[f64; 3]> = samples.iter().map(|&b| s.coeffs_to_input(b)).collect();
+        let want = cov(&mapped);
+        let got = s.cov_to_input(&cov(&samples));
+        for r in 0..3 {
+            for c in 0..3 {
+                let tol = 1e-9 * want[(r, c)].abs().max(1e-12);
+                assert!((got[(r, c)] - want[(r, c)]).abs() <= tol, "({r}, {c})");
+            }
+        }
+    }
+
+    #[test]
+    fn downscaling_averages_each_block_and_rounds() {
+        // 6×4 input, f = 2: working 3×2; each block's mean rounded to the nearest level.
+        let input: Vec<u8> = vec![
+            0, 1, 10, 10, 255, 255, //
+            1, 1, 10, 11, 255, 254, //
+            7, 7, 0, 0, 100, 0, //
+            7, 8, 0, 1, 0, 0, //
+        ];
+        let src = GreyImage::new(&input, 6, 4, 6).expect("image");
+        let s = WorkingScale::for_input(6, 3);
+        assert_eq!(s.factor(), 2);
+        let (mut dst, mut acc) = (vec![9u8; 6], vec![0u32; 3]);
+        s.downscale_rows(&src, &mut dst, 3, (0, 2), &mut acc);
+        // (0+1+1+1)/4 = 0.75 → 1; 41/4 = 10.25 → 10; 1019/4 = 254.75 → 255;
+        // 29/4 = 7.25 → 7; 1/4 → 0; 100/4 = 25.
+        assert_eq!(dst, vec![1, 10, 255, 7, 0, 25]);
+        // Only the rows asked for are written.
+        let mut dst = vec![9u8; 6];
+        s.downscale_rows(&src, &mut dst, 3, (1, 2), &mut acc);
+        assert_eq!(dst, vec![9, 9, 9, 7, 0, 25]);
+    }
+
+    #[test]
+    fn spans_cover_the_input_columns_of_their_working_columns() {
+        let s = WorkingScale { factor: 4 };
+        let span = s.span_to_input(ColSpan {
+            col_start_px: 10,
+            col_end_px: 21,
+        });
+        assert_eq!((span.col_start_px, span.col_end_px), (40, 84));
+    }
+}
