@@ -15,6 +15,7 @@ mod monte_carlo;
 mod paths;
 mod python;
 mod regress;
+mod resample_lanes;
 mod vivid;
 
 #[derive(Parser)]
@@ -50,6 +51,9 @@ enum Cmd {
     /// Score the lane tracker on the real labelled sets (--data, default ../shared/data/lanes),
     /// beside the ceiling, the presets and the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
     EvalLanes(eval_lanes::EvalLanesArgs),
+    /// Write the labelled sets enlarged K times (frames bicubic, labels mapped) into
+    /// target/lanes-{K}x, for `eval-lanes --data` at another resolution.
+    ResampleLanes(resample_lanes::ResampleLanesArgs),
     /// Check the crate boundaries: lane-tracker pulls in no image codec, V4L2, CLI, Monte Carlo or
     /// INS crate; lane-io and lane-eval no INS, V4L2, CLI or Monte Carlo crate; ins-sim neither
     /// rayon nor plotters.
@@ -74,6 +78,7 @@ fn main() -> Result<()> {
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
         Cmd::EvalLanes(args) => eval_lanes::run(args),
+        Cmd::ResampleLanes(args) => resample_lanes::run(args),
         Cmd::Python(args) => python::run(args),
         Cmd::Halves => halves::run(),
         Cmd::MonteCarlo(args) => monte_carlo::run(args),

@@ -5,9 +5,9 @@
 //! Hough + LS per lane, one windowed refinement on the same frame) and the two reported lanes
 //! are scored against the two ego lanes of `gt_instance_image/` at rows 160, 170, … (TuSimple's
 //! h-samples) from the ROI top down: correct within 20 px at 1280 px width.
-//! The outdoor preset is used as it is (its pixel parameters are for 320-px-wide frames, and the
-//! tracker works on the 1280-px frames' 4 × 4 box average: `frame.working_width_px`) with the ROI
-//! top at 40 % of the height (the horizon of these frames is at about 36 %).
+//! The default configuration is used as it is (its pixel parameters are for 320-px-wide frames,
+//! and the tracker works on the 1280-px frames' 4 × 4 box average: `frame.working_width_px`) with
+//! the ROI top at 40 % of the height (the horizon of these frames is at about 36 %).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::PathBuf;
@@ -26,7 +26,7 @@ fn main() {
                 "/../../../shared/data/lanenet"
             ))
         });
-    let mut cfg = TrackerConfig::outdoor().unwrap();
+    let mut cfg = TrackerConfig::default_preset().unwrap();
     cfg.roi.top_row_fraction = 0.40;
     let (mut frame, mut label) = (GreyFrame::default(), GreyFrame::default());
     let (mut points, mut correct) = (0u64, 0u64);

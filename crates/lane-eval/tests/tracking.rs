@@ -127,7 +127,7 @@ fn a_wide_frame_reports_the_working_frames_lanes_mapped_to_its_pixels() {
             let (a, b) = (rw.lanes[k], rs.lanes[k]);
             assert_eq!(a.state, b.state, "frame {i}");
             assert_eq!(a.points, b.points, "frame {i}");
-            let (Some(_), Some(cs)) = (a.coeffs, b.coeffs) else {
+            let (Some(_), Some(_)) = (a.coeffs, b.coeffs) else {
                 assert_eq!(a.coeffs.is_some(), b.coeffs.is_some(), "frame {i}");
                 continue;
             };

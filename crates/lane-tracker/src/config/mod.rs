@@ -803,7 +803,9 @@ impl TrackerConfig {
     }
 
     /// Multiply every pixel-valued parameter by `k` (> 0): the presets are tuned for 320-px-wide
-    /// frames, so a 1280-px frame takes `k = 4`. Scaled: window and inlier half-widths, jump
+    /// frames, which the tracker works at by default whatever the input's size
+    /// (`frame.working_width_px`); with `frame.working_width_px = 0` (tracking at the input's own
+    /// size) a 1280-px frame takes `k = 4`. The working width itself is not scaled. Scaled: window and inlier half-widths, jump
     /// gate, lane separation, Hough band and candidate separation, stripe width and the periodic
     /// stripes' widest (at least 4 px
     /// with `init.kerb_foot`, which reads a kerb's face within it, and 2 px with

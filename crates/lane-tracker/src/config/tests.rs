@@ -63,6 +63,10 @@ fn an_out_of_range_field_in_a_file_names_the_file_line_and_column() {
 fn each_out_of_range_field_is_named() {
     type Edit = fn(&mut TrackerConfig);
     let cases: &[(&str, Edit)] = &[
+        ("frame.working_width_px", |c| c.frame.working_width_px = 15),
+        ("frame.working_width_px", |c| {
+            c.frame.working_width_px = 16385
+        }),
         ("gradient.magnitude_threshold", |c| {
             c.gradient.magnitude_threshold = 3000
         }),
@@ -381,4 +385,36 @@ fn a_value_a_component_refuses_names_its_field_and_keeps_the_components_error() 
         }
         other => panic!("expected a located error, got {other:?}"),
     }
+}
+
+#[test]
+fn the_working_width_is_320_when_absent_and_located_in_a_file_when_out_of_range() {
+    // The presets have no `[frame]`: they are tuned at 320 px and work there.
+    for preset in [OUTDOOR_TOML, INDOOR_TOML] {
+        assert!(!preset.contains("[frame]"));
+        let c = TrackerConfig::from_toml_str("p.toml", preset).unwrap();
+        assert_eq!(c.frame.working_width_px, DEFAULT_WORKING_WIDTH_PX);
+    }
+    let default = TrackerConfig::default_preset().unwrap();
+    assert_eq!(default.frame.working_width_px, 320);
+    let text = DEFAULT_TOML.replace("working_width_px = 320", "working_width_px = 8");
+    let line = 1 + text[..text.find("working_width_px = 8").unwrap()]
+        .matches('\n')
+        .count();
+    let msg = TrackerConfig::from_toml_str("w.toml", &text)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.starts_with(&format!("w.toml:{line}:1: `frame.working_width_px` = 8")),
+        "{msg}"
+    );
+    // 0: the input's own size, accepted.
+    let text = DEFAULT_TOML.replace("working_width_px = 320", "working_width_px = 0");
+    assert_eq!(
+        TrackerConfig::from_toml_str("w.toml", &text)
+            .unwrap()
+            .frame
+            .working_width_px,
+        0
+    );
 }

@@ -2,12 +2,13 @@
 //!
 //! The paper's frames are the BT848's 320×240, and every pixel-valued setting of the default and
 //! the presets (mark widths, windows, gates, noise) is tuned there. A camera or a recording of
-//! another size would meet those settings at another scale: measured on the labelled stills
-//! resampled to 640×360 and 1280×720, the default's pixel settings as they are fall from
-//! 78.8 % to 64.7 % and 43.0 % (held out), and scaled with the width
-//! ([`crate::TrackerConfig::scale_pixels`]) still to 76.1 % and 63.3 % — a 3×3 Sobel on a
-//! frame four times as sharp sees edges four times as soft, and the work grows with the area.
-//! The tracker therefore works on a frame near the working width `W` (320 px by default):
+//! another size would meet those settings at another scale: on the labelled stills enlarged to
+//! 640×360 and 1280×720 (`cargo xtask resample-lanes`), the default's pixel settings used at the
+//! input's size reach 66.0 % and 43.9 % held out (TuSimple) against 78.8 % at 320×180; scaled
+//! with the width (`TrackerConfig::scale_pixels`) they still lose ground at 4× — a 3×3 Sobel on
+//! a frame four times as sharp sees edges four times as soft — and the work grows with the
+//! area. The tracker therefore works on a frame near the working width `W` (320 px by default),
+//! which reaches 79.0 % and 79.5 % there:
 //!
 //! ```text
 //! f = max(1, round(input width / W)),   working frame: ⌊w/f⌋ × ⌊h/f⌋,
