@@ -53,7 +53,10 @@ fn tracking_frame(c: &mut Criterion) {
     let cases = [
         ("udacity_320x240", udacity_frame()),
         ("synthetic_320x240", synthetic_frame(320, 240)),
+        // Wider frames are tracked on their box average near 320 px wide
+        // (`frame.working_width_px`): 640×480 at 320×240, 1280×720 at 320×180.
         ("synthetic_640x480", synthetic_frame(640, 480)),
+        ("synthetic_1280x720", synthetic_frame(1280, 720)),
     ];
     for (name, frame) in &cases {
         for (est_name, est) in [("kif", Estimator::Kif), ("wrls", Estimator::Wrls)] {

@@ -184,6 +184,17 @@ fn a_wide_frame_reports_the_working_frames_lanes_mapped_to_its_pixels() {
     assert!(compared > 40, "{compared} lanes compared");
     let (top, bottom) = small.roi_rows();
     assert_eq!(wide.roi_rows(), (f * top, f * bottom));
+    // After a reset the wide tracker hands out nothing of the last frame, as the small one.
+    wide.reset();
+    small.reset();
+    assert!(wide.init_candidates().is_empty());
+    for side in [Side::Left, Side::Right] {
+        let (vw, vs) = (wide.lane_view(side), small.lane_view(side));
+        let r = |v: &lane_tracker::LaneView<'_>| (v.report.state, v.report.coeffs, v.report.points);
+        assert_eq!(r(&vw), r(&vs));
+        assert!(vw.points.is_empty());
+        assert!(vw.spans.iter().all(|s| s.col_end_px == s.col_start_px));
+    }
 }
 
 #[test]

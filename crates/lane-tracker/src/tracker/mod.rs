@@ -703,6 +703,14 @@ impl LaneTracker {
         self.counters = TrackerCounters::default();
         self.last_failure = [None; 2];
         self.frames_since_full_gradient = 0;
+        // What the accessors hand out with a resampled input, cleared alike.
+        let s = self.scale;
+        self.out_lanes = [0, 1].map(|i| s.report_to_input(self.lanes[i].report()));
+        self.out_candidates.clear();
+        for (spans, points) in self.out_spans.iter_mut().zip(&mut self.out_points) {
+            spans.fill(ColSpan::EMPTY);
+            points.clear();
+        }
     }
 
     /// Why lane `side`'s filter last refused a prediction, an update or an initialisation (the
@@ -842,8 +850,7 @@ impl LaneTracker {
     fn publish_in_input_pixels(&mut self, mut report: TrackReport) -> TrackReport {
         let s = self.scale;
         for (out, lane) in report.lanes.iter_mut().zip(&mut self.out_lanes) {
-            out.coeffs = out.coeffs.map(|b| s.coeffs_to_input(b));
-            out.rows = out.rows.map(|r| s.to_input_px(r));
+            *out = s.report_to_input(*out);
             *lane = *out;
         }
         self.out_candidates.clear();

@@ -40,6 +40,8 @@
 use nalgebra::Matrix3;
 use vision_gradient::{ColSpan, GreyImage};
 
+use super::LaneReport;
+
 /// The integer scale between the input frame and the working frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct WorkingScale {
@@ -95,6 +97,13 @@ impl WorkingScale {
     pub(crate) fn coeffs_to_input(self, b: [f64; 3]) -> [f64; 3] {
         let a = self.coeff_map() * nalgebra::Vector3::from(b);
         [a[0], a[1], a[2] + self.offset_px()]
+    }
+
+    /// A lane's report with its coefficients and rows in input pixels.
+    pub(crate) fn report_to_input(self, mut report: LaneReport) -> LaneReport {
+        report.coeffs = report.coeffs.map(|b| self.coeffs_to_input(b));
+        report.rows = report.rows.map(|r| self.to_input_px(r));
+        report
     }
 
     /// A covariance of working-frame coefficients as one of input-pixel coefficients:
