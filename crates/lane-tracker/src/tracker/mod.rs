@@ -402,7 +402,7 @@ pub struct LaneTracker {
     /// Input pixels per working pixel (`frame.working_width_px`).
     scale: WorkingScale,
     /// The working frame's pixels, `width` a row (empty when the input is not resampled), and
-    /// the row sums of its box average.
+    /// the column sums of its box average (the input's width).
     work: Vec<u8>,
     work_sums: Vec<u32>,
     /// The working rows any stage reads, `[first, end)`: the regions searched and the Sobel's
@@ -577,7 +577,7 @@ impl LaneTracker {
             input_size,
             scale: working,
             work: vec![0; if resampled { width * height } else { 0 }],
-            work_sums: vec![0; if resampled { width } else { 0 }],
+            work_sums: vec![0; if resampled { input_size.0 } else { 0 }],
             work_rows,
             out_lanes: [empty_report, lanes[1].report()],
             out_candidates: Vec::with_capacity(if resampled {

@@ -125,40 +125,73 @@ impl WorkingScale {
     }
 
     /// Box-average rows `rows = [first, end)` of the working frame from `src` into `dst`
-    /// (`working_width` bytes a row, row `r` at `r · working_width`), summing in `acc`
-    /// (`working_width` entries). Rows outside `rows` are left as they are.
+    /// (`working_width` bytes a row, row `r` at `r · working_width`), summing the `f` input rows
+    /// of each working row column by column in `sums` (at least `f · working_width` entries;
+    /// `u32`), then each run of `f` sums. Rows outside `rows` are left as they are.
     ///
-    /// Needs `src` at least `f·working_width` wide and `f·end` high, `dst` and `acc` large
+    /// Needs `src` at least `f·working_width` wide and `f·end` high, `dst` and `sums` large
     /// enough; the tracker sizes all of them in `LaneTracker::new` and checks the frame's size
-    /// before calling.
+    /// before calling. The common factors are compiled for their constant `f` (the sums of a
+    /// run then vectorise).
     pub(crate) fn downscale_rows(
         self,
         src: &GreyImage<'_>,
         dst: &mut [u8],
         working_width: usize,
         rows: (usize, usize),
-        acc: &mut [u32],
+        sums: &mut [u32],
     ) {
-        let f = self.factor;
-        let area = (f * f) as u32;
-        let acc = &mut acc[..working_width];
-        for r in rows.0..rows.1 {
-            acc.fill(0);
-            for j in 0..f {
-                let Some(line) = src.row(f * r + j) else {
-                    continue;
-                };
-                for (a, block) in acc.iter_mut().zip(line.chunks_exact(f)) {
-                    *a += block.iter().map(|&v| u32::from(v)).sum::<u32>();
-                }
-            }
-            let Some(out) = dst.get_mut(r * working_width..(r + 1) * working_width) else {
-                return;
+        match self.factor {
+            2 => box_rows::<2>(src, dst, working_width, rows, sums),
+            3 => box_rows::<3>(src, dst, working_width, rows, sums),
+            4 => box_rows::<4>(src, dst, working_width, rows, sums),
+            5 => box_rows::<5>(src, dst, working_width, rows, sums),
+            6 => box_rows::<6>(src, dst, working_width, rows, sums),
+            f => box_rows_any(f, src, dst, working_width, rows, sums),
+        }
+    }
+}
+
+/// [`WorkingScale::downscale_rows`] for a constant factor `F` (the body inlined with `f = F`).
+fn box_rows<const F: usize>(
+    src: &GreyImage<'_>,
+    dst: &mut [u8],
+    working_width: usize,
+    rows: (usize, usize),
+    sums: &mut [u32],
+) {
+    box_rows_any(F, src, dst, working_width, rows, sums);
+}
+
+/// [`WorkingScale::downscale_rows`] for any factor `f`.
+#[inline(always)]
+fn box_rows_any(
+    f: usize,
+    src: &GreyImage<'_>,
+    dst: &mut [u8],
+    working_width: usize,
+    rows: (usize, usize),
+    sums: &mut [u32],
+) {
+    let area = (f * f) as u32;
+    let sums = &mut sums[..f * working_width];
+    for r in rows.0..rows.1 {
+        sums.fill(0);
+        for j in 0..f {
+            let Some(line) = src.row(f * r + j) else {
+                continue;
             };
-            for (o, &a) in out.iter_mut().zip(acc.iter()) {
-                // Rounded to the nearest grey level; ≤ 255 as a mean of bytes.
-                *o = ((a + area / 2) / area).min(255) as u8;
+            for (s, &v) in sums.iter_mut().zip(line) {
+                *s += u32::from(v);
             }
+        }
+        let Some(out) = dst.get_mut(r * working_width..(r + 1) * working_width) else {
+            return;
+        };
+        for (o, run) in out.iter_mut().zip(sums.chunks_exact(f)) {
+            let sum: u32 = run.iter().sum();
+            // Rounded to the nearest grey level; ≤ 255 as a mean of bytes.
+            *o = ((sum + area / 2) / area).min(255) as u8;
         }
     }
 }
@@ -256,7 +289,7 @@ mod tests {
         let src = GreyImage::new(&input, 6, 4, 6).expect("image");
         let s = WorkingScale::for_input(6, 3);
         assert_eq!(s.factor(), 2);
-        let (mut dst, mut acc) = (vec![9u8; 6], vec![0u32; 3]);
+        let (mut dst, mut acc) = (vec![9u8; 6], vec![0u32; 6]);
         s.downscale_rows(&src, &mut dst, 3, (0, 2), &mut acc);
         // (0+1+1+1)/4 = 0.75 → 1; 41/4 = 10.25 → 10; 1019/4 = 254.75 → 255;
         // 29/4 = 7.25 → 7; 1/4 → 0; 100/4 = 25.
@@ -265,6 +298,36 @@ mod tests {
         let mut dst = vec![9u8; 6];
         s.downscale_rows(&src, &mut dst, 3, (1, 2), &mut acc);
         assert_eq!(dst, vec![9, 9, 9, 7, 0, 25]);
+    }
+
+    #[test]
+    fn every_factor_gives_each_blocks_rounded_mean() {
+        // The compiled-in factors and the general path against the mean block by block, on a
+        // frame whose sides are not multiples of the factor (the remainder is not read).
+        let (w, h) = (53usize, 37usize);
+        let input: Vec<u8> = (0..w * h).map(|i| ((i * 7919 + i / w * 31) % 256) as u8).collect();
+        let src = GreyImage::new(&input, w, h, w).expect("image");
+        for f in 2..=9 {
+            let s = WorkingScale { factor: f };
+            let (ww, wh) = s.working_size(w, h);
+            let (mut dst, mut sums) = (vec![0u8; ww * wh], vec![0u32; w]);
+            s.downscale_rows(&src, &mut dst, ww, (0, wh), &mut sums);
+            for r in 0..wh {
+                for c in 0..ww {
+                    let mut sum = 0u32;
+                    for j in 0..f {
+                        for i in 0..f {
+                            sum += u32::from(input[(f * r + j) * w + f * c + i]);
+                        }
+                    }
+                    let mean = (f64::from(sum) / (f * f) as f64).round();
+                    assert!(
+                        (f64::from(dst[r * ww + c]) - mean).abs() <= 0.5,
+                        "f = {f} at ({c}, {r})"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
