@@ -365,9 +365,15 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
             }
             None => None,
         };
-        // The ceiling: a parabola fitted to the labels themselves over the default's ROI rows,
+        // The ceiling: a parabola fitted to the labels themselves over the default's ROI rows
+        // (the tracker's, in this set's pixels: a wide frame's working rows mapped back),
         // scored by the same rules (what the lane model can reach on this set).
-        let roi = configs[0].1.roi_rows(set.height);
+        let roi =
+            lane_tracker::LaneTracker::new(&configs[0].1, Estimator::Kif, set.width, set.height)
+                .with_context(|| {
+                    format!("{}: no tracker for {}×{}", set.set, set.width, set.height)
+                })?
+                .roi_rows();
         runs.push((
             CEILING_NAME.to_owned(),
             set.frames

@@ -7,7 +7,9 @@
 //! bicubic, the `image` crate) and each label point mapped by the pixel-centre rule
 //! `x' = (x + 0.5)·K − 0.5` (rows alike), then sampled again at one point per integer row
 //! (linear between neighbours; points outside the image dropped, lanes left with fewer than 2
-//! dropped). Score them with `cargo xtask eval-lanes --data target/lanes-{K}x`.
+//! dropped). Score them with `cargo xtask eval-lanes --data target/lanes-{K}x` (its
+//! `--census` reads the frames at their own size, with pixel settings meant for the working
+//! frame: read it on the sets as labelled).
 
 use std::path::{Path, PathBuf};
 
@@ -47,6 +49,12 @@ pub fn run(args: ResampleLanesArgs) -> Result<()> {
         Some(d) => d.clone(),
         None => root.join(format!("target/lanes-{}x", args.factor)),
     };
+    if std::fs::canonicalize(&out).ok() == std::fs::canonicalize(&data).ok() {
+        bail!(
+            "resample-lanes: --out {} is the data directory itself",
+            out.display()
+        );
+    }
     let mut sets = 0;
     let mut entries: Vec<_> = std::fs::read_dir(&data)
         .with_context(|| {
@@ -82,6 +90,9 @@ pub fn run(args: ResampleLanesArgs) -> Result<()> {
 
 /// One set: its frames enlarged, its labels mapped, into `out/<set name>/`.
 fn resample_set(dir: &Path, out: &Path, factor: u32) -> Result<()> {
+    // The labels checked as `eval-lanes` reads them (schema, sizes, points inside, sorted).
+    lane_eval::labelled::LabelSet::load(dir)
+        .with_context(|| format!("resample-lanes: {}", dir.display()))?;
     let name = dir
         .file_name()
         .context("a set directory without a name")?
@@ -114,6 +125,18 @@ fn resample_set(dir: &Path, out: &Path, factor: u32) -> Result<()> {
         let img = image::open(&src)
             .with_context(|| format!("cannot read {}", src.display()))?
             .to_luma8();
+        if u64::from(img.width()) * u64::from(factor) != width
+            || u64::from(img.height()) * u64::from(factor) != height
+        {
+            bail!(
+                "{}: {}×{}, the set declares {}×{}",
+                src.display(),
+                img.width(),
+                img.height(),
+                width / u64::from(factor),
+                height / u64::from(factor)
+            );
+        }
         let big = image::imageops::resize(
             &img,
             img.width() * factor,
@@ -188,7 +211,8 @@ fn resample_points(points: &[[f64; 2]], k: f64, width: f64, height: f64) -> Vec<
     {
         out.push([x, y]);
     }
-    out.retain(|&[x, y]| (0.0..width - 0.5).contains(&x) && (0.0..height).contains(&y));
+    // Inside the image as the loader has it: columns [−0.5, W), rows [0, H).
+    out.retain(|&[x, y]| (-0.5..width).contains(&x) && (0.0..height).contains(&y));
     out
 }
 
@@ -201,7 +225,12 @@ mod tests {
         // Two points a row apart at 1x become rows 0.5·2 − 0.5 = 0.5 → 2.5: rows 1 and 2.
         let p = resample_points(&[[10.0, 0.0], [12.0, 1.0]], 2.0, 640.0, 360.0);
         assert_eq!(p, vec![[20.5 + 2.0 * 0.5, 1.0], [20.5 + 2.0 * 1.5, 2.0]]);
-        // Outside the image: dropped.
+        // Outside the image: dropped (640.3 ≥ 640); a point left of column 0 but inside the
+        // image's extent (−0.4 → −0.3) kept.
         assert!(resample_points(&[[319.9, 0.0], [319.9, 1.0]], 2.0, 640.0, 360.0).is_empty());
+        assert_eq!(
+            resample_points(&[[-0.4, 0.0], [-0.4, 1.0]], 2.0, 640.0, 360.0).len(),
+            2
+        );
     }
 }

@@ -19,10 +19,21 @@ fn allocations_while_tracking(estimator: Estimator, scene: &str) -> (u64, u64) {
 }
 
 fn allocations_with(estimator: Estimator, scene: &str, cfg: &TrackerConfig) -> (u64, u64) {
+    allocations_at(estimator, scene, cfg, 320, 240)
+}
+
+/// [`allocations_with`] on frames `w × h` (wider ones are tracked on their box average).
+fn allocations_at(
+    estimator: Estimator,
+    scene: &str,
+    cfg: &TrackerConfig,
+    w: usize,
+    h: usize,
+) -> (u64, u64) {
     let spec = SCENES.iter().find(|s| s.name == scene).copied().unwrap();
     let cfg = *cfg;
-    let mut renderer = SceneRenderer::new(spec, 320, 240);
-    let mut tracker = LaneTracker::new(&cfg, estimator, 320, 240).unwrap();
+    let mut renderer = SceneRenderer::new(spec, w, h);
+    let mut tracker = LaneTracker::new(&cfg, estimator, w, h).unwrap();
     let mut frame = GreyFrame::default();
     let mut frames = 0;
     let mut allocs = 0;
@@ -112,4 +123,23 @@ fn the_counter_sees_an_allocation() {
     let (v, allocations) = allocations_in(|| Vec::<u8>::with_capacity(17));
     drop(v);
     assert_eq!(allocations, 1);
+}
+
+#[test]
+fn wide_frames_tracked_on_their_box_average_do_not_allocate() {
+    // The working resolution: the box average, the mapping of every output back to input
+    // pixels and a reset, at 1280×720 (f = 4) and at a size that is no multiple of it.
+    let cfg = TrackerConfig::default_preset().unwrap();
+    for (w, h) in [(1280, 720), (1283, 722)] {
+        for scene in ["wall_recovery", "noise"] {
+            let (allocs, frames) = allocations_at(Estimator::Kif, scene, &cfg, w, h);
+            assert!(frames > 20);
+            assert_eq!(allocs, 0, "{scene} at {w}×{h}: {allocs} allocations");
+        }
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+        let frame = GreyFrame::from_vec(w, h, vec![90; w * h]).unwrap();
+        tracker.track(&frame).unwrap();
+        let ((), n) = allocations_in(|| tracker.reset());
+        assert_eq!(n, 0, "reset at {w}×{h}");
+    }
 }

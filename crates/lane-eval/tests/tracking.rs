@@ -127,10 +127,24 @@ fn a_wide_frame_reports_the_working_frames_lanes_mapped_to_its_pixels() {
             let (a, b) = (rw.lanes[k], rs.lanes[k]);
             assert_eq!(a.state, b.state, "frame {i}");
             assert_eq!(a.points, b.points, "frame {i}");
+            for (yw, ys) in a.rows.iter().zip(b.rows) {
+                assert!((yw - (f as f64 * ys + o)).abs() < 1e-9, "frame {i}: rows");
+            }
             let (Some(_), Some(_)) = (a.coeffs, b.coeffs) else {
                 assert_eq!(a.coeffs.is_some(), b.coeffs.is_some(), "frame {i}");
                 continue;
             };
+            let (fw, fs) = (
+                wide.lane_fit_rows(side).unwrap(),
+                small.lane_fit_rows(side).unwrap(),
+            );
+            assert_eq!(fw.weights, fs.weights, "frame {i}");
+            for (yw, ys) in fw.rows_px.iter().zip(fs.rows_px) {
+                assert!(
+                    (yw - (f as f64 * ys + o)).abs() < 1e-9,
+                    "frame {i}: fit rows"
+                );
+            }
             for y_w in [150.0, 180.5, 239.0] {
                 let want = f as f64 * b.col_at_row(y_w).unwrap() + o;
                 let got = a.col_at_row(f as f64 * y_w + o).unwrap();
@@ -535,4 +549,18 @@ fn the_real_udacity_clip_as_an_mp4_keeps_both_lanes_on_every_frame() {
     let c = continuity(&run.reports, 239.0);
     assert_eq!(c.frames, 221, "{c:?}");
     assert_eq!(c.frames_both_reported, 221, "{c:?}");
+}
+
+#[test]
+fn a_short_wide_frame_keeps_a_working_frame_of_three_rows() {
+    // 1280×8: f is held to a third of the height (2: a 640×4 working frame), not 4 (640×2,
+    // too small); 1280×5 is tracked as it is. Both track a blank frame without an error.
+    let cfg = TrackerConfig::default_preset().unwrap();
+    for (h, working) in [(8, (640, 4)), (5, (1280, 5))] {
+        let mut t = LaneTracker::new(&cfg, Estimator::Kif, 1280, h).unwrap();
+        assert_eq!(t.working_size(), working);
+        let frame = GreyFrame::from_vec(1280, h, vec![100; 1280 * h]).unwrap();
+        let r = t.track(&frame).unwrap();
+        assert!(r.lanes.iter().all(|l| l.coeffs.is_none()));
+    }
 }

@@ -464,11 +464,12 @@ pub struct FilterConfig {
 
 /// The resolution the tracker works at (an addition beyond the paper, whose frames are the
 /// BT848's 320×240): every pixel-valued field of the configuration is in pixels of the
-/// **working frame**, which for an input frame wider than the working width is the input
-/// box-averaged over `f × f` pixel blocks, `f` the whole number nearest `input width /
-/// working_width_px` (module `tracker::working`). Reports stay in input pixels.
+/// **working frame**, which for an input frame at least 1.5 times the working width is the
+/// input box-averaged over `f × f` pixel blocks, `f` the whole number nearest `input width /
+/// working_width_px` and at most a third of either side (module `tracker::working`). Reports
+/// stay in input pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct FrameConfig {
     /// The working width, px: 320 (the default when absent; the presets and the default are
     /// tuned there), 16..=16384, or 0: track every frame at its own size (the paper; pixel

@@ -362,7 +362,8 @@ pub struct InitCandidate {
     /// weighed (`init.candidate_coverage`), else the Hough line itself (`a1 = 0`).
     pub coeffs: [f64; 3],
     /// Its support in the choice: the row coverage net of the clutter beside it
-    /// (`init.candidate_coverage`), else its Hough votes.
+    /// (`init.candidate_coverage`), else its Hough votes; counted in the working frame
+    /// ([`LaneTracker::working_size`]) like every count the tracker reports.
     pub support: f64,
     /// The side the choice gave it, if any. A side without an estimate, or whose competing
     /// tracked lane (re-validation on) lies off this candidate's mark, is then initialised from
@@ -409,7 +410,8 @@ pub struct LaneTracker {
     /// row beside them; only these are resampled.
     work_rows: (usize, usize),
     /// With a resampled input: the last frame's reports, candidates, windows and points in
-    /// input pixels (what the accessors hand out), refreshed at the end of every frame.
+    /// input pixels (what the accessors hand out), refreshed at the end of every frame (also
+    /// one that returned an error) and by `reset`.
     out_lanes: [LaneReport; 2],
     out_candidates: Vec<InitCandidate>,
     out_spans: [Vec<ColSpan>; 2],
@@ -493,7 +495,7 @@ impl LaneTracker {
             .into());
         }
         let input_size = (width, height);
-        let working = WorkingScale::for_input(width, cfg.frame.working_width_px);
+        let working = WorkingScale::for_input(width, height, cfg.frame.working_width_px);
         let (width, height) = working.working_size(width, height);
         if width < 3 || height < 3 {
             return Err(TrackerError::ZeroSize {
@@ -568,7 +570,6 @@ impl LaneTracker {
         } else {
             0
         };
-        let empty_report = lanes[0].report();
         Ok(LaneTracker {
             cfg: *cfg,
             estimator,
@@ -579,7 +580,7 @@ impl LaneTracker {
             work: vec![0; if resampled { width * height } else { 0 }],
             work_sums: vec![0; if resampled { input_size.0 } else { 0 }],
             work_rows,
-            out_lanes: [empty_report, lanes[1].report()],
+            out_lanes: [0, 1].map(|i| working.report_to_input(lanes[i].report())),
             out_candidates: Vec::with_capacity(if resampled {
                 4 * MAX_CANDIDATE_LINES
             } else {
@@ -731,7 +732,8 @@ impl LaneTracker {
     /// the normalised rows `u = (y − y_c)/s`, mapped by the exact linear map `T` between the
     /// normalised and the pixel coefficients (`info_filter::RowNorm`). WRLS: its `P` (a scaled
     /// inverse normal matrix) times `filter.r_sigma_px²`, the least-squares covariance for that
-    /// pixel noise. No allocation.
+    /// pixel noise. With a resampled input, mapped once more from working to input pixels
+    /// (`T_w·P·T_wᵀ`, module `working`). No allocation.
     pub fn lane_covariance_px(&self, side: Side) -> Option<Matrix3<f64>> {
         let lane = &self.lanes[side as usize];
         if !lane.has_estimate() {
@@ -840,18 +842,20 @@ impl LaneTracker {
             .map_err(TrackerError::from)
             .and_then(|image| self.track_working(&image));
         self.work = work;
-        let report = tracked?;
-        Ok(self.publish_in_input_pixels(report))
+        // Published whatever happened, so the accessors read this frame's state as they do
+        // without resampling (also after an error part-way through).
+        self.publish_in_input_pixels();
+        let mut report = tracked?;
+        report.lanes = self.out_lanes;
+        Ok(report)
     }
 
-    /// With a resampled input: the frame's reports, candidates, windows and points mapped to
-    /// input pixels (module `working`) into the buffers the accessors hand out; the report
-    /// returned likewise.
-    fn publish_in_input_pixels(&mut self, mut report: TrackReport) -> TrackReport {
+    /// With a resampled input: the lanes' reports, candidates, windows and points as they are
+    /// now, mapped to input pixels (module `working`), into the buffers the accessors hand out.
+    fn publish_in_input_pixels(&mut self) {
         let s = self.scale;
-        for (out, lane) in report.lanes.iter_mut().zip(&mut self.out_lanes) {
-            *out = s.report_to_input(*out);
-            *lane = *out;
+        for (out, lane) in self.out_lanes.iter_mut().zip(&self.lanes) {
+            *out = s.report_to_input(lane.report());
         }
         self.out_candidates.clear();
         // Within capacity: as many as `init_candidates` holds.
@@ -878,7 +882,6 @@ impl LaneTracker {
                 )
             }));
         }
-        report
     }
 
     /// [`LaneTracker::track_pixels`] on the working frame.

@@ -33,9 +33,11 @@
 //!     ⎣  o²/f   −o   f ⎦        ⎣ o ⎦
 //! ```
 //!
-//! Every report, covariance, candidate and overlay leaves the tracker in input pixels by these
-//! maps; with `f = 1` (a frame up to 1.5 W wide, or `working_width_px = 0`) nothing is
-//! resampled or mapped, and the tracker is the one it was.
+//! Every report, covariance, row profile, window, point and candidate's coefficients leave the
+//! tracker in input pixels by these maps (counts — a report's points, a candidate's support —
+//! stay counts of the working frame); with `f = 1` (a frame narrower than 1.5 W, a frame under
+//! 6 px high or wide, or `working_width_px = 0`) nothing is resampled or mapped, and the tracker
+//! is the one it was. `f` is at most a third of either side, so a working frame keeps 3 × 3 px.
 
 use nalgebra::Matrix3;
 use vision_gradient::{ColSpan, GreyImage};
@@ -50,13 +52,22 @@ pub(crate) struct WorkingScale {
 }
 
 impl WorkingScale {
-    /// The scale for frames `input_width_px` wide at working width `working_width_px` (0: none).
-    pub(crate) fn for_input(input_width_px: usize, working_width_px: usize) -> Self {
+    /// The scale for `input_width_px × input_height_px` frames at working width
+    /// `working_width_px` (0: none): the whole number nearest the width over the working width
+    /// (half up: 480 px at 320 → 2, 479 px → 1), at most a third of either side (a working
+    /// frame keeps 3 × 3 px: a 1280 × 8 strip is tracked at 640 × 4), at least 1.
+    pub(crate) fn for_input(
+        input_width_px: usize,
+        input_height_px: usize,
+        working_width_px: usize,
+    ) -> Self {
         let factor = if working_width_px == 0 {
             1
         } else {
-            // Round half up: 480 px at 320 → 2, 400 px → 1.
-            ((2 * input_width_px + working_width_px) / (2 * working_width_px)).max(1)
+            ((2 * input_width_px + working_width_px) / (2 * working_width_px))
+                .min(input_width_px / 3)
+                .min(input_height_px / 3)
+                .max(1)
         };
         WorkingScale { factor }
     }
@@ -206,7 +217,7 @@ mod tests {
 
     #[test]
     fn the_factor_is_the_nearest_whole_ratio_and_never_below_one() {
-        let f = |w, ww| WorkingScale::for_input(w, ww).factor();
+        let f = |w, ww| WorkingScale::for_input(w, 720, ww).factor();
         assert_eq!(f(320, 320), 1);
         assert_eq!(f(479, 320), 1);
         assert_eq!(f(480, 320), 2);
@@ -215,6 +226,12 @@ mod tests {
         assert_eq!(f(1640, 320), 5);
         assert_eq!(f(160, 320), 1);
         assert_eq!(f(1280, 0), 1);
+        // A short frame keeps a working frame of 3 rows at least.
+        let short = |h| WorkingScale::for_input(1280, h, 320);
+        assert_eq!(short(5).factor(), 1);
+        assert_eq!(short(8).factor(), 2);
+        assert_eq!(short(8).working_size(1280, 8), (640, 4));
+        assert_eq!(short(12).factor(), 4);
     }
 
     #[test]
@@ -287,7 +304,7 @@ mod tests {
             7, 8, 0, 1, 0, 0, //
         ];
         let src = GreyImage::new(&input, 6, 4, 6).expect("image");
-        let s = WorkingScale::for_input(6, 3);
+        let s = WorkingScale::for_input(6, 6, 3);
         assert_eq!(s.factor(), 2);
         let (mut dst, mut acc) = (vec![9u8; 6], vec![0u32; 6]);
         s.downscale_rows(&src, &mut dst, 3, (0, 2), &mut acc);
@@ -305,7 +322,9 @@ mod tests {
         // The compiled-in factors and the general path against the mean block by block, on a
         // frame whose sides are not multiples of the factor (the remainder is not read).
         let (w, h) = (53usize, 37usize);
-        let input: Vec<u8> = (0..w * h).map(|i| ((i * 7919 + i / w * 31) % 256) as u8).collect();
+        let input: Vec<u8> = (0..w * h)
+            .map(|i| ((i * 7919 + i / w * 31) % 256) as u8)
+            .collect();
         let src = GreyImage::new(&input, w, h, w).expect("image");
         for f in 2..=9 {
             let s = WorkingScale { factor: f };
