@@ -177,11 +177,10 @@ fn resample_set(dir: &Path, out: &Path, factor: u32) -> Result<()> {
     let json = serde_json::to_string(&labels)?;
     std::fs::write(set_out.join("labels.json"), json)
         .with_context(|| format!("cannot write {}", set_out.join("labels.json").display()))?;
-    for extra in ["SOURCE.md"] {
-        if dir.join(extra).is_file() {
-            std::fs::copy(dir.join(extra), set_out.join(extra))
-                .with_context(|| format!("cannot copy {}", dir.join(extra).display()))?;
-        }
+    let source = dir.join("SOURCE.md");
+    if source.is_file() {
+        std::fs::copy(&source, set_out.join("SOURCE.md"))
+            .with_context(|| format!("cannot copy {}", source.display()))?;
     }
     Ok(())
 }

@@ -704,13 +704,9 @@ impl LaneTracker {
         self.counters = TrackerCounters::default();
         self.last_failure = [None; 2];
         self.frames_since_full_gradient = 0;
-        // What the accessors hand out with a resampled input, cleared alike.
-        let s = self.scale;
-        self.out_lanes = [0, 1].map(|i| s.report_to_input(self.lanes[i].report()));
-        self.out_candidates.clear();
-        for (spans, points) in self.out_spans.iter_mut().zip(&mut self.out_points) {
-            spans.fill(ColSpan::EMPTY);
-            points.clear();
+        // What the accessors hand out with a resampled input: the cleared lanes, mapped.
+        if self.scale.resamples() {
+            self.publish_in_input_pixels();
         }
     }
 
@@ -826,7 +822,7 @@ impl LaneTracker {
         }
         let input = GreyImage::new(data, width, height, stride_px)?;
         if !self.scale.resamples() {
-            return self.track_working(&input);
+            return self.track_working(input);
         }
         // The working frame (module `working`), in a buffer taken out of `self` for the
         // frame (no allocation: `take` leaves an empty vector) and put back whatever happens.
@@ -840,7 +836,7 @@ impl LaneTracker {
         );
         let tracked = GreyImage::new(&work, self.width, self.height, self.width)
             .map_err(TrackerError::from)
-            .and_then(|image| self.track_working(&image));
+            .and_then(|image| self.track_working(image));
         self.work = work;
         // Published whatever happened, so the accessors read this frame's state as they do
         // without resampling (also after an error part-way through).
@@ -885,8 +881,7 @@ impl LaneTracker {
     }
 
     /// [`LaneTracker::track_pixels`] on the working frame.
-    fn track_working(&mut self, image: &GreyImage<'_>) -> Result<TrackReport, TrackerError> {
-        let image = *image;
+    fn track_working(&mut self, image: GreyImage<'_>) -> Result<TrackReport, TrackerError> {
         self.counters.frames += 1;
         self.init_candidates.clear();
         for i in 0..2 {
