@@ -7,9 +7,8 @@
 //! bicubic, the `image` crate) and each label point mapped by the pixel-centre rule
 //! `x' = (x + 0.5)·K − 0.5` (rows alike), then sampled again at one point per integer row
 //! (linear between neighbours; points outside the image dropped, lanes left with fewer than 2
-//! dropped). Score them with `cargo xtask eval-lanes --data target/lanes-{K}x` (its
-//! `--census` reads the frames at their own size, with pixel settings meant for the working
-//! frame: read it on the sets as labelled).
+//! dropped). Score them with `cargo xtask eval-lanes --data target/lanes-{K}x` (`--census`
+//! too: it reads the edges on the tracker's working frame, as the stages do).
 
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,8 @@
 //! tracked mark is matched, a label where no mark is has no candidate and no edge near it, a
 //! label a little beside a mark has no candidate but an edge near it, a label on a mark the
 //! ego-pair choice passed over is "not chosen", a lane tracked from the previous frame is not
-//! classified.
+//! classified. A frame four times as large (each pixel repeated 4 × 4, the labels mapped) is
+//! classified as its working frame is: the same counts.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -35,57 +36,58 @@ fn marks(curves: &[fn(f64) -> f64]) -> image::GrayImage {
     })
 }
 
-/// A label lane along `f` from row 100 down, one point per row.
-fn label(side: &str, f: fn(f64) -> f64) -> String {
+/// A label lane along `f` from row 100 down, one point per row, in the pixels of the frame
+/// enlarged `scale` times (working pixel `c` centred on `scale·c + (scale − 1)/2`).
+fn label(side: &str, f: fn(f64) -> f64, scale: u32) -> String {
+    let (k, o) = (f64::from(scale), 0.5 * f64::from(scale - 1));
     let pts: Vec<String> = (100..H)
-        .map(|y| format!("[{:.2}, {y}]", f(y as f64)))
+        .map(|y| format!("[{:.3}, {:.3}]", k * f(y as f64) + o, k * y as f64 + o))
         .collect();
     format!(r#"{{"side": "{side}", "points": [{}]}}"#, pts.join(", "))
 }
 
-#[test]
-fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
-    let dir: PathBuf = std::env::temp_dir().join(format!("ita-nav-census-{}", std::process::id()));
+/// A scene: the curves marked, and the left and right labels' sides and curves.
+type Scene<'a> = (&'a [Curve], [(&'a str, Curve); 2]);
+type Curve = fn(f64) -> f64;
+
+/// Writes the census scenes (the frames of [`every_scored_label_lane_is_put_in_the_stage_where_it_is_lost`],
+/// each pixel repeated `scale × scale` times, the labels mapped) into a fresh directory.
+/// `tag` names the directory apart from another test's.
+fn write_scenes(tag: &str, scale: u32) -> (PathBuf, LabelSet) {
+    let dir: PathBuf = std::env::temp_dir().join(format!(
+        "ita-nav-census-{}-{tag}-{scale}x",
+        std::process::id()
+    ));
     std::fs::create_dir_all(dir.join("frames")).unwrap();
     // Frame 0: labels on the two marks. Frame 1: the right label 40 px right of any mark.
     // Frame 2: a neighbour's mark too, and the right label on it. Frames 3 and 4: one clip of
     // two frames with the labels on the marks (the second frame is tracked, not initialised).
-    // Frame 5: the right label 9 px right of the mark's centre line (its edge 6.5 px away:
-    // beyond the TuSimple tolerance of 5 / cos(atan 0.6) = 5.8 px, within the census's
-    // 5 + 16/2 = 13 px of an edge: the default's stripe width).
+    // Frames 5 and 6: the right label 9 and 12 px right of the mark's centre line (its edge
+    // 6.5 and 9.5 px away: beyond the TuSimple tolerance of 5 / cos(atan 0.6) = 5.8 px, within
+    // the census's 5 + 16/2 = 13 px of an edge: the default's stripe width; at 4 × in input
+    // pixels, 20 + 8 = 28 px would not reach frame 6's edge, 38 px away).
     let shifted: fn(f64) -> f64 = |y| right(y) + 40.0;
     let beside: fn(f64) -> f64 = |y| right(y) + 9.0;
-    let frames = [
-        (
-            marks(&[left, right]),
-            [label("left", left), label("right", right)],
-        ),
-        (
-            marks(&[left, right]),
-            [label("left", left), label("right", shifted)],
-        ),
-        (
-            marks(&[left, right, outer]),
-            [label("left", left), label("right", outer)],
-        ),
-        (
-            marks(&[left, right]),
-            [label("left", left), label("right", right)],
-        ),
-        (
-            marks(&[left, right]),
-            [label("left", left), label("right", right)],
-        ),
-        (
-            marks(&[left, right]),
-            [label("left", left), label("right", beside)],
-        ),
+    let farther: fn(f64) -> f64 = |y| right(y) + 12.0;
+    let frames: [Scene; 7] = [
+        (&[left, right], [("left", left), ("right", right)]),
+        (&[left, right], [("left", left), ("right", shifted)]),
+        (&[left, right, outer], [("left", left), ("right", outer)]),
+        (&[left, right], [("left", left), ("right", right)]),
+        (&[left, right], [("left", left), ("right", right)]),
+        (&[left, right], [("left", left), ("right", beside)]),
+        (&[left, right], [("left", left), ("right", farther)]),
     ];
-    let clips = [0, 1, 2, 3, 3, 5];
+    let clips = [0, 1, 2, 3, 3, 5, 6];
     let mut entries = Vec::new();
-    for (i, (img, lanes)) in frames.iter().enumerate() {
+    for (i, (curves, lanes)) in frames.iter().enumerate() {
         let file = format!("frames/{i:04}.png");
+        let small = marks(curves);
+        let img = image::GrayImage::from_fn(W as u32 * scale, H as u32 * scale, |x, y| {
+            *small.get_pixel(x / scale, y / scale)
+        });
         img.save(dir.join(&file)).unwrap();
+        let lanes = lanes.map(|(side, f)| label(side, f, scale));
         entries.push(format!(
             r#"{{"index": {i}, "file": "{file}", "clip": "c{}", "lanes": [{}]}}"#,
             clips[i],
@@ -94,11 +96,19 @@ fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
     }
     let json = format!(
         r#"{{"schema": 1, "set": "census", "kind": "road", "source": "rendered by the test",
-            "licence": "none", "width": {W}, "height": {H}, "frames": [{}]}}"#,
+            "licence": "none", "width": {}, "height": {}, "frames": [{}]}}"#,
+        W as u32 * scale,
+        H as u32 * scale,
         entries.join(", ")
     );
     std::fs::write(dir.join("labels.json"), json).unwrap();
     let set = LabelSet::load(&dir).unwrap();
+    (dir, set)
+}
+
+#[test]
+fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
+    let (dir, set) = write_scenes("stages", 1);
     let cfg = TrackerConfig::default_preset().unwrap();
     let rules = ScoringRules::default();
     let census = |frames| census_set(&dir, &set, &cfg, Estimator::Kif, frames, &rules).unwrap();
@@ -124,14 +134,40 @@ fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
     let clip = census(3..5);
     assert_eq!(clip, counts(2, 0, 0, 0, 2));
     // Beside the mark: no candidate, but the mark's edge is near the label.
-    let off = census(5..6);
-    assert_eq!(off, counts(1, 1, 0, 0, 0));
+    let off = census(5..7);
+    assert_eq!(
+        off,
+        StageCensus {
+            label_lanes: 4,
+            ..counts(2, 2, 0, 0, 0)
+        }
+    );
     // Ranges of separate clips add up.
-    let all = census(0..6);
+    let all = census(0..7);
     let mut sum = StageCensus::default();
     for c in [first, nowhere, passed_over, clip, off] {
         sum.add(&c);
     }
     assert_eq!(all, sum);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_frame_four_times_as_large_is_classified_as_its_working_frame() {
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let rules = ScoringRules::default();
+    let (small_dir, small) = write_scenes("large", 1);
+    let (large_dir, large) = write_scenes("large", 4);
+    for frames in [0..1, 1..2, 2..3, 3..5, 5..6, 6..7] {
+        let at = |dir: &PathBuf, set: &LabelSet| {
+            census_set(dir, set, &cfg, Estimator::Kif, frames.clone(), &rules).unwrap()
+        };
+        assert_eq!(
+            at(&large_dir, &large),
+            at(&small_dir, &small),
+            "frames {frames:?}"
+        );
+    }
+    std::fs::remove_dir_all(&small_dir).unwrap();
+    std::fs::remove_dir_all(&large_dir).unwrap();
 }

@@ -116,13 +116,21 @@ fn a_wide_frame_reports_the_working_frames_lanes_mapped_to_its_pixels() {
     let mut wide = LaneTracker::new(&cfg, Estimator::Kif, 1280, 960).unwrap();
     let mut small = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
     assert_eq!(wide.working_size(), (320, 240));
+    assert_eq!(wide.working_factor(), f);
     assert_eq!(wide.frame_size(), (1280, 960));
     let mut frame = GreyFrame::default();
     let mut compared = 0;
     for i in 0..spec.frames.min(40) {
         renderer.render(i, &mut frame);
         let rw = wide.track(&frame).unwrap();
-        let rs = small.track(&box_average(&frame, f)).unwrap();
+        let averaged = box_average(&frame, f);
+        let rs = small.track(&averaged).unwrap();
+        // What the stages read: the box average on the rows they read.
+        let (work, (first, end)) = wide.working_frame().unwrap();
+        assert!(first < end && end <= 240, "frame {i}: rows {first}..{end}");
+        for r in first..end {
+            assert_eq!(work.row(r), averaged.row(r), "frame {i}: working row {r}");
+        }
         for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
             let (a, b) = (rw.lanes[k], rs.lanes[k]);
             assert_eq!(a.state, b.state, "frame {i}");
@@ -221,6 +229,8 @@ fn working_width_zero_tracks_at_the_input_size_with_scaled_pixels() {
     cfg.scale_pixels(2.0);
     let tracker = LaneTracker::new(&cfg, Estimator::Kif, 640, 480).unwrap();
     assert_eq!(tracker.working_size(), (640, 480));
+    assert_eq!(tracker.working_factor(), 1);
+    assert!(tracker.working_frame().is_none());
     let (reports, truth) = run_scene_with(spec, &cfg, Estimator::Kif, 640, 480);
     let s = score_sequence(&truth, &reports);
     assert!(s.accuracy >= 0.98, "{s:?}");

@@ -307,7 +307,9 @@
 //! target/lanes-2x`): held out 79.0 % and 79.5 % (TuSimple) against 78.8 % at 320×180, where
 //! the same pixel settings used at the input's size reach 66.0 % and 43.9 %; and the work per
 //! frame stays that of a 320-px frame plus the box average. `working_width_px = 0` tracks every
-//! frame at its own size (the paper).
+//! frame at its own size (the paper). [`LaneTracker::working_factor`] gives `f` and
+//! [`LaneTracker::working_frame`] the last frame's working pixels, for diagnostics that must
+//! read the frame as the stages do (`lane_eval::labelled::census_set`).
 //!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field

@@ -21,6 +21,10 @@
 //! before stripe pairing; [`lane_tracker::GradientConfig::params`]) keep an edge pixel within
 //! `r = t + gradient.stripe_max_width_px / 2` columns of the point, `t` the TuSimple tolerance at
 //! this width (the edges of a mark up to a stripe width wide centred within `t` of the label).
+//! The edges are read where the stages read them, on the tracker's working frame
+//! ([`lane_tracker::LaneTracker::working_frame`]: a wide input's box average), the label's
+//! points and `t` mapped into its pixels (input `x` is working `(x − (f − 1)/2)/f`), so a set
+//! enlarged `f` times is classified as the working frame is.
 //! No mark detector fits a lane there: the label runs where the image shows nothing this
 //! detector keeps (a lane boundary without paint, a mark worn away, hidden, or outside the
 //! edge-angle band). It is a lower bound of such labels: clutter near a label counts as an edge.
@@ -33,7 +37,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use lane_tracker::{Estimator, GreyFrame, Side, TrackerConfig};
+use lane_tracker::{Estimator, LaneTracker, Side, TrackerConfig};
 use vision_gradient::{EdgeBuffer, GradientDetector, GreyImage, Region};
 
 use super::{
@@ -97,12 +101,21 @@ pub fn census_set(
     let y_top = rules.eval_top_fraction * set.height as f64;
     let tus_px = rules.tusimple_px_at_1280 * set.width as f64 / 1280.0;
     let joint = cfg.init.candidate_lines > 0;
-    let (roi_top, roi_bottom) = cfg.roi_rows(set.height);
-    let reach_px = tus_px + 0.5 * f64::from(cfg.gradient.stripe_max_width_px);
+    // The edges are read where the tracker's stages read them: on its working frame (a wide
+    // input's box average, `frame.working_width_px`), whose pixels the configuration's are.
+    let (working_w, working_h, factor) = {
+        let probe = LaneTracker::new(cfg, estimator, set.width, set.height)?;
+        let (w, h) = probe.working_size();
+        (w, h, probe.working_factor() as f64)
+    };
+    let (roi_top, roi_bottom) = cfg.roi_rows(working_h);
+    let reach_px = tus_px / factor + 0.5 * f64::from(cfg.gradient.stripe_max_width_px);
+    // Input pixel `x` is working pixel `(x − (f − 1)/2) / f`.
+    let to_working = |v: f64| (v - 0.5 * (factor - 1.0)) / factor;
     let detector = GradientDetector::new(cfg.gradient.params())?;
-    let mut edges = EdgeBuffer::with_capacity(set.width * (roi_bottom - roi_top));
-    // Per ROI pixel: does the gradient stage keep an edge there.
-    let mut edge_at = vec![false; set.width * (roi_bottom - roi_top)];
+    let mut edges = EdgeBuffer::with_capacity(working_w * (roi_bottom - roi_top));
+    // Per working ROI pixel: does the gradient stage keep an edge there.
+    let mut edge_at = vec![false; working_w * (roi_bottom - roi_top)];
     run_label_set(
         dir,
         set,
@@ -153,9 +166,16 @@ pub fn census_set(
                 } else {
                     census.no_candidate += 1;
                     if !edges_read {
+                        let image = match tracker.working_frame() {
+                            Some((image, _)) => image,
+                            None => {
+                                let (w, h) = (frame.width(), frame.height());
+                                GreyImage::new(frame.data(), w, h, w)?
+                            }
+                        };
                         mark_edges(
                             &detector,
-                            frame,
+                            &image,
                             (roi_top, roi_bottom),
                             &mut edges,
                             &mut edge_at,
@@ -164,10 +184,11 @@ pub fn census_set(
                     }
                     let (mut in_roi, mut with_edge) = (0usize, 0usize);
                     for &[x, y] in &pts {
+                        let (x, y) = (to_working(x), to_working(y));
                         let row = y.round();
                         if row >= roi_top as f64 && row < roi_bottom as f64 {
                             in_roi += 1;
-                            let near = edge_near(&edge_at, set.width, roi_top, (x, y), reach_px);
+                            let near = edge_near(&edge_at, working_w, roi_top, (x, y), reach_px);
                             with_edge += usize::from(near);
                         }
                     }
@@ -183,18 +204,17 @@ pub fn census_set(
 }
 
 /// `edge_at[(r − top)·W + c]` = the gradient stage keeps an edge pixel at row `r`, column `c`
-/// of `frame`, for the rows `[top, bottom)`.
+/// of `image`, for the rows `[top, bottom)`.
 fn mark_edges(
     detector: &GradientDetector,
-    frame: &GreyFrame,
+    image: &GreyImage<'_>,
     (top, bottom): (usize, usize),
     edges: &mut EdgeBuffer,
     edge_at: &mut [bool],
 ) -> Result<(), EvalError> {
-    let (w, h) = (frame.width(), frame.height());
-    let image = GreyImage::new(frame.data(), w, h, w)?;
+    let w = image.width();
     detector.detect(
-        &image,
+        image,
         Region::Rows {
             row_start_px: top,
             row_end_px: bottom,

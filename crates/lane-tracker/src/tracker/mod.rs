@@ -643,6 +643,27 @@ impl LaneTracker {
         (self.width, self.height)
     }
 
+    /// Input pixels per working pixel along each axis (`f ≥ 1`; module `tracker::working`):
+    /// working pixel `c'` is the mean of input pixels `f·c' … f·c' + f − 1`, centred on input
+    /// `x = f·c' + (f − 1)/2`. 1 when the stages work on the input itself.
+    pub fn working_factor(&self) -> usize {
+        self.scale.factor()
+    }
+
+    /// What the stages read of the last frame, when the input is resampled (`f > 1`): the
+    /// working frame ([`LaneTracker::working_size`]) and the rows `[first, end)` of it that are
+    /// written — the rows any stage reads (the ROI, the second search's rows, a row beside
+    /// them for the Sobel); the other rows are not (zero). All zero before the first frame.
+    /// `None` with `f = 1`: the stages read the input frame as it is. For diagnostics on the
+    /// working frame (`lane_eval::labelled::census_set`); no copy.
+    pub fn working_frame(&self) -> Option<(GreyImage<'_>, (usize, usize))> {
+        if !self.scale.resamples() {
+            return None;
+        }
+        let image = GreyImage::new(&self.work, self.width, self.height, self.width).ok()?;
+        Some((image, self.work_rows))
+    }
+
     /// The rows lane `i` is refined, tracked and its kerb read over: the second search's taller
     /// rows for a lane it found (`Lane::tracked_tall`), else the ROI's.
     fn rows_of(&self, i: usize) -> (usize, usize) {
