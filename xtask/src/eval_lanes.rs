@@ -22,7 +22,8 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use lane_eval::labelled::{
     EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, NEAR_MISS_FRACTION,
-    ScoringRules, StageCensus, ceiling_prediction, census_set, score_frame, track_label_set,
+    ScoringRules, StageCensus, ceiling_prediction, census_set, choice_bound_set, score_frame,
+    track_label_set,
 };
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
@@ -80,6 +81,9 @@ const FLOOR_MARGIN: f64 = 0.03;
 const DEFAULT_NAME: &str = "default";
 /// Name of the ceiling (parabolas fitted to the labels over the ROI rows) in the reports.
 const CEILING_NAME: &str = "ceiling";
+/// Name of the bound of the default's choice (`lane_eval::labelled::choice_bound_set`: per
+/// side, the best of its output and its Hough candidates, picked by the labels).
+const CHOICE_BOUND_NAME: &str = "best-of-candidates";
 /// What the OpenCV peer's virtual environment (`target/opencv-venv`) holds, from PyPI.
 const PEER_REQUIREMENTS: &[&str] = &["opencv-python-headless<5", "numpy"];
 /// Name of the OpenCV peer in the reports.
@@ -374,6 +378,13 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
                     format!("{}: no tracker for {}×{}", set.set, set.width, set.height)
                 })?
                 .roi_rows();
+        // What a perfect choice among the default's own candidates would reach (the labels
+        // pick): tells the choice's losses from the detection's.
+        runs.push((
+            CHOICE_BOUND_NAME.to_owned(),
+            choice_bound_set(dir, set, &configs[0].1, Estimator::Kif, &rules)
+                .with_context(|| format!("choice bound of set {}", set.set))?,
+        ));
         runs.push((
             CEILING_NAME.to_owned(),
             set.frames

@@ -49,7 +49,7 @@ enum Cmd {
     /// Run the lane tracker over every fixture and compare with the recorded expectations.
     Regress(regress::RegressArgs),
     /// Score the lane tracker on the real labelled sets (--data, default ../shared/data/lanes),
-    /// beside the ceiling, the presets and the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
+    /// beside the ceiling, the best of the default's candidates, the presets and the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
     EvalLanes(eval_lanes::EvalLanesArgs),
     /// Write the labelled sets enlarged K times (frames bicubic, labels mapped) into
     /// target/lanes-{K}x, for `eval-lanes --data` at another resolution.

@@ -2,14 +2,17 @@
 //! tracked mark is matched, a label where no mark is has no candidate and no edge near it, a
 //! label a little beside a mark has no candidate but an edge near it, a label on a mark the
 //! ego-pair choice passed over is "not chosen", a lane tracked from the previous frame is not
-//! classified. A frame four times as large (each pixel repeated 4 × 4, the labels mapped) is
+//! classified. The choice's bound takes a candidate only where it beats the output against the
+//! labels. A frame four times as large (each pixel repeated 4 × 4, the labels mapped) is
 //! classified as its working frame is: the same counts.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::PathBuf;
 
-use lane_eval::labelled::{LabelSet, ScoringRules, StageCensus, census_set};
+use lane_eval::labelled::{
+    LabelSet, ScoringRules, StageCensus, census_set, choice_bound_set, score_frame, track_label_set,
+};
 use lane_tracker::{Estimator, TrackerConfig};
 
 const W: usize = 320;
@@ -170,4 +173,33 @@ fn a_frame_four_times_as_large_is_classified_as_its_working_frame() {
     }
     std::fs::remove_dir_all(&small_dir).unwrap();
     std::fs::remove_dir_all(&large_dir).unwrap();
+}
+
+#[test]
+fn the_choice_bound_takes_a_candidate_only_where_it_beats_the_output() {
+    let (dir, set) = write_scenes("bound", 1);
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let rules = ScoringRules::default();
+    let output = track_label_set(&dir, &set, &cfg, Estimator::Kif).unwrap();
+    let bound = choice_bound_set(&dir, &set, &cfg, Estimator::Kif, &rules).unwrap();
+    assert_eq!(bound.len(), set.frames.len());
+    let score = |i: usize, p| score_frame(&set.frames[i], W, H, p, &rules);
+    for i in 0..set.frames.len() {
+        let (o, b) = (score(i, &output[i]), score(i, &bound[i]));
+        assert_eq!(o.label_lanes, b.label_lanes, "frame {i}");
+        assert!(
+            b.tusimple_acc_sum >= o.tusimple_acc_sum,
+            "frame {i}: {b:?} below {o:?}"
+        );
+    }
+    // Both output lanes on their labels: the output itself.
+    assert_eq!(bound[0], output[0]);
+    // The right label on the neighbour's mark, which the choice passed over: the bound takes
+    // that candidate (matched), the left lane stays the output's.
+    let (o, b) = (score(2, &output[2]), score(2, &bound[2]));
+    assert_eq!((o.tusimple_matched, b.tusimple_matched), (1, 2));
+    assert_eq!(bound[2][0], output[2][0]);
+    // The right label 40 px from any mark: no candidate comes near it, the output stays.
+    assert_eq!(bound[1], output[1]);
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -664,7 +664,9 @@ fn fit_slope(pts: &[[f64; 2]]) -> f64 {
 }
 
 mod census;
+mod choice_bound;
 #[cfg(test)]
 mod tests;
 
 pub use census::{StageCensus, census_set};
+pub use choice_bound::choice_bound_set;
