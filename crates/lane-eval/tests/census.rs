@@ -3,7 +3,7 @@
 //! label a little beside a mark has no candidate but an edge near it, a label on a mark the
 //! ego-pair choice passed over is "not chosen", a lane tracked from the previous frame is not
 //! classified. The choice's bound takes a candidate only where it beats the output against the
-//! labels. A frame four times as large (each pixel repeated 4 × 4, the labels mapped) is
+//! labels, and its abstaining form drops a far lane. A frame four times as large (each pixel repeated 4 × 4, the labels mapped) is
 //! classified as its working frame is: the same counts.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -180,8 +180,11 @@ fn the_choice_bound_takes_a_candidate_only_where_it_beats_the_output() {
     let (dir, set) = write_scenes("bound", 1);
     let cfg = TrackerConfig::default_preset().unwrap();
     let rules = ScoringRules::default();
+    let run = choice_bound_set(&dir, &set, &cfg, Estimator::Kif, &rules).unwrap();
+    // The same run as the tracker's own.
     let output = track_label_set(&dir, &set, &cfg, Estimator::Kif).unwrap();
-    let bound = choice_bound_set(&dir, &set, &cfg, Estimator::Kif, &rules).unwrap();
+    assert_eq!(run.output, output);
+    let bound = &run.best;
     assert_eq!(bound.len(), set.frames.len());
     let score = |i: usize, p| score_frame(&set.frames[i], W, H, p, &rules);
     for i in 0..set.frames.len() {
@@ -201,5 +204,12 @@ fn the_choice_bound_takes_a_candidate_only_where_it_beats_the_output() {
     assert_eq!(bound[2][0], output[2][0]);
     // The right label 40 px from any mark: no candidate comes near it, the output stays.
     assert_eq!(bound[1], output[1]);
+    // Best or none: the far right lane of frame 1 (no label point within the tolerance) is not
+    // reported; where the best lane matches, it is the best.
+    assert!(bound[1][1].is_some());
+    assert_eq!(run.best_or_none[1], [bound[1][0], None]);
+    for i in [0, 2] {
+        assert_eq!(run.best_or_none[i], bound[i], "frame {i}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -669,4 +669,4 @@ mod choice_bound;
 mod tests;
 
 pub use census::{StageCensus, census_set};
-pub use choice_bound::choice_bound_set;
+pub use choice_bound::{ChoiceBound, choice_bound_set};
