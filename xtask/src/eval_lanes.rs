@@ -10,8 +10,10 @@
 //! leaves it out). The default's false positives are also split by what they lie on
 //! (`lane_eval::labelled::FalsePositives`: a side without a label, another labelled marking, a
 //! near miss, the rest). Writes
-//! `summary.md`, `summary.json` and `worst_frames.png` (the worst frames of the default run:
-//! labels green, nav-app red, the OpenCV peer blue). `--check` compares the default's figures with
+//! `summary.md`, `summary.json`, `worst_frames.png` (the worst frames of the default run:
+//! labels green, nav-app red, the OpenCV peer blue) and `frames.csv` (the default run's outcome
+//! per scored ego side of every frame, `lane_eval::labelled::score_side`; with `--dev-only` the
+//! only file written, and of the development part alone). `--check` compares the default's figures with
 //! the floors in `fixtures/expectations-lanes-real.json` and fails below them; `--record` writes
 //! them (measured accuracy − 3 points, measured false positives + 3 points).
 
@@ -23,7 +25,7 @@ use anyhow::{Context, Result, bail};
 use lane_eval::labelled::{
     EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, NEAR_MISS_FRACTION,
     ScoringRules, StageCensus, ceiling_prediction, census_set, choice_bound_set, score_frame,
-    track_label_set,
+    score_side, track_label_set,
 };
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
@@ -51,7 +53,8 @@ pub struct EvalLanesArgs {
     /// Record the floors from this run (default configuration, all frames).
     #[arg(long)]
     record: bool,
-    /// Print and write the development part only (what tuning may look at).
+    /// Print the development part only and write only its `frames.csv` (what tuning may look
+    /// at).
     #[arg(long)]
     dev_only: bool,
     /// Do not run the OpenCV peer even if its venv exists.
@@ -220,6 +223,73 @@ fn dev_count(n: usize) -> usize {
     (DEV_FRACTION * n as f64).ceil() as usize
 }
 
+/// Header of `frames.csv` (one row per scored ego side of every frame, default configuration).
+const FRAMES_CSV_HEADER: &str = "set,file,split,side,label,predicted,tusimple_accuracy,\
+tusimple_matched,aly_matched,false_positive,mean_abs_error_px\n";
+
+/// The `frames.csv` rows of one frame's prediction `p`: one per ego side that the scorer scores
+/// (`lane_eval::labelled::score_side`: a label lane in the scored rows, or a prediction on a
+/// side without one); empty fields where there is no label lane (accuracy, matches) or no
+/// prediction (error); `false_positive` names the kind of an unmatched prediction
+/// (`lane_eval::labelled::FalsePositives`), empty otherwise.
+fn side_rows(
+    set: &LabelSet,
+    f: &LabelFrame,
+    dev: bool,
+    p: &EgoPrediction,
+    rules: &ScoringRules,
+) -> String {
+    let mut rows = String::new();
+    for (k, (side, name)) in [(LabelSide::Left, "left"), (LabelSide::Right, "right")]
+        .into_iter()
+        .enumerate()
+    {
+        let t = score_side(f, set.width, set.height, side, p[k], rules);
+        if t.label_lanes + t.predicted_lanes == 0 {
+            continue;
+        }
+        let fp = &t.false_positives;
+        let kind = [
+            (fp.unlabelled_side, "unlabelled_side"),
+            (fp.other_marking, "other_marking"),
+            (fp.near, "near"),
+            (fp.far, "far"),
+        ]
+        .into_iter()
+        .find(|(n, _)| *n > 0)
+        .map_or("", |(_, kind)| kind);
+        let labelled = t.label_lanes > 0;
+        let on_label = |v: String| if labelled { v } else { String::new() };
+        let error = if t.abs_err_points > 0 {
+            format!("{:.2}", t.abs_err_sum_px / t.abs_err_points as f64)
+        } else {
+            String::new()
+        };
+        rows += &format!(
+            "{},{},{},{name},{},{},{},{},{},{kind},{error}\n",
+            csv_field(&set.set),
+            csv_field(&f.file),
+            if dev { "dev" } else { "hold-out" },
+            u8::from(labelled),
+            t.predicted_lanes,
+            on_label(format!("{:.4}", t.tusimple_acc_sum)),
+            on_label(t.tusimple_matched.to_string()),
+            on_label(t.aly_matched.to_string()),
+        );
+    }
+    rows
+}
+
+/// `v` as one CSV field (RFC 4180): quoted, with its quotes doubled, when it holds a comma, a
+/// quote or a line break.
+fn csv_field(v: &str) -> std::borrow::Cow<'_, str> {
+    if v.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", v.replace('"', "\"\"")).into()
+    } else {
+        v.into()
+    }
+}
+
 /// A scored frame of the default run, for the contact sheet.
 struct FrameRank {
     set: usize,
@@ -340,6 +410,7 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
     let mut overall: BTreeMap<String, SplitTotals> = BTreeMap::new();
     let mut ranks = Vec::new();
     let mut drawn: Vec<(Vec<EgoPrediction>, Option<Vec<EgoPrediction>>)> = Vec::new();
+    let mut frames_csv = String::from(FRAMES_CSV_HEADER);
     for (si, (dir, set)) in sets.iter().enumerate() {
         let n_dev = dev_count(set.frames.len());
         if args.census {
@@ -401,6 +472,9 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
             for (i, (f, p)) in set.frames.iter().zip(preds).enumerate() {
                 let t = score_frame(f, set.width, set.height, p, &rules);
                 totals.add(&t, i < n_dev);
+                if name == DEFAULT_NAME && (i < n_dev || !args.dev_only) {
+                    frames_csv += &side_rows(set, f, i < n_dev, p, &rules);
+                }
                 if name == DEFAULT_NAME && t.label_lanes + t.predicted_lanes > 0 {
                     ranks.push(FrameRank {
                         set: si,
@@ -446,6 +520,9 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
         md += &render_census(&censuses);
     }
     print!("{md}");
+    let frames_path = out.join("frames.csv");
+    std::fs::write(&frames_path, &frames_csv)
+        .with_context(|| format!("cannot write {}", frames_path.display()))?;
     if !args.dev_only {
         std::fs::write(out.join("summary.md"), &md)?;
         std::fs::write(
@@ -735,4 +812,92 @@ fn contact_sheet(
         .save(path)
         .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use lane_eval::labelled::{
+        LabelFrame, LabelLane, LabelSet, LabelSide, SceneKind, ScoringRules,
+    };
+
+    use super::{FRAMES_CSV_HEADER, side_rows};
+
+    fn set() -> LabelSet {
+        LabelSet {
+            schema: 1,
+            set: "my,set".into(),
+            kind: SceneKind::Road,
+            source: String::new(),
+            licence: String::new(),
+            width: 320,
+            height: 240,
+            frames: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn frame_rows_give_one_row_per_scored_side_with_its_outcome() {
+        // Left label x = 100 on rows 150..240, right label only in the far field (not scored).
+        let f = LabelFrame {
+            index: 3,
+            file: "frames/a\"b.png".into(),
+            clip: "c".into(),
+            lanes: vec![
+                LabelLane {
+                    side: LabelSide::Left,
+                    points: (150..240).map(|y| [100.0, f64::from(y)]).collect(),
+                },
+                LabelLane {
+                    side: LabelSide::Right,
+                    points: (0..40).map(|y| [250.0, f64::from(y)]).collect(),
+                },
+            ],
+        };
+        let rules = ScoringRules::default();
+        let columns = FRAMES_CSV_HEADER.trim_end().split(',').count();
+        // On the label: matched; the far-field right side gives no row.
+        let rows = side_rows(
+            &set(),
+            &f,
+            true,
+            &[Some([0.0, 0.0, 101.0]), Some([0.0, 0.0, 0.0])],
+            &rules,
+        );
+        assert_eq!(
+            rows,
+            "\"my,set\",\"frames/a\"\"b.png\",dev,left,1,1,1.0000,1,1,,1.00\n"
+        );
+        // 40 px off: a far false positive; no prediction: a missed label with no error.
+        let rows = side_rows(&set(), &f, false, &[Some([0.0, 0.0, 140.0]), None], &rules);
+        assert_eq!(
+            rows,
+            "\"my,set\",\"frames/a\"\"b.png\",hold-out,left,1,1,0.0000,0,0,far,40.00\n"
+        );
+        let rows = side_rows(&set(), &f, false, &[None, None], &rules);
+        assert!(
+            rows.ends_with(",hold-out,left,1,0,0.0000,0,0,,\n"),
+            "{rows}"
+        );
+        // Only the left label: a right prediction is scored on its own row, unlabelled.
+        let mut left_only = f.clone();
+        left_only.lanes.truncate(1);
+        let rows = side_rows(
+            &set(),
+            &left_only,
+            true,
+            &[None, Some([0.0, 0.0, 250.0])],
+            &rules,
+        );
+        let lines: Vec<&str> = rows.lines().collect();
+        assert_eq!(lines.len(), 2);
+        assert!(
+            lines[1].ends_with(",dev,right,0,1,,,,unlabelled_side,"),
+            "{rows}"
+        );
+        // Every row has the header's columns (the quoted fields hold commas).
+        for l in lines {
+            let unquoted = l.replace("\"my,set\"", "s");
+            assert_eq!(unquoted.split(',').count(), columns, "{l}");
+        }
+    }
 }

@@ -452,7 +452,8 @@ fn on_another_marking(
             .any(|l| meets(&lane_scored_points(l, y_top).collect::<Vec<_>>()))
 }
 
-/// Score one frame's ego prediction against its labels under `rules`.
+/// Score one frame's ego prediction against its labels under `rules`: the sum of
+/// [`score_side`] over the two sides, as one frame.
 pub fn score_frame(
     labels: &LabelFrame,
     width: usize,
@@ -464,65 +465,93 @@ pub fn score_frame(
         frames: 1,
         ..LaneTotals::default()
     };
+    for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
+        t.add(&score_side(
+            labels,
+            width,
+            height,
+            side,
+            prediction[k],
+            rules,
+        ));
+    }
+    t
+}
+
+/// Score one ego side of a frame (`side` [`LabelSide::Left`] or [`LabelSide::Right`]; `Other`
+/// has no prediction and scores nothing): its prediction `prediction` against that side's label
+/// lane under `rules`. At most one label lane and one prediction; `frames` is 0 (a side is not
+/// a frame). A side labelled only above the scored rows scores nothing, its prediction
+/// included; a prediction on a side with no label is a false positive
+/// ([`FalsePositives::unlabelled_side`]).
+pub fn score_side(
+    labels: &LabelFrame,
+    width: usize,
+    height: usize,
+    side: LabelSide,
+    prediction: Option<[f64; 3]>,
+    rules: &ScoringRules,
+) -> LaneTotals {
+    let mut t = LaneTotals::default();
+    if side == LabelSide::Other {
+        return t;
+    }
     let y_top = rules.eval_top_fraction * height as f64;
     let tus_px = rules.tusimple_px_at_1280 * width as f64 / 1280.0;
     let aly_px = rules.aly_px_at_640 * width as f64 / 640.0;
-    for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
-        let pts = scored_points(labels, side, y_top);
-        let labelled = labels.lanes.iter().any(|l| l.side == side);
-        let pred = prediction[k];
-        if labelled && pts.len() < 2 {
-            // Labelled only in the far field: neither the label nor a prediction is scored.
-            continue;
-        }
-        if pred.is_some() {
-            t.predicted_lanes += 1;
-        }
-        if pts.is_empty() {
-            // No label on this side: a prediction there is a false positive.
-            t.false_positives.unlabelled_side += u64::from(pred.is_some());
-            continue;
-        }
-        t.label_lanes += 1;
-        let Some(c) = pred else { continue };
-        let acc = tusimple_lane_accuracy(&pts, c, tus_px, &mut t.abs_err_sum_px);
-        t.abs_err_points += pts.len() as u64;
-        t.tusimple_acc_sum += acc;
-        if acc >= rules.tusimple_match_fraction {
-            t.tusimple_matched += 1;
-        } else if on_another_marking(labels, side, y_top, c, tus_px, rules) {
-            t.false_positives.other_marking += 1;
-        } else if acc >= NEAR_MISS_FRACTION {
-            t.false_positives.near += 1;
-        } else {
-            t.false_positives.far += 1;
-        }
-        // Aly: median nearest-point distance to the prediction sampled on every row.
-        let y_lo = (y_top - aly_px).max(0.0).floor() as i64;
-        let y_hi = (height as f64 - 1.0 + aly_px).ceil() as i64;
-        let mut d: Vec<f64> = pts
-            .iter()
-            .map(|&[x, y]| {
-                (y_lo..=y_hi)
-                    .map(|r| {
-                        let r = r as f64;
-                        let dx = eval_parabola(c, r) - x;
-                        let dy = r - y;
-                        dx * dx + dy * dy
-                    })
-                    .fold(f64::INFINITY, f64::min)
-                    .sqrt()
-            })
-            .collect();
-        d.sort_by(f64::total_cmp);
-        let median = if d.len() % 2 == 1 {
-            d[d.len() / 2]
-        } else {
-            0.5 * (d[d.len() / 2 - 1] + d[d.len() / 2])
-        };
-        if median <= aly_px {
-            t.aly_matched += 1;
-        }
+    let pts = scored_points(labels, side, y_top);
+    let labelled = labels.lanes.iter().any(|l| l.side == side);
+    if labelled && pts.len() < 2 {
+        // Labelled only in the far field: neither the label nor a prediction is scored.
+        return t;
+    }
+    if prediction.is_some() {
+        t.predicted_lanes += 1;
+    }
+    if pts.is_empty() {
+        // No label on this side: a prediction there is a false positive.
+        t.false_positives.unlabelled_side += u64::from(prediction.is_some());
+        return t;
+    }
+    t.label_lanes += 1;
+    let Some(c) = prediction else { return t };
+    let acc = tusimple_lane_accuracy(&pts, c, tus_px, &mut t.abs_err_sum_px);
+    t.abs_err_points += pts.len() as u64;
+    t.tusimple_acc_sum += acc;
+    if acc >= rules.tusimple_match_fraction {
+        t.tusimple_matched += 1;
+    } else if on_another_marking(labels, side, y_top, c, tus_px, rules) {
+        t.false_positives.other_marking += 1;
+    } else if acc >= NEAR_MISS_FRACTION {
+        t.false_positives.near += 1;
+    } else {
+        t.false_positives.far += 1;
+    }
+    // Aly: median nearest-point distance to the prediction sampled on every row.
+    let y_lo = (y_top - aly_px).max(0.0).floor() as i64;
+    let y_hi = (height as f64 - 1.0 + aly_px).ceil() as i64;
+    let mut d: Vec<f64> = pts
+        .iter()
+        .map(|&[x, y]| {
+            (y_lo..=y_hi)
+                .map(|r| {
+                    let r = r as f64;
+                    let dx = eval_parabola(c, r) - x;
+                    let dy = r - y;
+                    dx * dx + dy * dy
+                })
+                .fold(f64::INFINITY, f64::min)
+                .sqrt()
+        })
+        .collect();
+    d.sort_by(f64::total_cmp);
+    let median = if d.len() % 2 == 1 {
+        d[d.len() / 2]
+    } else {
+        0.5 * (d[d.len() / 2 - 1] + d[d.len() / 2])
+    };
+    if median <= aly_px {
+        t.aly_matched += 1;
     }
     t
 }

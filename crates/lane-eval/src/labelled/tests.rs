@@ -268,3 +268,57 @@ fn clips_split_runs_of_one_id() {
     assert_eq!(lens, vec![2, 1, 1]);
     assert_eq!(set.longest_clip(), 2);
 }
+
+#[test]
+fn a_frame_scores_as_the_sum_of_its_two_sides_and_each_side_only_itself() {
+    let rules = ScoringRules::default();
+    let both = frame(vec![
+        line(LabelSide::Left, -0.5, 200.0),
+        line(LabelSide::Right, 0.6, 100.0),
+        line(LabelSide::Other, 1.5, 0.0),
+    ]);
+    let left_only = frame(vec![line(LabelSide::Left, -0.5, 200.0)]);
+    // Exact, on the neighbour's mark, 6 px beside the right label, far, nothing; on frames with
+    // both sides or one side labelled.
+    let preds: [Option<[f64; 3]>; 5] = [
+        Some([0.0, -0.5, 200.0]),
+        Some([0.0, 1.5, 0.0]),
+        Some([0.0, 0.6, 106.0]),
+        Some([0.0, 0.0, 20.0]),
+        None,
+    ];
+    for f in [&both, &left_only] {
+        for l in preds {
+            for r in preds {
+                let whole = score_frame(f, 320, 240, &[l, r], &rules);
+                let left = score_side(f, 320, 240, LabelSide::Left, l, &rules);
+                let right = score_side(f, 320, 240, LabelSide::Right, r, &rules);
+                let mut sum = LaneTotals {
+                    frames: 1,
+                    ..LaneTotals::default()
+                };
+                sum.add(&left);
+                sum.add(&right);
+                assert_eq!(whole, sum, "{l:?} {r:?}");
+                // A side holds at most its own label lane and its own prediction.
+                for s in [left, right] {
+                    assert_eq!(s.frames, 0);
+                    assert!(s.label_lanes <= 1 && s.predicted_lanes <= 1, "{s:?}");
+                }
+                assert_eq!(right.predicted_lanes, u64::from(r.is_some()));
+            }
+        }
+    }
+    // The right side's prediction on a frame labelled on the left only is that side's false
+    // positive, and the left side does not see it.
+    let r = score_side(&left_only, 320, 240, LabelSide::Right, preds[0], &rules);
+    assert_eq!((r.label_lanes, r.false_positives.unlabelled_side), (0, 1));
+    let l = score_side(&left_only, 320, 240, LabelSide::Left, preds[0], &rules);
+    assert_eq!(
+        (l.label_lanes, l.tusimple_matched, l.false_positives.total()),
+        (1, 1, 0)
+    );
+    // `Other` is not an ego side: nothing scored.
+    let o = score_side(&both, 320, 240, LabelSide::Other, preds[1], &rules);
+    assert_eq!(o, LaneTotals::default());
+}
