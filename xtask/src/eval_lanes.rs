@@ -12,8 +12,9 @@
 //! near miss, the rest). Writes
 //! `summary.md`, `summary.json`, `worst_frames.png` (the worst frames of the default run:
 //! labels green, nav-app red, the OpenCV peer blue) and `frames.csv` (the default run's outcome
-//! per scored ego side of every frame, `lane_eval::labelled::score_side`; with `--dev-only` the
-//! only file written, and of the development part alone). `--check` compares the default's figures with
+//! per scored ego side of every frame, `lane_eval::labelled::score_side`, and with `--census`
+//! the stage where its label lane is lost, `lane_eval::labelled::census_lanes`; with
+//! `--dev-only` the only file written, and of the development part alone). `--check` compares the default's figures with
 //! the floors in `fixtures/expectations-lanes-real.json` and fails below them; `--record` writes
 //! them (measured accuracy − 3 points, measured false positives + 3 points).
 
@@ -23,9 +24,9 @@ use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 use lane_eval::labelled::{
-    EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneRates, LaneTotals, NEAR_MISS_FRACTION,
-    ScoringRules, StageCensus, ceiling_prediction, census_set, choice_bound_set, score_frame,
-    score_side, track_label_set,
+    EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneCensus, LaneRates, LaneTotals,
+    NEAR_MISS_FRACTION, ScoringRules, StageCensus, ceiling_prediction, census_lanes,
+    choice_bound_set, score_frame, score_side, track_label_set,
 };
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
@@ -225,18 +226,22 @@ fn dev_count(n: usize) -> usize {
 
 /// Header of `frames.csv` (one row per scored ego side of every frame, default configuration).
 const FRAMES_CSV_HEADER: &str = "set,file,split,side,label,predicted,tusimple_accuracy,\
-tusimple_matched,aly_matched,false_positive,mean_abs_error_px\n";
+tusimple_matched,aly_matched,false_positive,mean_abs_error_px,census_stage\n";
 
 /// The `frames.csv` rows of one frame's prediction `p`: one per ego side that the scorer scores
 /// (`lane_eval::labelled::score_side`: a label lane in the scored rows, or a prediction on a
 /// side without one); empty fields where there is no label lane (accuracy, matches) or no
 /// prediction (error); `false_positive` names the kind of an unmatched prediction
-/// (`lane_eval::labelled::FalsePositives`), empty otherwise.
+/// (`lane_eval::labelled::FalsePositives`), empty otherwise; `census_stage` the stage where the
+/// side's label lane is lost (`lane_eval::labelled::LaneStage`) when `census` (the set's, with
+/// `--census`: development part) classifies the frame at `position`, empty otherwise.
 fn side_rows(
     set: &LabelSet,
     f: &LabelFrame,
+    position: usize,
     dev: bool,
     p: &EgoPrediction,
+    census: &[LaneCensus],
     rules: &ScoringRules,
 ) -> String {
     let mut rows = String::new();
@@ -265,8 +270,12 @@ fn side_rows(
         } else {
             String::new()
         };
+        let stage = census
+            .iter()
+            .find(|c| c.position == position && c.side == side)
+            .map_or("", |c| c.stage.name());
         rows += &format!(
-            "{},{},{},{name},{},{},{},{},{},{kind},{error}\n",
+            "{},{},{},{name},{},{},{},{},{},{kind},{error},{stage}\n",
             csv_field(&set.set),
             csv_field(&f.file),
             if dev { "dev" } else { "hold-out" },
@@ -413,11 +422,14 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
     let mut frames_csv = String::from(FRAMES_CSV_HEADER);
     for (si, (dir, set)) in sets.iter().enumerate() {
         let n_dev = dev_count(set.frames.len());
-        if args.census {
-            let c = census_set(dir, set, &configs[0].1, Estimator::Kif, 0..n_dev, &rules)
+        let lanes_census = if args.census {
+            let lanes = census_lanes(dir, set, &configs[0].1, Estimator::Kif, 0..n_dev, &rules)
                 .with_context(|| format!("census of set {}", set.set))?;
-            censuses.push((set.set.clone(), c));
-        }
+            censuses.push((set.set.clone(), StageCensus::count(&lanes)));
+            lanes
+        } else {
+            Vec::new()
+        };
         let mut results = BTreeMap::new();
         let mut runs: Vec<(String, Vec<EgoPrediction>)> = Vec::new();
         // The default's run also gives the bounds of its choice: what a perfect choice among
@@ -473,7 +485,7 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
                 let t = score_frame(f, set.width, set.height, p, &rules);
                 totals.add(&t, i < n_dev);
                 if name == DEFAULT_NAME && (i < n_dev || !args.dev_only) {
-                    frames_csv += &side_rows(set, f, i < n_dev, p, &rules);
+                    frames_csv += &side_rows(set, f, i, i < n_dev, p, &lanes_census, &rules);
                 }
                 if name == DEFAULT_NAME && t.label_lanes + t.predicted_lanes > 0 {
                     ranks.push(FrameRank {
@@ -817,7 +829,7 @@ fn contact_sheet(
 #[cfg(test)]
 mod tests {
     use lane_eval::labelled::{
-        LabelFrame, LabelLane, LabelSet, LabelSide, SceneKind, ScoringRules,
+        LabelFrame, LabelLane, LabelSet, LabelSide, LaneCensus, LaneStage, SceneKind, ScoringRules,
     };
 
     use super::{FRAMES_CSV_HEADER, side_rows};
@@ -859,23 +871,56 @@ mod tests {
         let rows = side_rows(
             &set(),
             &f,
+            3,
             true,
             &[Some([0.0, 0.0, 101.0]), Some([0.0, 0.0, 0.0])],
+            &[],
             &rules,
         );
         assert_eq!(
             rows,
-            "\"my,set\",\"frames/a\"\"b.png\",dev,left,1,1,1.0000,1,1,,1.00\n"
+            "\"my,set\",\"frames/a\"\"b.png\",dev,left,1,1,1.0000,1,1,,1.00,\n"
         );
+        // The census's stage of this frame's side, not of another frame's or side's.
+        let census = |position, side, stage| LaneCensus {
+            position,
+            side,
+            stage,
+        };
+        let stages = [
+            census(2, LabelSide::Left, LaneStage::NotChosen),
+            census(3, LabelSide::Right, LaneStage::NoCandidate),
+            census(3, LabelSide::Left, LaneStage::FoundByRefinement),
+        ];
+        let rows = side_rows(
+            &set(),
+            &f,
+            3,
+            true,
+            &[Some([0.0, 0.0, 101.0]), None],
+            &stages,
+            &rules,
+        );
+        assert!(rows.ends_with(",1.00,found_by_refinement\n"), "{rows}");
+        let rows = side_rows(&set(), &f, 2, true, &[None, None], &stages, &rules);
+        assert!(rows.ends_with(",,not_chosen\n"), "{rows}");
         // 40 px off: a far false positive; no prediction: a missed label with no error.
-        let rows = side_rows(&set(), &f, false, &[Some([0.0, 0.0, 140.0]), None], &rules);
+        let rows = side_rows(
+            &set(),
+            &f,
+            3,
+            false,
+            &[Some([0.0, 0.0, 140.0]), None],
+            &[],
+            &rules,
+        );
         assert_eq!(
             rows,
-            "\"my,set\",\"frames/a\"\"b.png\",hold-out,left,1,1,0.0000,0,0,far,40.00\n"
+            "\"my,set\",\"frames/a\"\"b.png\",hold-out,left,1,1,0.0000,0,0,far,40.00,\n"
         );
-        let rows = side_rows(&set(), &f, false, &[None, None], &rules);
+        let rows = side_rows(&set(), &f, 3, false, &[None, None], &[], &rules);
         assert!(
-            rows.ends_with(",hold-out,left,1,0,0.0000,0,0,,\n"),
+            rows.ends_with(",hold-out,left,1,0,0.0000,0,0,,,\n"),
             "{rows}"
         );
         // Only the left label: a right prediction is scored on its own row, unlabelled.
@@ -884,14 +929,16 @@ mod tests {
         let rows = side_rows(
             &set(),
             &left_only,
+            3,
             true,
             &[None, Some([0.0, 0.0, 250.0])],
+            &[],
             &rules,
         );
         let lines: Vec<&str> = rows.lines().collect();
         assert_eq!(lines.len(), 2);
         assert!(
-            lines[1].ends_with(",dev,right,0,1,,,,unlabelled_side,"),
+            lines[1].ends_with(",dev,right,0,1,,,,unlabelled_side,,"),
             "{rows}"
         );
         // Every row has the header's columns (the quoted fields hold commas).

@@ -1,4 +1,5 @@
-//! `census_set` puts every scored ego label lane in the stage where it is lost: a label on the
+//! `census_lanes` lists every scored ego label lane with the stage where it is lost, and
+//! `census_set` counts them: a label on the
 //! tracked mark is matched, a label where no mark is has no candidate and no edge near it, a
 //! label a little beside a mark has no candidate but an edge near it, a label on a mark the
 //! ego-pair choice passed over is "not chosen", a lane tracked from the previous frame is not
@@ -11,7 +12,8 @@
 use std::path::PathBuf;
 
 use lane_eval::labelled::{
-    LabelSet, ScoringRules, StageCensus, census_set, choice_bound_set, score_frame, track_label_set,
+    LabelSet, LabelSide, LaneCensus, LaneStage, ScoringRules, StageCensus, census_lanes,
+    census_set, choice_bound_set, score_frame, track_label_set,
 };
 use lane_tracker::{Estimator, TrackerConfig};
 
@@ -153,6 +155,84 @@ fn every_scored_label_lane_is_put_in_the_stage_where_it_is_lost() {
     }
     assert_eq!(all, sum);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn each_label_lane_is_listed_with_its_frame_side_and_stage() {
+    let (dir, set) = write_scenes("lanes", 1);
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let rules = ScoringRules::default();
+    let lanes = census_lanes(&dir, &set, &cfg, Estimator::Kif, 0..7, &rules).unwrap();
+    let (l, r) = (LabelSide::Left, LabelSide::Right);
+    let want: Vec<LaneCensus> = [
+        (0, l, LaneStage::Matched),
+        (0, r, LaneStage::Matched),
+        (1, l, LaneStage::Matched),
+        (1, r, LaneStage::NoEdgeNearLabel),
+        (2, l, LaneStage::Matched),
+        (2, r, LaneStage::NotChosen),
+        (3, l, LaneStage::Matched),
+        (3, r, LaneStage::Matched),
+        (4, l, LaneStage::NotClassified),
+        (4, r, LaneStage::NotClassified),
+        (5, l, LaneStage::Matched),
+        (5, r, LaneStage::NoCandidate),
+        (6, l, LaneStage::Matched),
+        (6, r, LaneStage::NoCandidate),
+    ]
+    .into_iter()
+    .map(|(position, side, stage)| LaneCensus {
+        position,
+        side,
+        stage,
+    })
+    .collect();
+    assert_eq!(lanes, want);
+    // The counts are those of the lanes; a range lists only its own frames.
+    assert_eq!(
+        StageCensus::count(&lanes),
+        census_set(&dir, &set, &cfg, Estimator::Kif, 0..7, &rules).unwrap()
+    );
+    let part = census_lanes(&dir, &set, &cfg, Estimator::Kif, 2..4, &rules).unwrap();
+    assert_eq!(part, want[4..8]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn stage_counts_nest_the_refinement_in_matched_and_the_missing_edge_in_no_candidate() {
+    let lane = |stage| LaneCensus {
+        position: 0,
+        side: LabelSide::Left,
+        stage,
+    };
+    let all = [
+        LaneStage::Matched,
+        LaneStage::FoundByRefinement,
+        LaneStage::NoCandidate,
+        LaneStage::NoEdgeNearLabel,
+        LaneStage::NotChosen,
+        LaneStage::LostAfterChoice,
+        LaneStage::NotClassified,
+    ]
+    .map(lane);
+    assert_eq!(
+        StageCensus::count(&all),
+        StageCensus {
+            label_lanes: 6,
+            matched: 2,
+            found_by_refinement: 1,
+            no_candidate: 2,
+            no_edge_near_label: 1,
+            not_chosen: 1,
+            lost_after_choice: 1,
+            not_classified: 1,
+        }
+    );
+    // Names as serialised, one per stage.
+    for l in &all {
+        let json = serde_json::to_string(&l.stage).unwrap();
+        assert_eq!(json, format!("\"{}\"", l.stage.name()));
+    }
 }
 
 #[test]

@@ -1,5 +1,7 @@
 //! Where the ego label lanes are lost, stage by stage: a diagnostic for tuning the
-//! initialisation (`cargo xtask eval-lanes --census`).
+//! initialisation (`cargo xtask eval-lanes --census`). [`census_lanes`] gives each lane's stage
+//! ([`LaneStage`]; `frames.csv`'s `census_stage`), [`census_set`] their counts
+//! ([`StageCensus::count`]).
 //!
 //! On a frame where the tracker ran its joint initialisation, every scored ego label lane is put
 //! in exactly one of five classes, by the TuSimple rule of [`super::score_frame`] (a lane is
@@ -69,7 +71,80 @@ pub struct StageCensus {
     pub not_classified: u64,
 }
 
+/// The stage where one scored ego label lane is lost (module docs), as [`StageCensus`] counts
+/// it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LaneStage {
+    /// Matched by the output, and by the chosen candidate alone.
+    Matched,
+    /// Matched by the output, not by the chosen candidate (found by the refinement).
+    FoundByRefinement,
+    /// No Hough candidate matched it; the gradient stage keeps edges near the label.
+    NoCandidate,
+    /// No Hough candidate matched it, and no edge near the label either.
+    NoEdgeNearLabel,
+    /// A candidate matched it, not the one chosen for its side.
+    NotChosen,
+    /// The chosen candidate matched it, the output does not.
+    LostAfterChoice,
+    /// On a side that kept its tracked estimate, or on a frame without a joint initialisation.
+    NotClassified,
+}
+
+impl LaneStage {
+    /// Its name in reports (`snake_case`, as serialised).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Matched => "matched",
+            Self::FoundByRefinement => "found_by_refinement",
+            Self::NoCandidate => "no_candidate",
+            Self::NoEdgeNearLabel => "no_edge_near_label",
+            Self::NotChosen => "not_chosen",
+            Self::LostAfterChoice => "lost_after_choice",
+            Self::NotClassified => "not_classified",
+        }
+    }
+}
+
+/// One scored ego label lane of the census: where in the set, which side, and its stage.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LaneCensus {
+    /// The frame's position in the set.
+    pub position: usize,
+    /// [`LabelSide::Left`] or [`LabelSide::Right`].
+    pub side: LabelSide,
+    /// Where it is lost.
+    pub stage: LaneStage,
+}
+
 impl StageCensus {
+    /// The counts of per-lane classes: every lane in its class, and in
+    /// [`StageCensus::label_lanes`] unless it is not classified (so the counts add up as the
+    /// fields' docs say).
+    pub fn count(lanes: &[LaneCensus]) -> Self {
+        let mut c = Self::default();
+        for l in lanes {
+            c.label_lanes += u64::from(l.stage != LaneStage::NotClassified);
+            match l.stage {
+                LaneStage::Matched => c.matched += 1,
+                LaneStage::FoundByRefinement => {
+                    c.matched += 1;
+                    c.found_by_refinement += 1;
+                }
+                LaneStage::NoCandidate => c.no_candidate += 1,
+                LaneStage::NoEdgeNearLabel => {
+                    c.no_candidate += 1;
+                    c.no_edge_near_label += 1;
+                }
+                LaneStage::NotChosen => c.not_chosen += 1,
+                LaneStage::LostAfterChoice => c.lost_after_choice += 1,
+                LaneStage::NotClassified => c.not_classified += 1,
+            }
+        }
+        c
+    }
+
     /// Add another census.
     pub fn add(&mut self, o: &StageCensus) {
         self.label_lanes += o.label_lanes;
@@ -84,11 +159,11 @@ impl StageCensus {
 }
 
 /// The census of the frames at positions `frames` (in set order) of a labelled set, the tracker
-/// run as [`super::track_label_set`] runs it (clip by clip, from the first frame of each clip).
+/// run as [`super::track_label_set`] runs it (clip by clip, from the first frame of each clip):
+/// the counts of [`census_lanes`].
 ///
 /// # Errors
-/// As [`super::track_label_set`]: a frame that cannot be read or has another size than the set
-/// declares, or a configuration the tracker refuses.
+/// As [`census_lanes`].
 pub fn census_set(
     dir: &Path,
     set: &LabelSet,
@@ -97,7 +172,27 @@ pub fn census_set(
     frames: Range<usize>,
     rules: &ScoringRules,
 ) -> Result<StageCensus, EvalError> {
-    let mut census = StageCensus::default();
+    Ok(StageCensus::count(&census_lanes(
+        dir, set, cfg, estimator, frames, rules,
+    )?))
+}
+
+/// Every scored ego label lane of the frames at positions `frames` (in set order) of a labelled
+/// set with the stage where it is lost (module docs), in set order, left before right; the
+/// tracker run as [`super::track_label_set`] runs it.
+///
+/// # Errors
+/// As [`super::track_label_set`]: a frame that cannot be read or has another size than the set
+/// declares, or a configuration the tracker refuses.
+pub fn census_lanes(
+    dir: &Path,
+    set: &LabelSet,
+    cfg: &TrackerConfig,
+    estimator: Estimator,
+    frames: Range<usize>,
+    rules: &ScoringRules,
+) -> Result<Vec<LaneCensus>, EvalError> {
+    let mut census = Vec::new();
     let y_top = rules.eval_top_fraction * set.height as f64;
     let tus_px = rules.tusimple_px_at_1280 * set.width as f64 / 1280.0;
     let joint = cfg.init.candidate_lines > 0;
@@ -143,11 +238,17 @@ pub fn census_set(
                 // now, or left without an estimate); a side that kept its tracked estimate is not.
                 let lane = &report.lanes[k];
                 let initialised_for = lane.initialised || lane.coeffs.is_none();
+                let mut put = |stage| {
+                    census.push(LaneCensus {
+                        position,
+                        side: label_side,
+                        stage,
+                    });
+                };
                 if !(report.full_gradient && joint && initialised_for) {
-                    census.not_classified += 1;
+                    put(LaneStage::NotClassified);
                     continue;
                 }
-                census.label_lanes += 1;
                 let matches = |c: [f64; 3]| {
                     tusimple_lane_accuracy(&pts, c, tus_px, &mut 0.0)
                         >= rules.tusimple_match_fraction
@@ -157,14 +258,16 @@ pub fn census_set(
                     .iter()
                     .any(|c| c.chosen == Some(side) && matches(c.coeffs));
                 if output {
-                    census.matched += 1;
-                    census.found_by_refinement += u64::from(!chosen);
+                    put(if chosen {
+                        LaneStage::Matched
+                    } else {
+                        LaneStage::FoundByRefinement
+                    });
                 } else if chosen {
-                    census.lost_after_choice += 1;
+                    put(LaneStage::LostAfterChoice);
                 } else if candidates.iter().any(|c| matches(c.coeffs)) {
-                    census.not_chosen += 1;
+                    put(LaneStage::NotChosen);
                 } else {
-                    census.no_candidate += 1;
                     if !edges_read {
                         let image = match tracker.working_frame() {
                             Some((image, _)) => image,
@@ -192,9 +295,11 @@ pub fn census_set(
                             with_edge += usize::from(near);
                         }
                     }
-                    if 2 * with_edge < in_roi {
-                        census.no_edge_near_label += 1;
-                    }
+                    put(if 2 * with_edge < in_roi {
+                        LaneStage::NoEdgeNearLabel
+                    } else {
+                        LaneStage::NoCandidate
+                    });
                 }
             }
             Ok(())

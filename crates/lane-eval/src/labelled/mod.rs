@@ -697,5 +697,5 @@ mod choice_bound;
 #[cfg(test)]
 mod tests;
 
-pub use census::{StageCensus, census_set};
+pub use census::{LaneCensus, LaneStage, StageCensus, census_lanes, census_set};
 pub use choice_bound::{ChoiceBound, choice_bound_set};
