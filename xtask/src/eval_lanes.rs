@@ -12,7 +12,7 @@
 //! near miss, the rest). Writes
 //! `summary.md`, `summary.json`, `worst_frames.png` (the worst frames of the default run:
 //! labels green, nav-app red, the OpenCV peer blue) and `frames.csv` (the default run's outcome
-//! per scored ego side of every frame, `lane_eval::labelled::score_side`, and with `--census`
+//! per scored ego side of every frame, `lane_eval::labelled::score_sides`, and with `--census`
 //! the stage where its label lane is lost, `lane_eval::labelled::census_lanes`; with
 //! `--dev-only` the only file written, and of the development part alone). `--check` compares the default's figures with
 //! the floors in `fixtures/expectations-lanes-real.json` and fails below them; `--record` writes
@@ -26,7 +26,7 @@ use anyhow::{Context, Result, bail};
 use lane_eval::labelled::{
     EgoPrediction, LabelFrame, LabelSet, LabelSide, LaneCensus, LaneRates, LaneTotals,
     NEAR_MISS_FRACTION, ScoringRules, StageCensus, ceiling_prediction, census_lanes,
-    choice_bound_set, score_frame, score_side, track_label_set,
+    choice_bound_set, score_sides, track_label_set,
 };
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
@@ -62,7 +62,7 @@ pub struct EvalLanesArgs {
     #[arg(long)]
     no_peer: bool,
     /// Also report where the default configuration loses the ego label lanes of the development
-    /// part, stage by stage (`lane_eval::labelled::census_set`: no Hough candidate — and of
+    /// part, stage by stage (`lane_eval::labelled::census_lanes`: no Hough candidate — and of
     /// those, no edge near the label — candidate not chosen, lost after the choice, found by the
     /// refinement).
     #[arg(long)]
@@ -191,7 +191,7 @@ fn render_census(censuses: &[(String, StageCensus)]) -> String {
     let mut md = String::from(
         "\n## Where the default loses the development part's ego lanes (`--census`)\n\n\
          Label lanes on frames with a joint initialisation, by the TuSimple rule \
-         (`lane_eval::labelled::census_set`).\n\n\
+         (`lane_eval::labelled::census_lanes`).\n\n\
          | set | label lanes | matched | … found by the refinement | no Hough candidate | \
          … no edge near the label | candidate not chosen | lost after the choice | \
          not classified |\n\
@@ -228,9 +228,9 @@ fn dev_count(n: usize) -> usize {
 const FRAMES_CSV_HEADER: &str = "set,file,split,side,label,predicted,tusimple_accuracy,\
 tusimple_matched,aly_matched,false_positive,mean_abs_error_px,census_stage\n";
 
-/// The `frames.csv` rows of one frame's prediction `p`: one per ego side that the scorer scores
-/// (`lane_eval::labelled::score_side`: a label lane in the scored rows, or a prediction on a
-/// side without one); empty fields where there is no label lane (accuracy, matches) or no
+/// The `frames.csv` rows of one frame from its sides' scores `sides` (left, right;
+/// `lane_eval::labelled::score_sides`): one per ego side that the scorer scores (a label lane in
+/// the scored rows, or a prediction on a side without one); empty fields where there is no label lane (accuracy, matches) or no
 /// prediction (error); `false_positive` names the kind of an unmatched prediction
 /// (`lane_eval::labelled::FalsePositives`), empty otherwise; `census_stage` the stage where the
 /// side's label lane is lost (`lane_eval::labelled::LaneStage`) when `census` (the set's, with
@@ -240,16 +240,15 @@ fn side_rows(
     f: &LabelFrame,
     position: usize,
     dev: bool,
-    p: &EgoPrediction,
+    sides: &[LaneTotals; 2],
     census: &[LaneCensus],
-    rules: &ScoringRules,
 ) -> String {
     let mut rows = String::new();
     for (k, (side, name)) in [(LabelSide::Left, "left"), (LabelSide::Right, "right")]
         .into_iter()
         .enumerate()
     {
-        let t = score_side(f, set.width, set.height, side, p[k], rules);
+        let t = &sides[k];
         if t.label_lanes + t.predicted_lanes == 0 {
             continue;
         }
@@ -482,10 +481,11 @@ pub fn run(args: EvalLanesArgs) -> Result<()> {
         for (name, preds) in &runs {
             let mut totals = SplitTotals::default();
             for (i, (f, p)) in set.frames.iter().zip(preds).enumerate() {
-                let t = score_frame(f, set.width, set.height, p, &rules);
+                let sides = score_sides(f, set.width, set.height, p, &rules);
+                let t = LaneTotals::of_frame(&sides);
                 totals.add(&t, i < n_dev);
                 if name == DEFAULT_NAME && (i < n_dev || !args.dev_only) {
-                    frames_csv += &side_rows(set, f, i, i < n_dev, p, &lanes_census, &rules);
+                    frames_csv += &side_rows(set, f, i, i < n_dev, &sides, &lanes_census);
                 }
                 if name == DEFAULT_NAME && t.label_lanes + t.predicted_lanes > 0 {
                     ranks.push(FrameRank {
@@ -832,7 +832,23 @@ mod tests {
         LabelFrame, LabelLane, LabelSet, LabelSide, LaneCensus, LaneStage, SceneKind, ScoringRules,
     };
 
+    use lane_eval::labelled::{EgoPrediction, score_sides};
+
     use super::{FRAMES_CSV_HEADER, side_rows};
+
+    /// `frames.csv`'s rows of frame `f` at `position` for prediction `p`, scored as `eval-lanes`
+    /// scores it.
+    fn rows(
+        f: &LabelFrame,
+        position: usize,
+        dev: bool,
+        p: &EgoPrediction,
+        census: &[LaneCensus],
+    ) -> String {
+        let set = set();
+        let sides = score_sides(f, set.width, set.height, p, &ScoringRules::default());
+        side_rows(&set, f, position, dev, &sides, census)
+    }
 
     fn set() -> LabelSet {
         LabelSet {
@@ -865,20 +881,17 @@ mod tests {
                 },
             ],
         };
-        let rules = ScoringRules::default();
         let columns = FRAMES_CSV_HEADER.trim_end().split(',').count();
         // On the label: matched; the far-field right side gives no row.
-        let rows = side_rows(
-            &set(),
+        let got = rows(
             &f,
             3,
             true,
             &[Some([0.0, 0.0, 101.0]), Some([0.0, 0.0, 0.0])],
             &[],
-            &rules,
         );
         assert_eq!(
-            rows,
+            got,
             "\"my,set\",\"frames/a\"\"b.png\",dev,left,1,1,1.0000,1,1,,1.00,\n"
         );
         // The census's stage of this frame's side, not of another frame's or side's.
@@ -892,54 +905,27 @@ mod tests {
             census(3, LabelSide::Right, LaneStage::NoCandidate),
             census(3, LabelSide::Left, LaneStage::FoundByRefinement),
         ];
-        let rows = side_rows(
-            &set(),
-            &f,
-            3,
-            true,
-            &[Some([0.0, 0.0, 101.0]), None],
-            &stages,
-            &rules,
-        );
-        assert!(rows.ends_with(",1.00,found_by_refinement\n"), "{rows}");
-        let rows = side_rows(&set(), &f, 2, true, &[None, None], &stages, &rules);
-        assert!(rows.ends_with(",,not_chosen\n"), "{rows}");
+        let got = rows(&f, 3, true, &[Some([0.0, 0.0, 101.0]), None], &stages);
+        assert!(got.ends_with(",1.00,found_by_refinement\n"), "{got}");
+        let got = rows(&f, 2, true, &[None, None], &stages);
+        assert!(got.ends_with(",,not_chosen\n"), "{got}");
         // 40 px off: a far false positive; no prediction: a missed label with no error.
-        let rows = side_rows(
-            &set(),
-            &f,
-            3,
-            false,
-            &[Some([0.0, 0.0, 140.0]), None],
-            &[],
-            &rules,
-        );
+        let got = rows(&f, 3, false, &[Some([0.0, 0.0, 140.0]), None], &[]);
         assert_eq!(
-            rows,
+            got,
             "\"my,set\",\"frames/a\"\"b.png\",hold-out,left,1,1,0.0000,0,0,far,40.00,\n"
         );
-        let rows = side_rows(&set(), &f, 3, false, &[None, None], &[], &rules);
-        assert!(
-            rows.ends_with(",hold-out,left,1,0,0.0000,0,0,,,\n"),
-            "{rows}"
-        );
+        let got = rows(&f, 3, false, &[None, None], &[]);
+        assert!(got.ends_with(",hold-out,left,1,0,0.0000,0,0,,,\n"), "{got}");
         // Only the left label: a right prediction is scored on its own row, unlabelled.
         let mut left_only = f.clone();
         left_only.lanes.truncate(1);
-        let rows = side_rows(
-            &set(),
-            &left_only,
-            3,
-            true,
-            &[None, Some([0.0, 0.0, 250.0])],
-            &[],
-            &rules,
-        );
-        let lines: Vec<&str> = rows.lines().collect();
+        let got = rows(&left_only, 3, true, &[None, Some([0.0, 0.0, 250.0])], &[]);
+        let lines: Vec<&str> = got.lines().collect();
         assert_eq!(lines.len(), 2);
         assert!(
             lines[1].ends_with(",dev,right,0,1,,,,unlabelled_side,,"),
-            "{rows}"
+            "{got}"
         );
         // Every row has the header's columns (the quoted fields hold commas).
         for l in lines {

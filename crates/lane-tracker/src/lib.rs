@@ -309,7 +309,7 @@
 //! frame stays that of a 320-px frame plus the box average. `working_width_px = 0` tracks every
 //! frame at its own size (the paper). [`LaneTracker::working_factor`] gives `f` and
 //! [`LaneTracker::working_frame`] the last frame's working pixels, for diagnostics that must
-//! read the frame as the stages do (`lane_eval::labelled::census_set`).
+//! read the frame as the stages do (`lane_eval::labelled::census_lanes`).
 //!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field

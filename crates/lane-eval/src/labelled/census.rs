@@ -1,7 +1,7 @@
 //! Where the ego label lanes are lost, stage by stage: a diagnostic for tuning the
 //! initialisation (`cargo xtask eval-lanes --census`). [`census_lanes`] gives each lane's stage
-//! ([`LaneStage`]; `frames.csv`'s `census_stage`), [`census_set`] their counts
-//! ([`StageCensus::count`]).
+//! ([`LaneStage`]; `frames.csv`'s `census_stage`), [`StageCensus::count`] their counts (the
+//! `--census` table).
 //!
 //! On a frame where the tracker ran its joint initialisation, every scored ego label lane is put
 //! in exactly one of five classes, by the TuSimple rule of [`super::score_frame`] (a lane is
@@ -158,28 +158,10 @@ impl StageCensus {
     }
 }
 
-/// The census of the frames at positions `frames` (in set order) of a labelled set, the tracker
-/// run as [`super::track_label_set`] runs it (clip by clip, from the first frame of each clip):
-/// the counts of [`census_lanes`].
-///
-/// # Errors
-/// As [`census_lanes`].
-pub fn census_set(
-    dir: &Path,
-    set: &LabelSet,
-    cfg: &TrackerConfig,
-    estimator: Estimator,
-    frames: Range<usize>,
-    rules: &ScoringRules,
-) -> Result<StageCensus, EvalError> {
-    Ok(StageCensus::count(&census_lanes(
-        dir, set, cfg, estimator, frames, rules,
-    )?))
-}
-
 /// Every scored ego label lane of the frames at positions `frames` (in set order) of a labelled
 /// set with the stage where it is lost (module docs), in set order, left before right; the
-/// tracker run as [`super::track_label_set`] runs it.
+/// tracker run as [`super::track_label_set`] runs it (clip by clip, from the first frame of each
+/// clip).
 ///
 /// # Errors
 /// As [`super::track_label_set`]: a frame that cannot be read or has another size than the set

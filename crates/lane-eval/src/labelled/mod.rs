@@ -312,6 +312,17 @@ impl FalsePositives {
 }
 
 impl LaneTotals {
+    /// One frame's totals from its two sides' ([`score_sides`]): their sum, counted as one frame.
+    pub fn of_frame(sides: &[LaneTotals; 2]) -> Self {
+        let mut t = Self {
+            frames: 1,
+            ..Self::default()
+        };
+        t.add(&sides[0]);
+        t.add(&sides[1]);
+        t
+    }
+
     /// Add another total.
     pub fn add(&mut self, o: &LaneTotals) {
         self.frames += o.frames;
@@ -452,8 +463,8 @@ fn on_another_marking(
             .any(|l| meets(&lane_scored_points(l, y_top).collect::<Vec<_>>()))
 }
 
-/// Score one frame's ego prediction against its labels under `rules`: the sum of
-/// [`score_side`] over the two sides, as one frame.
+/// Score one frame's ego prediction against its labels under `rules`: its two sides
+/// ([`score_sides`]) as one frame ([`LaneTotals::of_frame`]).
 pub fn score_frame(
     labels: &LabelFrame,
     width: usize,
@@ -461,21 +472,22 @@ pub fn score_frame(
     prediction: &EgoPrediction,
     rules: &ScoringRules,
 ) -> LaneTotals {
-    let mut t = LaneTotals {
-        frames: 1,
-        ..LaneTotals::default()
-    };
-    for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
-        t.add(&score_side(
-            labels,
-            width,
-            height,
-            side,
-            prediction[k],
-            rules,
-        ));
-    }
-    t
+    LaneTotals::of_frame(&score_sides(labels, width, height, prediction, rules))
+}
+
+/// [`score_side`] of the left and of the right side of one frame's ego prediction.
+pub fn score_sides(
+    labels: &LabelFrame,
+    width: usize,
+    height: usize,
+    prediction: &EgoPrediction,
+    rules: &ScoringRules,
+) -> [LaneTotals; 2] {
+    let side = |side, p| score_side(labels, width, height, side, p, rules);
+    [
+        side(LabelSide::Left, prediction[0]),
+        side(LabelSide::Right, prediction[1]),
+    ]
 }
 
 /// Score one ego side of a frame (`side` [`LabelSide::Left`] or [`LabelSide::Right`]; `Other`
@@ -697,5 +709,5 @@ mod choice_bound;
 #[cfg(test)]
 mod tests;
 
-pub use census::{LaneCensus, LaneStage, StageCensus, census_lanes, census_set};
+pub use census::{LaneCensus, LaneStage, StageCensus, census_lanes};
 pub use choice_bound::{ChoiceBound, choice_bound_set};

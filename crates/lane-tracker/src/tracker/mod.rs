@@ -351,7 +351,7 @@ pub(crate) const MAX_CANDIDATE_LINES: usize = 8;
 
 /// One Hough candidate line of the last joint initialisation (`init.candidate_lines > 0`) as the
 /// choice of the ego pair weighed it: for overlays, and for finding at which stage a lane is lost
-/// (`lane_eval::labelled::census_set`).
+/// (`lane_eval::labelled::census_lanes`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct InitCandidate {
     /// The angle band whose pixels voted for it: [`Side::Left`] the `/` band, [`Side::Right`]
@@ -655,7 +655,7 @@ impl LaneTracker {
     /// written — the rows any stage reads (the ROI, the second search's rows, a row beside
     /// them for the Sobel); the other rows are not (zero). All zero before the first frame.
     /// `None` with `f = 1`: the stages read the input frame as it is. For diagnostics on the
-    /// working frame (`lane_eval::labelled::census_set`); no copy.
+    /// working frame (`lane_eval::labelled::census_lanes`); no copy.
     pub fn working_frame(&self) -> Option<(GreyImage<'_>, (usize, usize))> {
         if !self.scale.resamples() {
             return None;
