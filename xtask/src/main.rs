@@ -3,6 +3,7 @@
 //! `cargo xtask test` is the project's one test command (the README's and `.ci/run`'s).
 
 use std::process::Command;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
@@ -166,13 +167,16 @@ const STEPS: &[Step] = &[
 /// First makes sure the system packages the workspace build and tests need are present (Debian
 /// `libclang-dev`, for the `v4l` crate's bindgen step, and `ffmpeg`, for video inputs; installed
 /// with apt-get when missing and running as root or under CI with passwordless sudo), then runs
-/// every step and closes with one `xtask: N passed, M failed` line.
+/// every step, printing each one's wall time as it ends, and closes with a table of the steps'
+/// wall times (`timing_table`) and one `xtask: N passed, M failed` line.
 fn test() -> Result<()> {
     vivid::ensure_test_packages()
         .context("the workspace build and tests need libclang-dev and ffmpeg (Debian)")?;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let this = std::env::current_exe().context("cannot locate the xtask binary")?;
     let mut failed = Vec::new();
+    let mut timings = Vec::with_capacity(STEPS.len());
+    let gate_start = Instant::now();
     for step in STEPS {
         let (program, args) = match &step.run {
             Run::Cargo(args) => (std::ffi::OsStr::new(&cargo), *args),
@@ -191,18 +195,103 @@ fn test() -> Result<()> {
         if std::env::var_os("CI").is_some() && std::env::var_os("CARGO_INCREMENTAL").is_none() {
             command.env("CARGO_INCREMENTAL", "0");
         }
+        let step_start = Instant::now();
         let status = command
             .status()
             .with_context(|| format!("could not start step `{}`", step.name))?;
-        if !status.success() {
-            eprintln!("xtask: step `{}` FAILED ({status})", step.name);
+        let took = step_start.elapsed();
+        if status.success() {
+            eprintln!("xtask: step `{}` passed in {}", step.name, wall_time(took));
+        } else {
+            eprintln!(
+                "xtask: step `{}` FAILED ({status}) after {}",
+                step.name,
+                wall_time(took)
+            );
             failed.push(step.name);
         }
+        timings.push((step.name, took));
     }
+    eprint!("{}", timing_table(&timings, gate_start.elapsed()));
     let passed = STEPS.len() - failed.len();
     println!("xtask: {passed} passed, {} failed", failed.len());
     if !failed.is_empty() {
         bail!("failed steps: {}", failed.join(", "));
     }
     Ok(())
+}
+
+/// A wall time as the gate prints it: `42 s` under a minute, else `6 min 31 s` (whole seconds,
+/// rounded down: a CI budget is read in minutes).
+fn wall_time(took: Duration) -> String {
+    let secs = took.as_secs();
+    if secs < 60 {
+        format!("{secs} s")
+    } else {
+        format!("{} min {:02} s", secs / 60, secs % 60)
+    }
+}
+
+/// The gate's closing table: each step's wall time and its share of the whole, then the total, so
+/// a CI run shows which step to make faster when the gate nears its budget (README: well inside
+/// 90 minutes, kept under 45).
+fn timing_table(timings: &[(&str, Duration)], total: Duration) -> String {
+    let width = timings
+        .iter()
+        .map(|(name, _)| name.len())
+        .chain(["total".len()])
+        .max()
+        .unwrap_or(0);
+    let total_secs = total.as_secs_f64();
+    let mut out = String::from("xtask: wall time per step\n");
+    for (name, took) in timings {
+        let share = if total_secs > 0.0 {
+            100.0 * took.as_secs_f64() / total_secs
+        } else {
+            0.0
+        };
+        out.push_str(&format!(
+            "  {name:<width$}  {:>12}  {share:5.1} %\n",
+            wall_time(*took)
+        ));
+    }
+    out.push_str(&format!(
+        "  {:<width$}  {:>12}\n",
+        "total",
+        wall_time(total)
+    ));
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wall_times_read_in_seconds_then_minutes() {
+        assert_eq!(wall_time(Duration::from_millis(59_999)), "59 s");
+        assert_eq!(wall_time(Duration::from_secs(60)), "1 min 00 s");
+        assert_eq!(wall_time(Duration::from_secs(391)), "6 min 31 s");
+        assert_eq!(wall_time(Duration::from_secs(2361)), "39 min 21 s");
+    }
+
+    #[test]
+    fn the_timing_table_gives_each_step_its_share_and_the_total() {
+        let table = timing_table(
+            &[
+                ("fmt", Duration::from_secs(3)),
+                ("clippy", Duration::from_secs(391)),
+                ("vivid", Duration::from_secs(206)),
+            ],
+            Duration::from_secs(600),
+        );
+        let lines: Vec<&str> = table.lines().collect();
+        assert_eq!(lines.len(), 5, "{table}");
+        assert_eq!(lines[0], "xtask: wall time per step");
+        // Names padded to the longest, times right-aligned, shares of the total.
+        assert_eq!(lines[1], "  fmt              3 s    0.5 %");
+        assert_eq!(lines[2], "  clippy    6 min 31 s   65.2 %");
+        assert_eq!(lines[3], "  vivid     3 min 26 s   34.3 %");
+        assert_eq!(lines[4], "  total    10 min 00 s");
+    }
 }
