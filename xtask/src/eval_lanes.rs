@@ -31,7 +31,7 @@ use lane_eval::labelled::{
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
 
-use crate::paths::workspace_root;
+use crate::paths::{resolve, workspace_root};
 
 /// Arguments of `cargo xtask eval-lanes`.
 #[derive(clap::Args, Debug)]
@@ -315,14 +315,6 @@ struct PeerFile {
 struct PeerFrame {
     index: u64,
     lanes: [Option<[f64; 3]>; 2],
-}
-
-fn resolve(root: &Path, p: &Path) -> PathBuf {
-    if p.is_absolute() {
-        p.to_owned()
-    } else {
-        root.join(p)
-    }
 }
 
 /// The labelled sets under `dir`, sorted by name.

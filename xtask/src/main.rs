@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 mod eval_lanes;
 mod fixtures;
 mod halves;
+mod import_lanes;
 mod ins_real;
 mod monte_carlo;
 mod paths;
@@ -52,6 +53,9 @@ enum Cmd {
     /// Score the lane tracker on the real labelled sets (--data, default ../shared/data/lanes),
     /// beside the ceiling, the best of the default's candidates, the presets and the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
     EvalLanes(eval_lanes::EvalLanesArgs),
+    /// Write a labelled set in TuSimple's or CULane's format as a labels.json that eval-lanes
+    /// scores (`--data` its parent directory); the images stay where they are.
+    ImportLanes(import_lanes::ImportLanesArgs),
     /// Write the labelled sets enlarged K times (frames bicubic, labels mapped) into
     /// target/lanes-{K}x, for `eval-lanes --data` at another resolution.
     ResampleLanes(resample_lanes::ResampleLanesArgs),
@@ -79,6 +83,7 @@ fn main() -> Result<()> {
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
         Cmd::EvalLanes(args) => eval_lanes::run(args),
+        Cmd::ImportLanes(args) => import_lanes::run(args),
         Cmd::ResampleLanes(args) => resample_lanes::run(args),
         Cmd::Python(args) => python::run(args),
         Cmd::Halves => halves::run(),

@@ -17,6 +17,9 @@
 //! `right` are the two boundaries of the ego lane; frames with one `clip` id are consecutive video
 //! frames, run through one tracker in index order (the tracker is reset between clips).
 //!
+//! Sets labelled in TuSimple's or CULane's format are read into this schema by [`import`]
+//! (`cargo xtask import-lanes`).
+//!
 //! ## The rules ([`ScoringRules`])
 //! Only the ego lanes are scored, each against the tracker's lane of the same side. The label
 //! points scored are those at or below the evaluation row `eval_top_fraction · height` (the near
@@ -75,7 +78,8 @@ pub struct LabelLane {
 pub struct LabelFrame {
     /// Index in the set (frames are run in this order).
     pub index: u64,
-    /// Image file, relative to the set's directory.
+    /// Image file, relative to the set's directory; an absolute path is taken as it is (what
+    /// [`import`]'s sets hold: the user's images stay where they are).
     pub file: String,
     /// Clip id: frames with one id are consecutive video frames.
     pub clip: String,
@@ -706,6 +710,7 @@ fn fit_slope(pts: &[[f64; 2]]) -> f64 {
 
 mod census;
 mod choice_bound;
+pub mod import;
 #[cfg(test)]
 mod tests;
 
