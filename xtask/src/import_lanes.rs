@@ -7,6 +7,7 @@
 //! directory holds only `labels.json` and the user's recording stays where it is. Every image's
 //! size is read from its header; the set takes the first one's, and a frame of another size is
 //! skipped and reported, like a label record that cannot be read or an image that is missing.
+//! A `labels.json` already in the set directory is replaced only when this command wrote it.
 
 use std::path::{Path, PathBuf};
 
@@ -18,6 +19,10 @@ use lane_eval::labelled::import::{
 use lane_eval::labelled::{LABEL_SCHEMA, LabelFrame, LabelSet, SceneKind};
 
 use crate::paths::{resolve, workspace_root};
+
+/// The `licence` of a set this command writes: it marks the `labels.json` files it may
+/// overwrite (never another one, such as a shared set's).
+const IMPORTED_LICENCE: &str = "not stated (imported by cargo xtask import-lanes)";
 
 /// The label formats `import-lanes` reads.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -209,7 +214,7 @@ pub fn import(
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
-        licence: "not stated (imported by cargo xtask import-lanes)".to_owned(),
+        licence: IMPORTED_LICENCE.to_owned(),
         width,
         height,
         frames,
@@ -219,6 +224,15 @@ pub fn import(
     // What eval-lanes will read: checked by its own reader before it is written.
     LabelSet::from_json_str(&path.display().to_string(), &text)
         .context("import-lanes: the written set does not read back")?;
+    if path.exists() {
+        let ours = LabelSet::load(out).is_ok_and(|old| old.licence == IMPORTED_LICENCE);
+        if !ours {
+            bail!(
+                "import-lanes: {} exists and was not written by import-lanes: give another --out",
+                path.display()
+            );
+        }
+    }
     std::fs::create_dir_all(out)
         .with_context(|| format!("import-lanes: cannot create {}", out.display()))?;
     std::fs::write(&path, text)
@@ -382,6 +396,40 @@ mod tests {
         let sides: Vec<LabelSide> = set.frames[0].lanes.iter().map(|l| l.side).collect();
         assert_eq!(sides, [LabelSide::Left, LabelSide::Right]);
         assert_eq!(LabelSet::load(&out).expect("written"), set);
+        // Importing again over its own set is allowed; over a set it did not write, refused,
+        // and that set is left as it was.
+        assert!(
+            import(
+                Format::Culane,
+                std::slice::from_ref(&list),
+                None,
+                &out,
+                SceneKind::Road
+            )
+            .is_ok()
+        );
+        let theirs = dir.join("sets/theirs");
+        std::fs::create_dir_all(&theirs).expect("their set");
+        let their_text = std::fs::read_to_string(out.join("labels.json"))
+            .expect("labels")
+            .replace(IMPORTED_LICENCE, "CC-BY-4.0");
+        std::fs::write(theirs.join("labels.json"), &their_text).expect("their labels");
+        let over = import(
+            Format::Culane,
+            std::slice::from_ref(&list),
+            None,
+            &theirs,
+            SceneKind::Road,
+        )
+        .expect_err("not ours");
+        assert!(
+            over.to_string().contains("not written by import-lanes"),
+            "{over}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(theirs.join("labels.json")).expect("kept"),
+            their_text
+        );
         // Two list files are refused: one CULane list is one set.
         let two = import(
             Format::Culane,
