@@ -74,11 +74,15 @@ pub fn run(args: ImportLanesArgs) -> Result<()> {
         Kind::Road => SceneKind::Road,
         Kind::Indoor => SceneKind::Indoor,
     };
+    if args.root.is_some() && args.format != Format::Culane {
+        bail!(
+            "import-lanes: --root is CULane's data root (TuSimple's images are under its \
+             label file's directory)"
+        );
+    }
     let culane_root = args.root.as_deref().map(|r| resolve(&root, r));
     let (set, skipped) = import(args.format, &labels, culane_root.as_deref(), &out, kind)?;
-    for s in &skipped {
-        eprintln!("import-lanes: skipped {s}");
-    }
+    report_skipped(&skipped);
     println!(
         "import-lanes: {} frames ({}×{}) into {} ({} skipped); score with \
          `cargo xtask eval-lanes --no-peer --data {}`",
@@ -90,6 +94,22 @@ pub fn run(args: ImportLanesArgs) -> Result<()> {
         out.parent().unwrap_or(&out).display()
     );
     Ok(())
+}
+
+/// The skipped records shown one per line, at most this many (a wrong `--root` skips every image).
+const SKIPPED_SHOWN: usize = 20;
+
+/// Print what was skipped: the first [`SKIPPED_SHOWN`] records, then how many more.
+fn report_skipped(skipped: &[Skipped]) {
+    for s in skipped.iter().take(SKIPPED_SHOWN) {
+        eprintln!("import-lanes: skipped {s}");
+    }
+    if skipped.len() > SKIPPED_SHOWN {
+        eprintln!(
+            "import-lanes: … and {} more skipped",
+            skipped.len() - SKIPPED_SHOWN
+        );
+    }
 }
 
 /// Read `labels` in `format`, write `out/labels.json` and return the set and what was skipped.
@@ -189,9 +209,7 @@ pub fn import(
         });
     }
     let Some((width, height)) = size.filter(|_| !frames.is_empty()) else {
-        for s in &skipped {
-            eprintln!("import-lanes: skipped {s}");
-        }
+        report_skipped(&skipped);
         bail!("import-lanes: no frame could be imported (see the skipped records above)");
     };
     let name = out.file_name().map_or_else(
