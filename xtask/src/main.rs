@@ -129,25 +129,14 @@ const STEPS: &[Step] = &[
         run: Run::Cargo(&["test", "--workspace", "--all-targets", "--all-features"]),
     },
     Step {
-        // The build a user without libclang gets: `--device` must say capture is not built in
-        // (the `cli` and `capture_cli` tests, built without the capture features). Selected
-        // from the whole workspace with its other features on, so that most dependencies'
-        // features are unified as in `test` above and fewer crates are compiled again
-        // (`-p nav-app --no-default-features` unifies them for nav-app alone: serde, syn,
-        // zerocopy, num-complex, matrixmultiply and all that builds on them, faer and nalgebra
-        // among it, compiled a second time, 4 min 29 s of the 2-core gate on 2026-12-02).
+        // The build a user without libclang gets: `--device` must say capture is not built in.
+        // `-p nav-app` alone, its dependencies' features unified for nav-app only: they are
+        // compiled again here (2026-12-02: 4 min 29 s of the 2-core gate), but the Python
+        // step's wheel then reuses them (3 min 42 s). With `--workspace --no-default-features`
+        // and only nav-app's `cli` and `capture_cli` tests this step took 2 min 45 s and the
+        // Python step 7 min 04 s, its wheel compiling them itself: 2 min more in all.
         name: "test-no-capture",
-        run: Run::Cargo(&[
-            "test",
-            "--workspace",
-            "--no-default-features",
-            "--features",
-            "ita-nav-py/extension-module,toml-config/proptest",
-            "--test",
-            "cli",
-            "--test",
-            "capture_cli",
-        ]),
+        run: Run::Cargo(&["test", "-p", "nav-app", "--no-default-features"]),
     },
     Step {
         // The crate boundaries: lane-tracker, lane-io, lane-eval and ins-sim pull in nothing they must not.
