@@ -161,10 +161,7 @@ pub fn import(
                     }),
                 };
                 match lanes {
-                    Ok(lanes) => {
-                        let clip = image.rsplit_once('/').map_or("", |(d, _)| d).to_owned();
-                        read.push((data_root.clone(), ImportedFrame { image, clip, lanes }));
-                    }
+                    Ok(lanes) => read.push((data_root.clone(), ImportedFrame::new(image, lanes))),
                     Err(s) => skipped.push(s),
                 }
             }
@@ -208,7 +205,8 @@ pub fn import(
             lanes: assign_sides(&f.lanes, width, height),
         });
     }
-    let Some((width, height)) = size.filter(|_| !frames.is_empty()) else {
+    // Set by the first readable image, which is always kept: no size, no frame.
+    let Some((width, height)) = size else {
         report_skipped(&skipped);
         bail!("import-lanes: no frame could be imported (see the skipped records above)");
     };

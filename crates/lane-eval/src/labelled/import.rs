@@ -70,9 +70,13 @@ struct TusimpleRecord {
     raw_file: String,
 }
 
-/// The directory part of a `/`-separated relative path (`""` for a bare file name).
-fn directory_of(image: &str) -> &str {
-    image.rsplit_once('/').map_or("", |(dir, _)| dir)
+impl ImportedFrame {
+    /// A frame of `image` (a `/`-separated relative path) with its `lanes`; its clip is the
+    /// image's directory (`""` for a bare file name).
+    pub fn new(image: String, lanes: Vec<Vec<[f64; 2]>>) -> Self {
+        let clip = image.rsplit_once('/').map_or("", |(dir, _)| dir).to_owned();
+        Self { image, clip, lanes }
+    }
 }
 
 /// A TuSimple label file's records (`name` is used in the skipped records' reports).
@@ -124,11 +128,7 @@ pub fn parse_tusimple(name: &str, text: &str) -> (Vec<ImportedFrame>, Vec<Skippe
                     .collect()
             })
             .collect();
-        frames.push(ImportedFrame {
-            clip: directory_of(&image).to_owned(),
-            image,
-            lanes,
-        });
+        frames.push(ImportedFrame::new(image, lanes));
     }
     (frames, skipped)
 }
