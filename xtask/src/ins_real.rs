@@ -14,7 +14,7 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use ins_sim::real_sets::{REAL_SEED, REAL_SETS};
 
-use crate::paths::{target_dir, workspace_root};
+use crate::paths::{build_nav_app_release, workspace_root};
 
 /// Arguments of `cargo xtask ins-real`.
 #[derive(clap::Args, Debug)]
@@ -70,23 +70,7 @@ pub fn run(args: InsRealArgs) -> Result<()> {
         root.join(&args.out)
     };
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let build = Command::new(&cargo)
-        .current_dir(&root)
-        .args([
-            "build",
-            "--quiet",
-            "--release",
-            "-p",
-            "nav-app",
-            "--no-default-features",
-        ])
-        .status()
-        .context("cannot run cargo build -p nav-app")?;
-    if !build.success() {
-        bail!("cargo build --release -p nav-app failed ({build})");
-    }
-    let exe = target_dir(&root).join("release/nav-app");
+    let exe = build_nav_app_release(&root)?;
     let mut md = String::from(
         "| set | filter | preset | position RMS / max (m) | velocity RMS (m/s) | attitude RMS (mrad) | epochs inside 2σ pos / vel / att (%) | NIS per dof | NEES per dof |\n|---|---|---|---|---|---|---|---|---|\n",
     );

@@ -12,7 +12,7 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 
-use crate::paths::{target_dir, workspace_root};
+use crate::paths::{build_nav_app_release, target_dir, workspace_root};
 
 /// Arguments of `cargo xtask monte-carlo`: those of `nav-app monte-carlo`, passed through.
 #[derive(Args, Debug)]
@@ -64,23 +64,7 @@ pub fn nav_app_args(user: &[OsString]) -> Vec<OsString> {
 /// Builds `nav-app` and runs it.
 pub fn run(args: MonteCarloArgs) -> Result<()> {
     let root = workspace_root();
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let build = Command::new(&cargo)
-        .current_dir(&root)
-        .args([
-            "build",
-            "--quiet",
-            "--release",
-            "-p",
-            "nav-app",
-            "--no-default-features",
-        ])
-        .status()
-        .context("cannot run cargo build -p nav-app")?;
-    if !build.success() {
-        bail!("cargo build --release -p nav-app failed ({build})");
-    }
-    let exe = target_dir(&root).join("release/nav-app");
+    let exe = build_nav_app_release(&root)?;
     let status = Command::new(&exe)
         .args(nav_app_args(&args.args))
         .status()
