@@ -125,6 +125,8 @@ pub fn consistency(m: &ModeStats, q: usize, dof: usize) -> Option<Consistency> {
     })
 }
 
+/// The time bin of `t` seconds, the last one past the end ([`Stats`](ins_sim::stats::Stats) holds at
+/// least one a mode: checked on load).
 pub(super) fn at(m: &ModeStats, t: usize) -> &[Moments; super::stats::Q] {
     &m.bins[t.min(m.bins.len() - 1)]
 }

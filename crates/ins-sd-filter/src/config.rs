@@ -215,11 +215,7 @@ impl InsSdFilterConfig {
             ErrorStateEstimator::SageHusa(c) => c.validate(),
             _ => Ok(()),
         };
-        checked.map_err(|e| FilterError::InvalidConfig {
-            field: "estimator",
-            requirement: "adaptive-Q configuration must be valid",
-            value: e.to_string(),
-        })?;
+        checked.map_err(|source| FilterError::InvalidEstimator { source })?;
         Ok(())
     }
 

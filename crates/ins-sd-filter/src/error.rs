@@ -20,6 +20,14 @@ pub enum FilterError {
         /// The value found (formatted).
         value: String,
     },
+    /// The adaptive-Q estimator's configuration (`estimator`: window, forgetting factor, …) is
+    /// out of its domain; the estimator's own error names the field.
+    #[error("filter configuration: estimator: {source}")]
+    InvalidEstimator {
+        /// The estimator's error ([`AkfError::InvalidParameter`]).
+        #[source]
+        source: AkfError,
+    },
     /// A time stamp does not advance: IMU samples must be strictly increasing, sightings
     /// non-decreasing.
     #[error("{what} at t = {t_s} s is not after the previous one at {previous_s} s")]
@@ -100,7 +108,7 @@ pub enum FilterError {
     },
     /// The INS rejected its initial state or step.
     #[error("INS: {0}")]
-    Ins(InsError),
+    Ins(#[source] InsError),
     /// The sighting model failed for a landmark (geometry: too close, vertical, NaN).
     #[error("sighting of landmark {landmark} at t = {t_s} s: {source}")]
     Sighting {

@@ -173,16 +173,6 @@ impl Scenario {
         };
         for mode in [Mode::Kf, Mode::Akf, Mode::AkfSageHusa, Mode::AkfStructured] {
             let config = engine::online_config(self, mode);
-            let estimator = match &config.estimator {
-                ins_sd_filter::ErrorStateEstimator::MohamedSchwarz(c) => {
-                    c.validate(akf::DEFAULT_WINDOW_CAPACITY)
-                }
-                ins_sd_filter::ErrorStateEstimator::SageHusa(c) => c.validate(),
-                _ => Ok(()),
-            };
-            if let Err(akf::AkfError::InvalidParameter { field, reason }) = estimator {
-                return Err(named(&format!("estimator.{field}"), reason, String::new()));
-            }
             match config.validate() {
                 Ok(()) => {}
                 Err(ins_sd_filter::FilterError::InvalidConfig {
@@ -190,6 +180,9 @@ impl Scenario {
                     requirement,
                     value,
                 }) => return Err(named(field, requirement.to_string(), value)),
+                Err(ins_sd_filter::FilterError::InvalidEstimator {
+                    source: akf::AkfError::InvalidParameter { field, reason },
+                }) => return Err(named(&format!("estimator.{field}"), reason, String::new())),
                 Err(other) => {
                     return Err(SimError::ScenarioInvalid {
                         field: "filter".to_string(),

@@ -38,6 +38,10 @@ pub enum LaneIoError {
         input: String,
         /// ffmpeg's exit status and last message.
         reason: String,
+        /// What the reader of ffmpeg's output found wrong with it, when that is where it failed
+        /// (no stream header: ffmpeg wrote nothing, or something the reader refuses).
+        #[source]
+        source: Option<Box<LaneIoError>>,
     },
     /// A ROS 2 bag (MCAP) could not be read: the file, the container, or the topic (the error
     /// lists the bag's topics).

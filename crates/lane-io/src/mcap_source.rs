@@ -83,7 +83,10 @@ fn from_image(img: &Image<'_>, frame: &mut GreyFrame) -> Result<(), BagImageProb
             height_px: h,
         });
     }
-    if step < w * bpp || img.data.len() < step * (h - 1) + w * bpp {
+    // The bytes the rows need; where that overflows usize (a 32-bit target: sizes are u32), the
+    // data is short too.
+    let needed = step.checked_mul(h - 1).and_then(|n| n.checked_add(w * bpp));
+    if step < w * bpp || needed.is_none_or(|n| img.data.len() < n) {
         return Err(BagImageProblem::ShortData {
             len: img.data.len(),
             width_px: w,

@@ -115,7 +115,7 @@ impl VideoSource {
             finished: false,
         };
         let Some(stdout) = source.child.stdout.take() else {
-            return Err(source.decode_error("ffmpeg's output pipe is missing"));
+            return Err(source.decode_error("ffmpeg's output pipe is missing", None));
         };
         match Y4mSource::new(
             BufReader::with_capacity(1 << 16, stdout),
@@ -125,12 +125,13 @@ impl VideoSource {
                 source.y4m = Some(y4m);
                 Ok(source)
             }
-            Err(_) => Err(source.decode_error("no video stream")),
+            Err(e) => Err(source.decode_error("no video stream", Some(e))),
         }
     }
 
-    /// Waits for the child and turns its exit status and stderr into a decode error.
-    fn decode_error(&mut self, what: &str) -> LaneIoError {
+    /// Waits for the child and turns its exit status and stderr into a decode error, with the
+    /// reader's own error as its source where there is one.
+    fn decode_error(&mut self, what: &str, source: Option<LaneIoError>) -> LaneIoError {
         let _ = self.child.kill();
         let status = self.child.wait().ok();
         let stderr = self
@@ -148,6 +149,7 @@ impl VideoSource {
                     text => format!(": {}", text.lines().last().unwrap_or(text)),
                 }
             ),
+            source: source.map(Box::new),
         }
     }
 
@@ -173,7 +175,7 @@ impl FrameSource for VideoSource {
                 self.y4m = None;
                 match self.child.wait() {
                     Ok(status) if status.success() => Ok(None),
-                    _ => Err(self.decode_error("decoding stopped")),
+                    _ => Err(self.decode_error("decoding stopped", None)),
                 }
             }
         }

@@ -128,6 +128,21 @@ fn every_pixel_encoding_converts_and_bad_messages_are_skipped_with_their_problem
             m
         }),
         (IMG, image(8, "mono8", 1, |r, c| vec![grey(r, c)])),
+        // A row step and a height at u32::MAX (rows that fit their step): the bytes they need
+        // exceed what follows, and overflow usize on a 32-bit target: short data.
+        (
+            IMG,
+            Image {
+                header: header(9),
+                height: u32::MAX,
+                width: 1,
+                encoding: "mono8",
+                is_bigendian: 0,
+                step: u32::MAX,
+                data: &[0; 16],
+            }
+            .encode(),
+        ),
     ];
     let path = temp("encodings");
     write_bag(&path, &messages);
@@ -145,7 +160,7 @@ fn every_pixel_encoding_converts_and_bad_messages_are_skipped_with_their_problem
         }
     }
     std::fs::remove_file(&path).unwrap();
-    assert_eq!(got.len(), 9);
+    assert_eq!(got.len(), 10);
     let frame_ok = |i: usize, want: Vec<u8>| match &got[i] {
         Ok((t, data)) => {
             assert_eq!(*t, i as f64, "frame {i}");
@@ -177,6 +192,11 @@ fn every_pixel_encoding_converts_and_bad_messages_are_skipped_with_their_problem
         BagImageProblem::PixelEncoding { encoding } if encoding == "yuv422"
     ));
     assert!(matches!(problem(7), BagImageProblem::Message(_)));
+    assert!(matches!(
+        problem(9),
+        BagImageProblem::ShortData { width_px, step, .. }
+            if *width_px == 1 && *step == u32::MAX as usize
+    ));
 }
 
 #[test]

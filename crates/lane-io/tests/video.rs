@@ -161,6 +161,18 @@ fn a_file_ffmpeg_cannot_decode_is_an_error_naming_it() {
         shown.contains("broken.mp4") && shown.contains("ffmpeg"),
         "{shown}"
     );
+    // The reader's own finding is kept as the source: ffmpeg wrote no stream header.
+    let LaneIoError::VideoDecode {
+        source: Some(reader),
+        ..
+    } = &e
+    else {
+        panic!("no reader error kept as the source: {e:?}");
+    };
+    assert!(
+        matches!(**reader, LaneIoError::Y4mHeader { .. }),
+        "{reader}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -297,7 +297,7 @@ pub struct StatsFile {
 
 /// Everything needed to produce the reports: written as `stats.json` by every run (shard or
 /// not) and read back by `merge`. The fields are private so that what the accessors document
-/// holds: modes in `Mode::EVERY` order, each once, all with the same number of time bins; run
+/// holds: modes in `Mode::EVERY` order, each once, all with the same number of time bins, at least one; run
 /// ranges sorted, disjoint and within `0..runs_total`; exclusions and kept runs sorted by mode
 /// then run index, of modes present. A `stats.json` that breaks one is refused on load
 /// ([`SimError::StatsInvalid`] names the field).
@@ -373,6 +373,13 @@ impl TryFrom<StatsFile> for Stats {
                     first.mode,
                     first.bins.len()
                 ),
+            ));
+        }
+        // Every report reads the bin of a time (clamped to the last bin): none without one.
+        if let Some(m) = f.modes.iter().find(|m| m.bins.is_empty()) {
+            return Err(invalid(
+                "modes",
+                format!("`{}` has no time bins (at least one is needed)", m.mode),
             ));
         }
         f.run_ranges.sort_unstable();

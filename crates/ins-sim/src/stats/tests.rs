@@ -71,6 +71,10 @@ fn modes_out_of_order_duplicated_or_of_other_lengths_are_refused() {
     let mut f = file(&[Mode::Standalone, Mode::Kf]);
     f.modes[1].bins.pop();
     assert_eq!(invalid_field(Stats::try_from(f)), "modes");
+    // No time bin at all (a truncated or hand-edited stats.json): refused, not read past.
+    let mut f = file(&[Mode::Standalone, Mode::Kf]);
+    f.modes.iter_mut().for_each(|m| m.bins.clear());
+    assert_eq!(invalid_field(Stats::try_from(f)), "modes");
     // From stats.json: the serde error carries the reason.
     let mut f = file(&[Mode::Standalone, Mode::Kf]);
     f.modes.reverse();

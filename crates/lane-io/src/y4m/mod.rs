@@ -76,7 +76,9 @@ impl Y4mHeader {
         }
         let (mut width, mut height, mut fps, mut chroma) = (None, None, 0.0, Y4mChroma::C420);
         for token in tokens {
-            let (tag, value) = token.split_at(1);
+            // A token whose first character is not ASCII has no tag: the whole token is
+            // refused below as an unknown tag (splitting inside a character would panic).
+            let (tag, value) = token.split_at_checked(1).unwrap_or((token, ""));
             match tag {
                 "W" => {
                     width = Some(

@@ -76,6 +76,11 @@ fn bad_headers_are_typed_errors_naming_the_stream() {
         (b"YUV4MPEG2 W4 H3 Fabc\n", "frame rate"),
         (b"YUV4MPEG2 W4 H3 Q9\n", "unknown tag"),
         (b"\xff\xfe\n", "ASCII"),
+        // A token starting with a character of more than one byte: a tag error, not a panic.
+        (
+            "YUV4MPEG2 W4 H3 \u{a9}\n".as_bytes(),
+            "unknown tag `\u{a9}`",
+        ),
     ];
     for (bytes, what) in cases {
         let err = Y4mSource::new(*bytes, "clip.y4m").unwrap_err();
