@@ -254,15 +254,12 @@ impl Default for ImuConfig {
 
 /// Parses section `section` (e.g. `"imu"`) of a TOML document into `T` and returns it
 /// unvalidated, through the workspace's one TOML loader (crate `toml-config`). Unknown keys are
-/// rejected (`deny_unknown_fields`) with the key named; the message gives the line and column
-/// (`line 12, column 1: unknown field …`).
+/// rejected (`deny_unknown_fields`) with the key named; the loader's error, kept as the source,
+/// gives the line and column (`TOML text:12:1: unknown field …`).
 pub fn parse_section<T: DeserializeOwned>(toml_text: &str, section: &str) -> Result<T, InsError> {
-    let toml_err = |e: toml_config::TomlError| InsError::Toml {
+    let toml_err = |source| InsError::Toml {
         section: section.to_string(),
-        message: match (e.line, e.column) {
-            (Some(l), Some(c)) => format!("line {l}, column {c}: {}", e.message),
-            _ => e.message,
-        },
+        source: Box::new(source),
     };
     toml_config::TomlDoc::parse("TOML text", toml_text)
         .map_err(toml_err)?

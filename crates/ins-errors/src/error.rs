@@ -15,12 +15,14 @@ pub enum InsError {
         value: String,
     },
     /// A TOML document or section could not be parsed into the config struct.
-    #[error("TOML section [{section}]: {message}")]
+    #[error("TOML section [{section}]: {source}")]
     Toml {
         /// Section name (`trajectory`, `imu`).
         section: String,
-        /// Parser message (names the unknown or mistyped key).
-        message: String,
+        /// The loader's error: line, column and message (names the unknown or mistyped key);
+        /// boxed, so that every `Result` carrying an `InsError` stays small.
+        #[source]
+        source: Box<toml_config::TomlError>,
     },
     /// A caller-owned buffer has the wrong length.
     #[error("{what}: buffer length {got}, expected {expected}")]

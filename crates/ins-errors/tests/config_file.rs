@@ -76,7 +76,8 @@ fn bad_values_in_file_name_the_field() {
     let e =
         parse_section::<ImuConfig>(&imu_with("accel_bias_sigma_mg = \"3\""), "imu").unwrap_err();
     assert!(
-        matches!(&e, InsError::Toml { message, .. } if message.contains("accel_bias_sigma_mg")),
+        matches!(&e, InsError::Toml { source, .. }
+            if source.message.contains("accel_bias_sigma_mg") && source.line.is_some()),
         "{e}"
     );
     let e = parse_section::<ImuConfig>(&imu_with("bias_model = \"sometimes\""), "imu").unwrap_err();

@@ -111,9 +111,9 @@ proptest! {
     ) {
         match parse_section::<ImuConfig>(&text, "imu") {
             Ok(_) => {}
-            Err(InsError::Toml { section, message }) => {
+            Err(InsError::Toml { section, source }) => {
                 prop_assert_eq!(section, "imu");
-                prop_assert!(!message.is_empty());
+                prop_assert!(!source.message.is_empty());
             }
             Err(other) => prop_assert!(false, "unexpected {other}"),
         }
