@@ -259,7 +259,7 @@ pub fn import(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lane_eval::labelled::{LabelSide, track_label_set};
+    use lane_eval::labelled::{LabelSide, ScoringRules, score_frame, track_label_set};
     use lane_tracker::{Estimator, TrackerConfig};
 
     /// A fresh scratch directory under the build directory.
@@ -351,6 +351,16 @@ mod tests {
         let cfg = TrackerConfig::default_preset().expect("default");
         let predictions = track_label_set(&out, &back, &cfg, Estimator::Kif).expect("tracked");
         assert_eq!(predictions.len(), 2);
+        // The labels were written on the drawn stripes, so the tracker's two lanes match them.
+        for (frame, prediction) in back.frames.iter().zip(&predictions) {
+            let t = score_frame(frame, 160, 90, prediction, &ScoringRules::default());
+            assert_eq!(
+                (t.label_lanes, t.tusimple_matched),
+                (2, 2),
+                "{}: {prediction:?}",
+                frame.file
+            );
+        }
     }
 
     #[test]

@@ -145,7 +145,7 @@ fn q_hat_estimates_the_interval_noise_when_predicting_in_substeps() {
 }
 
 #[test]
-fn adaptive_filter_started_with_q_100x_wrong_approaches_the_true_q() {
+fn adaptive_filter_started_with_q_100x_wrong_settles_within_a_factor_of_two_of_the_true_q() {
     // The loop feeds each projected Q̂ back as the next Q. Measured behaviour (8 seeds): the
     // time-averaged Q used settles at q11 +40…+80 %, q22 −8…−20 % with the paper's window 10,
     // and q11 −5…+47 %, q22 −7…+1 % with window 50 — a biased but bounded fixed point, far from

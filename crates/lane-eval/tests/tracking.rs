@@ -258,6 +258,10 @@ fn a_lost_lane_is_reported_lost_without_coefficients_and_recovers() {
         for lane in reports[f as usize].unwrap().lanes {
             assert_eq!(lane.state, LaneState::Coasting, "frame {f}");
             assert_eq!(lane.points, 0);
+            assert!(
+                lane.coeffs.is_some(),
+                "frame {f}: a coasting lane reports its prediction"
+            );
         }
     }
     let back = reports[wall_end as usize].unwrap();

@@ -488,17 +488,33 @@ fn bad_lane_input_is_an_error_not_a_panic() {
         Err(GeometryError::NonFinite { .. })
     ));
     // A mark thrown far to the side: a finite geometry or an error, never a panic.
-    let _ = ego.geometry(&[0.0, 0.0, -1.0e7], &ok);
-    // Random coefficients never panic.
+    if let Ok(g) = ego.geometry(&[0.0, 0.0, -1.0e7], &ok) {
+        assert!(g.to_vector().iter().all(|v| v.is_finite()), "{g:?}");
+    }
+    // Random coefficients never panic: each gives a finite estimate (geometry, σ, covariance)
+    // or an error (these draws all give estimates).
     let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let (mut finite, mut refused) = (0, 0);
     for _ in 0..2000 {
         let l = [
             rng.random_range(-1.0..1.0),
             rng.random_range(-50.0..50.0),
             rng.random_range(-1e4..1e4),
         ];
-        let _ = ego.estimate(&l, &p, &ok, &p);
+        match ego.estimate(&l, &p, &ok, &p) {
+            Ok(lane) => {
+                assert!(
+                    lane.geometry.to_vector().iter().all(|v| v.is_finite())
+                        && lane.sigma.to_vector().iter().all(|v| v.is_finite())
+                        && lane.covariance.iter().all(|v| v.is_finite()),
+                    "a non-finite estimate for {l:?}: {lane:?}"
+                );
+                finite += 1;
+            }
+            Err(_) => refused += 1,
+        }
     }
+    assert!(finite > 1000, "{finite} finite, {refused} refused");
 }
 
 /// Rows `[far, near]` of a mark's image over a ground range, as `image_parabola` fits them.

@@ -8,7 +8,8 @@ use lane_tracker::camera::{
     LookaheadConfig, MountingConfig,
 };
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
+use proptest::strategy::ValueTree;
+use proptest::test_runner::{Config, RngSeed, TestRunner};
 
 fn proptest_config() -> Config {
     Config {
@@ -122,16 +123,6 @@ proptest! {
         }
     }
 
-    /// Any config the validator accepts serialises to TOML and parses back to itself.
-    #[test]
-    fn valid_configs_round_trip(cfg in arb_config()) {
-        if cfg.validate().is_ok() {
-            let text = toml::to_string(&cfg).unwrap();
-            let back = CameraConfig::from_toml_str("round trip", &text).unwrap();
-            prop_assert_eq!(back, cfg);
-        }
-    }
-
     /// Modelled cameras near the presets are accepted and round-trip.
     #[test]
     fn plausible_cameras_validate_and_round_trip(
@@ -164,4 +155,122 @@ fn a_bad_camera_field_is_named_with_its_file_line_and_column() {
         + 1;
     assert!(e.starts_with(&format!("cam.toml:{line}:")), "{e}");
     assert!(e.contains("hieght_m"), "{e}");
+}
+
+/// Configs near the presets: a pinhole camera (focal length, principal point inside the image,
+/// height, pitch down, small roll and yaw) or a homography of a trapezoid in the image onto a
+/// rectangle on the ground ahead, with an ordered look-ahead. Most are valid; some are not (a
+/// look-ahead beyond the horizon, a trapezoid the other way up).
+fn plausible_config() -> impl Strategy<Value = CameraConfig> {
+    let pinhole = (
+        100.0f64..2000.0,
+        0.2f64..0.8,
+        0.2f64..0.8,
+        0.1f64..5.0,
+        -0.1f64..0.8,
+        -0.1f64..0.1,
+        -0.1f64..0.1,
+    );
+    let trapezoid = (
+        0.3f64..0.5,
+        0.02f64..0.2,
+        0.3f64..0.7,
+        1.0f64..3.0,
+        2.0f64..10.0,
+        5.0f64..60.0,
+    );
+    (
+        (64usize..2000, 48usize..1500),
+        prop_oneof![pinhole.prop_map(Ok), trapezoid.prop_map(Err)],
+        (0.5f64..20.0, 1.1f64..10.0),
+    )
+        .prop_map(|((w, h), camera, (near, ratio))| {
+            let (wf, hf) = (w as f64, h as f64);
+            let (intrinsics, mounting, homography) = match camera {
+                Ok((f, cx, cy, height, pitch, roll, yaw)) => (
+                    Some(IntrinsicsConfig {
+                        focal_length_px: f,
+                        principal_point_px: [cx * wf, cy * hf],
+                    }),
+                    Some(MountingConfig {
+                        height_m: height,
+                        pitch_down_rad: pitch,
+                        roll_rad: roll,
+                        yaw_rad: yaw,
+                    }),
+                    None,
+                ),
+                Err((bottom, top, top_row, half_m, near_m, far_m)) => (
+                    None,
+                    None,
+                    Some(HomographyConfig {
+                        image_points_px: [
+                            [(0.5 - bottom) * wf, hf - 1.0],
+                            [(0.5 + bottom) * wf, hf - 1.0],
+                            [(0.5 + top) * wf, top_row * hf],
+                            [(0.5 - top) * wf, top_row * hf],
+                        ],
+                        // Ground frame: X forward, Y right.
+                        ground_points_m: [
+                            [near_m, -half_m],
+                            [near_m, half_m],
+                            [near_m + far_m, half_m],
+                            [near_m + far_m, -half_m],
+                        ],
+                    }),
+                ),
+            };
+            CameraConfig {
+                image_size_px: [w, h],
+                intrinsics,
+                mounting,
+                homography,
+                lookahead: LookaheadConfig {
+                    near_m: near,
+                    far_m: near * ratio,
+                },
+            }
+        })
+}
+
+/// Any config the validator accepts serialises to TOML and parses back to itself, and one it
+/// refuses is refused again when read from its own TOML (the loader validates what it parses).
+/// Arbitrary configs (almost all invalid) and plausible ones (mostly valid) are drawn; the test
+/// fails unless both pinhole and homography configs were accepted often enough for the round
+/// trip to have been exercised.
+#[test]
+fn valid_configs_round_trip_and_invalid_ones_are_refused_from_their_toml() {
+    let mut runner = TestRunner::new(proptest_config());
+    let (mut pinholes, mut homographies, mut refused) = (0usize, 0usize, 0usize);
+    for _ in 0..512 {
+        let strategy = prop_oneof![arb_config(), plausible_config()];
+        let cfg = strategy.new_tree(&mut runner).unwrap().current();
+        let text = toml::to_string(&cfg);
+        match cfg.validate() {
+            Ok(()) => {
+                let back = CameraConfig::from_toml_str("round trip", &text.unwrap()).unwrap();
+                assert_eq!(back, cfg);
+                if cfg.homography.is_some() {
+                    homographies += 1;
+                } else {
+                    pinholes += 1;
+                }
+            }
+            Err(_) => {
+                // Non-finite values have no TOML form the serialiser writes back; any that does
+                // must be refused on load.
+                if let Ok(text) = text {
+                    assert!(
+                        CameraConfig::from_toml_str("refused", &text).is_err(),
+                        "an invalid config loads from its TOML: {cfg:?}"
+                    );
+                }
+                refused += 1;
+            }
+        }
+    }
+    assert!(
+        pinholes >= 50 && homographies >= 50 && refused >= 100,
+        "accepted {pinholes} pinhole and {homographies} homography configs, refused {refused}"
+    );
 }
