@@ -8,15 +8,16 @@ use hough_init::{
 };
 use vision_gradient::EdgeClass;
 
-use super::LaneTracker;
-use super::init::{candidate_sources, counts_as};
+use super::candidates::{CandidateIndex, candidate_sources, counts_as};
+use super::edges::EdgeStage;
+use super::setup::{Rows, Setup};
 
 /// How far beyond its own band a chosen line's candidate pixels are gathered for its fit, in
-/// bands of `init.band_half_width_px` (`LaneTracker::fit_chosen_line`): a selection of the fit
+/// bands of `init.band_half_width_px` (`CandidateIndex::fit_chosen_line`): a selection of the fit
 /// that reaches farther, to a pixel left out, has the full set fitted instead.
 const CHOSEN_LINE_REACH_BANDS: f64 = 5.0;
 
-impl LaneTracker {
+impl CandidateIndex {
     /// `hough_init::fit_around_line` of a chosen `line` on the candidate pixels of `class`,
     /// leaving in `self.candidates` the pixels it was fitted on (`install` reads them): first on
     /// those within the line's band plus [`CHOSEN_LINE_REACH_BANDS`] bands of
@@ -26,31 +27,37 @@ impl LaneTracker {
     /// out on each side), its passes running over a fraction of the pixels — else on the full set.
     pub(super) fn fit_chosen_line(
         &mut self,
+        edges: &EdgeStage,
         class: EdgeClass,
         line: HoughLine,
+        rows: Rows,
+        setup: &Setup,
     ) -> Result<LaneInit, HoughError> {
-        if let Some(init) = self.fit_chosen_line_near(class, line)? {
+        if let Some(init) = self.fit_chosen_line_near(edges, class, line, rows, setup)? {
             return Ok(init);
         }
-        self.fill_candidates(class);
-        fit_around_line(&self.candidates, line, &self.init_params)
+        self.fill(edges, class, setup);
+        fit_around_line(&self.candidates, line, &setup.init_params)
     }
 
     /// [`Self::fit_chosen_line`]'s fit on the pixels near the line, `None` where a selection
     /// of the fit reaches a pixel left out (or the line is degenerate).
     pub(super) fn fit_chosen_line_near(
         &mut self,
+        edges: &EdgeStage,
         class: EdgeClass,
         line: HoughLine,
+        rows: Rows,
+        setup: &Setup,
     ) -> Result<Option<LaneInit>, HoughError> {
-        let band_px = self.init_params.band_px;
+        let band_px = setup.init_params.band_px;
         // (A line `fit_around_line_where` would not fit on a subset is fitted on the full set.)
         let Some((line_cols, cos_abs)) = line.columns(MIN_WHERE_COS) else {
             return Ok(None);
         };
         let reach_px = band_px / cos_abs + CHOSEN_LINE_REACH_BANDS * band_px;
-        self.fill_candidates_near(class, &line_cols, reach_px);
-        let (top, bottom) = self.search_rows;
+        self.fill_near(edges, class, &line_cols, reach_px, rows, setup);
+        let (top, bottom) = rows;
         let left_out = &self.left_out_cols;
         // Whether no pixel left out lies within `h` (and half a pixel, for rounding) of the
         // curve `c` on any row: the nearest ones on each side are farther.
@@ -63,22 +70,30 @@ impl LaneTracker {
                 f64::from(left) < x - h - 0.5 && f64::from(right) > x + h + 0.5
             })
         };
-        fit_around_line_where(&self.candidates, line, &self.init_params, complete)
+        fit_around_line_where(&self.candidates, line, &setup.init_params, complete)
     }
 
-    /// [`Self::fill_candidates`] restricted to the pixels within `reach_px` columns of the line
-    /// `line_cols` (its column by row), in the same order (`init::candidate_sources`); `self.left_out_cols[r]` = the columns of
+    /// [`Self::fill`] restricted to the pixels within `reach_px` columns of the line
+    /// `line_cols` (its column by row), in the same order (`candidates::candidate_sources`); `self.left_out_cols[r]` = the columns of
     /// the nearest candidate pixels of row `r` left out on each side (`±∞` without one), over
-    /// the rows searched. No allocation (a subset of what `fill_candidates` holds).
-    fn fill_candidates_near(&mut self, class: EdgeClass, line_cols: &Parabola, reach_px: f64) {
+    /// the rows searched. No allocation (a subset of what `fill` holds).
+    fn fill_near(
+        &mut self,
+        edges: &EdgeStage,
+        class: EdgeClass,
+        line_cols: &Parabola,
+        reach_px: f64,
+        rows: Rows,
+        setup: &Setup,
+    ) {
         self.candidates.clear();
-        let (top, bottom) = self.search_rows;
+        let (top, bottom) = rows;
         if let Some(rows) = self.left_out_cols.get_mut(top..bottom) {
             rows.fill((f32::NEG_INFINITY, f32::INFINITY));
         }
-        let near_vertical = self.near_vertical_either_class();
-        let votes = self.cfg.gradient.stripe_paired_votes;
-        for pixels in candidate_sources(&self.edges, &self.paired, votes) {
+        let near_vertical = setup.near_vertical_either_class();
+        let votes = setup.cfg.gradient.stripe_paired_votes;
+        for pixels in candidate_sources(&edges.edges, &edges.paired, votes) {
             for row in pixels.chunk_by(|a, b| a.row_px == b.row_px) {
                 let Some(first) = row.first() else { continue };
                 let centre = line_cols.col_at_row(f64::from(first.row_px));

@@ -49,7 +49,9 @@ use hough_init::Parabola;
 use nalgebra::Vector3;
 use vision_gradient::GreyImage;
 
-use super::LaneTracker;
+use super::lane::{Health, Lane};
+use super::report::Side;
+use super::setup::{Rows, Setup};
 
 /// Least mark contrast (grey levels) for a row to be read.
 const MIN_CONTRAST: f64 = 20.0;
@@ -264,65 +266,71 @@ fn valley_middle(row: &[u8], x_hat: f64, max_width_px: i64) -> Option<PairRow> {
     })
 }
 
-impl LaneTracker {
-    /// Lane `i`'s estimate moved to the middle of a double line, if its rows show one (module
-    /// docs); over the rows `self.search_rows`. Returns whether it moved.
-    pub(super) fn centre_on_double_line(&mut self, i: usize, image: &GreyImage<'_>) -> bool {
-        let Some(c) = self.lanes[i].filter.as_ref().map(|f| f.coeffs()) else {
-            return false;
+/// The estimate of the lane on `side` moved to the middle of a double line, if `rows` show one
+/// (module docs). Returns whether it moved (a filter refusing the new estimate is counted in
+/// `health` and leaves the lane as it was).
+pub(super) fn centre_on_double_line(
+    lane: &mut Lane,
+    side: Side,
+    image: &GreyImage<'_>,
+    rows: Rows,
+    setup: &Setup,
+    health: &mut Health,
+) -> bool {
+    let Some(c) = lane.filter.as_ref().map(|f| f.coeffs()) else {
+        return false;
+    };
+    let p = Parabola::from_coeffs(c);
+    let (top, bottom) = rows;
+    let max_width_px = i64::from(setup.cfg.gradient.stripe_max_width_px.max(1));
+    let image_width_px = setup.width as f64;
+    // Middles read from a line with its partner on the left, on the right, from between
+    // the lines; the half gaps read.
+    let mut middles = [LineSums::default(); 3];
+    let mut gaps = [LineSums::default(); 3];
+    let mut inside = 0usize;
+    for y in top..bottom {
+        let Some(row) = image.row(y) else { continue };
+        let x_hat = p.col_at_row(y as f64);
+        inside += usize::from((0.0..image_width_px).contains(&x_hat));
+        let Some(read) = pair_middle(row, x_hat, max_width_px)
+            .or_else(|| valley_middle(row, x_hat, max_width_px))
+        else {
+            continue;
         };
-        let p = Parabola::from_coeffs(c);
-        let (top, bottom) = self.search_rows;
-        let max_width_px = i64::from(self.cfg.gradient.stripe_max_width_px.max(1));
-        let image_width_px = self.width as f64;
-        // Middles read from a line with its partner on the left, on the right, from between
-        // the lines; the half gaps read.
-        let mut middles = [LineSums::default(); 3];
-        let mut gaps = [LineSums::default(); 3];
-        let mut inside = 0usize;
-        for y in top..bottom {
-            let Some(row) = image.row(y) else { continue };
-            let x_hat = p.col_at_row(y as f64);
-            inside += usize::from((0.0..image_width_px).contains(&x_hat));
-            let Some(read) = pair_middle(row, x_hat, max_width_px)
-                .or_else(|| valley_middle(row, x_hat, max_width_px))
-            else {
-                continue;
-            };
-            let k = match read.side {
-                PairSide::PartnerLeft => 0,
-                PairSide::PartnerRight => 1,
-                PairSide::Between => 2,
-            };
-            middles[k].add(y as f64, read.middle_offset_px);
-            gaps[k].add(y as f64, read.half_gap_px);
-        }
-        let (major, minor) = if middles[1].rows >= middles[0].rows {
-            (1, 0)
-        } else {
-            (0, 1)
+        let k = match read.side {
+            PairSide::PartnerLeft => 0,
+            PairSide::PartnerRight => 1,
+            PairSide::Between => 2,
         };
-        let (pair, pair_gaps) = (
-            middles[major].merged(middles[2]),
-            gaps[major].merged(gaps[2]),
-        );
-        if pair.rows < MIN_PAIR_ROWS
-            || (pair.rows as f64) < MIN_ROW_FRACTION * inside as f64
-            || 5 * middles[minor].rows > pair.rows
-        {
-            return false;
-        }
-        let (Some((alpha, beta)), Some((gamma, delta))) = (pair.fit(), pair_gaps.fit()) else {
-            return false;
-        };
-        let theta = Vector3::new(p.a1, p.a2 + beta, p.a3 + alpha);
-        let half_gap = |y: usize| (gamma + delta * y as f64).abs();
-        let moved = self.restart_filter(i, &theta);
-        if moved {
-            self.lanes[i].pair_half_gap_px = half_gap(top).max(half_gap(bottom - 1));
-        }
-        moved
+        middles[k].add(y as f64, read.middle_offset_px);
+        gaps[k].add(y as f64, read.half_gap_px);
     }
+    let (major, minor) = if middles[1].rows >= middles[0].rows {
+        (1, 0)
+    } else {
+        (0, 1)
+    };
+    let (pair, pair_gaps) = (
+        middles[major].merged(middles[2]),
+        gaps[major].merged(gaps[2]),
+    );
+    if pair.rows < MIN_PAIR_ROWS
+        || (pair.rows as f64) < MIN_ROW_FRACTION * inside as f64
+        || 5 * middles[minor].rows > pair.rows
+    {
+        return false;
+    }
+    let (Some((alpha, beta)), Some((gamma, delta))) = (pair.fit(), pair_gaps.fit()) else {
+        return false;
+    };
+    let theta = Vector3::new(p.a1, p.a2 + beta, p.a3 + alpha);
+    let half_gap = |y: usize| (gamma + delta * y as f64).abs();
+    let moved = lane.restart_filter(side, &theta, setup, health);
+    if moved {
+        lane.pair_half_gap_px = half_gap(top).max(half_gap(bottom - 1));
+    }
+    moved
 }
 
 #[cfg(test)]

@@ -53,8 +53,11 @@
 use hough_init::Parabola;
 use vision_gradient::GreyImage;
 
-use super::LaneTracker;
 use super::double_line::LineSums;
+use super::lane::Lane;
+use super::report::Side;
+use super::setup::Rows;
+use crate::TrackerConfig;
 
 /// Least grey-level difference across the step.
 const MIN_STEP_CONTRAST: f64 = 20.0;
@@ -172,31 +175,58 @@ fn line_fit(
     Some((sums.fit()?, sums.rows))
 }
 
-impl LaneTracker {
-    /// Lane `i`'s reported boundary moved to the foot of a kerb after its initialisation, if
-    /// its rows show one (module docs; the filter keeps the top edge); over the rows
-    /// `self.search_rows`. Returns whether it moved.
-    pub(super) fn onto_kerb_foot(&mut self, i: usize, image: &GreyImage<'_>) -> bool {
-        let Some(offset) = self.read_kerb_foot(i, image, 1) else {
+/// The kerb stage: reads a kerb's foot beside a lane (its buffer of feet per row sized once).
+#[derive(Debug)]
+pub(super) struct KerbReader {
+    /// The rows' kerb feet `(row, offset)` of the last reading (capacity: the height).
+    feet: Vec<(f64, f64)>,
+}
+
+impl KerbReader {
+    /// A reader for frames `height_px` rows tall.
+    pub(super) fn new(height_px: usize) -> Self {
+        KerbReader {
+            feet: Vec::with_capacity(height_px),
+        }
+    }
+
+    /// The reported boundary of the lane on `side` moved to the foot of a kerb after its
+    /// initialisation, if `rows` show one (module docs; the filter keeps the top edge).
+    /// Returns whether it moved.
+    pub(super) fn onto_kerb_foot(
+        &mut self,
+        lane: &mut Lane,
+        side: Side,
+        image: &GreyImage<'_>,
+        rows: Rows,
+        cfg: &TrackerConfig,
+    ) -> bool {
+        let Some(offset) = self.read(lane, side, image, 1, rows, cfg) else {
             return false;
         };
-        let lane = &mut self.lanes[i];
         lane.kerb_offset_px = offset;
         lane.kerb_misses = 0;
         true
     }
 
-    /// On a tracked frame, lane `i`'s kerb read again on every [`TRACKED_ROW_STEP`]-th row (the
-    /// face widens or narrows as the vehicle moves; the kerb may end): the offset follows the
-    /// reading, and after `track.lost_after_frames` frames in a row without one it is dropped
-    /// and the lane reported on the edge it tracks. Only for a lane with an offset.
-    pub(super) fn recheck_kerb_foot(&mut self, i: usize, image: &GreyImage<'_>) {
-        if self.lanes[i].kerb_offset_px == [0.0; 2] {
+    /// On a tracked frame, the kerb of the lane on `side` read again on every
+    /// [`TRACKED_ROW_STEP`]-th row (the face widens or narrows as the vehicle moves; the kerb
+    /// may end): the offset follows the reading, and after `track.lost_after_frames` frames in
+    /// a row without one it is dropped and the lane reported on the edge it tracks. Only for a
+    /// lane with an offset.
+    pub(super) fn recheck_kerb_foot(
+        &mut self,
+        lane: &mut Lane,
+        side: Side,
+        image: &GreyImage<'_>,
+        rows: Rows,
+        cfg: &TrackerConfig,
+    ) {
+        if lane.kerb_offset_px == [0.0; 2] {
             return;
         }
-        let reading = self.read_kerb_foot(i, image, TRACKED_ROW_STEP);
-        let lost_after = self.cfg.track.lost_after_frames;
-        let lane = &mut self.lanes[i];
+        let reading = self.read(lane, side, image, TRACKED_ROW_STEP, rows, cfg);
+        let lost_after = cfg.track.lost_after_frames;
         if let Some(offset) = reading {
             lane.kerb_offset_px = offset;
             lane.kerb_misses = 0;
@@ -209,20 +239,26 @@ impl LaneTracker {
         }
     }
 
-    /// The offset `[α, β]` of a kerb's foot from lane `i`'s tracked edge, read on every
-    /// `row_step`-th row of `self.search_rows` (module docs), or `None`.
-    fn read_kerb_foot(
+    /// The offset `[α, β]` of a kerb's foot from the tracked edge of the lane on `side`, read
+    /// on every `row_step`-th row of `rows` (module docs), or `None`.
+    fn read(
         &mut self,
-        i: usize,
+        lane: &Lane,
+        side: Side,
         image: &GreyImage<'_>,
         row_step: usize,
+        rows: Rows,
+        cfg: &TrackerConfig,
     ) -> Option<[f64; 2]> {
-        let c = self.lanes[i].filter.as_ref().map(|f| f.coeffs())?;
+        let c = lane.filter.as_ref().map(|f| f.coeffs())?;
         let p = Parabola::from_coeffs(c);
-        let (top, bottom) = self.search_rows;
-        let max_width_px = i64::from(self.cfg.gradient.stripe_max_width_px.max(1));
-        let dir = if i == 0 { -1 } else { 1 };
-        let feet = &mut self.kerb_rows;
+        let (top, bottom) = rows;
+        let max_width_px = i64::from(cfg.gradient.stripe_max_width_px.max(1));
+        let dir = match side {
+            Side::Left => -1,
+            Side::Right => 1,
+        };
+        let feet = &mut self.feet;
         feet.clear();
         let mut inside = 0usize;
         for y in (top..bottom).step_by(row_step.max(1)) {

@@ -68,7 +68,10 @@
 
 use vision_gradient::GreyImage;
 
-use super::{LaneFilter, LaneState, LaneTracker};
+use super::lane::{Health, Lane, LaneFilter};
+use super::report::{LaneState, Side};
+use super::setup::Rows;
+use crate::TrackerConfig;
 use crate::error::FilterFailure;
 
 /// Rows looked at each way from the refinement's middle point for the stripe the trace starts
@@ -162,26 +165,47 @@ pub(super) fn stripe_middle_near(
     best.map(|(middle, _)| middle)
 }
 
-impl LaneTracker {
-    /// Lane `i`'s stripe traced row by row over the rows searched and its middles one more
+/// The stripe tracer: follows a lane's stripe row by row (its buffer of middles sized once).
+#[derive(Debug)]
+pub(super) struct StripeTracer {
+    /// The middles of the stripe followed, one a row (capacity: the height).
+    traced: Vec<(f32, f32)>,
+}
+
+impl StripeTracer {
+    /// A tracer for frames `height_px` rows tall.
+    pub(super) fn new(height_px: usize) -> Self {
+        StripeTracer {
+            traced: Vec::with_capacity(height_px),
+        }
+    }
+
+    /// The stripe of the lane on `side` traced row by row over `rows` and its middles one more
     /// measurement update (module docs). Only a KIF lane updated by its refinement on this
     /// frame, not found by the second search, with edge pixels as measurements. Returns how
     /// many middles were traced into it (0: unchanged), appended to its points after the
     /// refinement's (for overlays and the row profile; every one while the points' buffer, the
     /// tracker's largest, has room). A failed update leaves the lane as it was and is counted
-    /// as a filter failure.
-    pub(super) fn trace_stripe(&mut self, i: usize, image: &GreyImage<'_>) -> usize {
-        let (top, bottom) = self.search_rows;
-        let w_max = self.cfg.gradient.stripe_max_width_px;
+    /// in `health` as a filter failure.
+    pub(super) fn trace(
+        &mut self,
+        lane: &mut Lane,
+        side: Side,
+        image: &GreyImage<'_>,
+        rows: Rows,
+        cfg: &TrackerConfig,
+        health: &mut Health,
+    ) -> usize {
+        let (top, bottom) = rows;
+        let w_max = cfg.gradient.stripe_max_width_px;
         // (At most 2040 / 4: an i16.)
-        let min_step_grey = (self.cfg.gradient.magnitude_threshold / 4).max(1) as i16;
-        let r_sigma_px = self.cfg.filter.r_sigma_px;
+        let min_step_grey = (cfg.gradient.magnitude_threshold / 4).max(1) as i16;
+        let r_sigma_px = cfg.filter.r_sigma_px;
         let follow_reach_px = (FOLLOW_REACH_STRIPES * f64::from(w_max)).max(MIN_FOLLOW_REACH_PX);
-        let lane = &self.lanes[i];
         if lane.state != LaneState::Tracking
             || !lane.updated_now
             || lane.tracked_tall
-            || self.cfg.track.mark_centres
+            || cfg.track.mark_centres
             || w_max < 2
         {
             return 0;
@@ -249,13 +273,11 @@ impl LaneTracker {
             }
         }
         // 3. One more measurement update with the middles.
-        let lane = &mut self.lanes[i];
         let Some(LaneFilter::Kif(kif)) = lane.filter.as_mut() else {
             return 0;
         };
         if let Err(e) = kif.update(&self.traced, r_sigma_px * r_sigma_px / MIDDLE_WEIGHT) {
-            self.counters.filter_failures[i] += 1;
-            self.last_failure[i] = Some(FilterFailure::Kif(e));
+            health.filter_failed(side, FilterFailure::Kif(e));
             return 0;
         }
         // The row profile weighs the refinement's edge pixels 1 and the middles as in the

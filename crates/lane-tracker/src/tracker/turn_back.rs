@@ -37,7 +37,9 @@
 
 use nalgebra::Vector3;
 
-use super::{LaneState, LaneTracker};
+use super::lane::{Health, Lane};
+use super::report::{LaneState, Side};
+use super::setup::{Rows, Setup};
 
 /// The least-squares line `(a2, a3)` of `x = a2·y + a3` through `points` (`(col, row)`, px;
 /// point `i` weighing `weights[i]`, 1 where `weights` has none, as in the lane's row profile)
@@ -96,34 +98,37 @@ pub(super) fn turn_back_line(
         .filter(|(slope, col_at_row_0)| slope.is_finite() && col_at_row_0.is_finite())
 }
 
-impl LaneTracker {
-    /// Lane `i`'s estimate replaced by the least-squares line through its refinement's points
-    /// (and traced middles)
-    /// when it turns back below them (module docs); over the rows `self.search_rows`. Returns
-    /// whether it was replaced. Only a lane whose last refinement pass updated it (tracking:
-    /// a pass that misses leaves it coasting or lost) is read, so its points are that update's
-    /// and, with `init.stripe_trace`, the stripe's middles traced after it, weighing as in
-    /// the trace's update (module `stripe_trace`): evidence as far down as the trace reached.
-    pub(super) fn straighten_turn_back(&mut self, i: usize) -> bool {
-        let lane = &self.lanes[i];
-        if lane.state != LaneState::Tracking || !lane.updated_now {
-            return false;
-        }
-        let Some(coeffs) = lane.filter.as_ref().map(|f| f.coeffs()) else {
-            return false;
-        };
-        let bottom_row_px = self.search_rows.1.saturating_sub(1) as f64;
-        let Some((a2, a3)) = turn_back_line(
-            coeffs,
-            &lane.points,
-            &lane.weights,
-            bottom_row_px,
-            self.width as f64,
-        ) else {
-            return false;
-        };
-        self.restart_filter(i, &Vector3::new(0.0, a2, a3))
+/// The estimate of the lane on `side` replaced by the least-squares line through its
+/// refinement's points (and traced middles) when it turns back below them (module docs); the
+/// bottom of `rows` is the lowest row searched. Returns whether it was replaced. Only a lane
+/// whose last refinement pass updated it (tracking: a pass that misses leaves it coasting or
+/// lost) is read, so its points are that update's and, with `init.stripe_trace`, the stripe's
+/// middles traced after it, weighing as in the trace's update (module `stripe_trace`): evidence
+/// as far down as the trace reached.
+pub(super) fn straighten_turn_back(
+    lane: &mut Lane,
+    side: Side,
+    rows: Rows,
+    setup: &Setup,
+    health: &mut Health,
+) -> bool {
+    if lane.state != LaneState::Tracking || !lane.updated_now {
+        return false;
     }
+    let Some(coeffs) = lane.filter.as_ref().map(|f| f.coeffs()) else {
+        return false;
+    };
+    let bottom_row_px = rows.1.saturating_sub(1) as f64;
+    let Some((a2, a3)) = turn_back_line(
+        coeffs,
+        &lane.points,
+        &lane.weights,
+        bottom_row_px,
+        setup.width as f64,
+    ) else {
+        return false;
+    };
+    lane.restart_filter(side, &Vector3::new(0.0, a2, a3), setup, health)
 }
 
 #[cfg(test)]

@@ -42,7 +42,9 @@
 use nalgebra::Matrix3;
 use vision_gradient::{ColSpan, GreyImage};
 
-use super::LaneReport;
+use super::lane::Lanes;
+use super::report::{InitCandidate, LaneReport, MAX_CANDIDATE_LINES};
+use super::setup::Rows;
 
 /// The integer scale between the input frame and the working frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -160,6 +162,151 @@ impl WorkingScale {
             6 => box_rows::<6>(src, dst, working_width, rows, sums),
             f => box_rows_any(f, src, dst, working_width, rows, sums),
         }
+    }
+}
+
+/// The working-frame stage: the input's size and scale, the working frame's pixels, and what
+/// the accessors hand out with a resampled input (the last frame's reports, candidates, windows
+/// and points mapped to input pixels, refreshed at the end of every frame, also one that
+/// returned an error, and by a reset). Without resampling it holds nothing.
+#[derive(Debug)]
+pub(super) struct WorkingFrame {
+    pub(super) scale: WorkingScale,
+    /// The input frames' size, px.
+    pub(super) input_size: (usize, usize),
+    /// The working frame's size, px.
+    size: (usize, usize),
+    /// The working frame's pixels, its width a row (empty when the input is not resampled),
+    /// and the column sums of its box average (the input's width).
+    pixels: Vec<u8>,
+    sums: Vec<u32>,
+    /// The working rows any stage reads, `[first, end)`: the regions searched and the Sobel's
+    /// row beside them; only these are resampled.
+    rows: Rows,
+    out_lanes: [LaneReport; 2],
+    out_candidates: Vec<InitCandidate>,
+    out_spans: [Vec<ColSpan>; 2],
+    out_points: [Vec<(f32, f32)>; 2],
+}
+
+impl WorkingFrame {
+    /// The stage for `input_size` frames worked on at `scale` (`size`, px), reading the working
+    /// rows `rows`; `lanes` as they start (their reports published, their point buffers'
+    /// capacity kept for the published points).
+    pub(super) fn new(
+        scale: WorkingScale,
+        input_size: (usize, usize),
+        size: (usize, usize),
+        rows: Rows,
+        lanes: &Lanes,
+    ) -> Self {
+        let resampled = scale.resamples();
+        let point_capacity = match lanes.iter().next() {
+            Some(lane) if resampled => lane.points.capacity(),
+            _ => 0,
+        };
+        WorkingFrame {
+            scale,
+            input_size,
+            size,
+            pixels: vec![0; if resampled { size.0 * size.1 } else { 0 }],
+            sums: vec![0; if resampled { input_size.0 } else { 0 }],
+            rows,
+            out_lanes: lanes.reports().map(|r| scale.report_to_input(r)),
+            out_candidates: Vec::with_capacity(if resampled {
+                4 * MAX_CANDIDATE_LINES
+            } else {
+                0
+            }),
+            out_spans: std::array::from_fn(|_| {
+                vec![ColSpan::EMPTY; if resampled { input_size.1 } else { 0 }]
+            }),
+            out_points: std::array::from_fn(|_| Vec::with_capacity(point_capacity)),
+        }
+    }
+
+    /// Whether the input is resampled (`f > 1`).
+    pub(super) fn resamples(&self) -> bool {
+        self.scale.resamples()
+    }
+
+    /// The working frame of `input` (its working rows resampled, the others as they
+    /// were), in a buffer taken out of the stage (no allocation: `take` leaves an empty vector);
+    /// give it back with [`Self::put_back`].
+    pub(super) fn downscale(&mut self, input: &GreyImage<'_>) -> Vec<u8> {
+        let mut pixels = std::mem::take(&mut self.pixels);
+        self.scale
+            .downscale_rows(input, &mut pixels, self.size.0, self.rows, &mut self.sums);
+        pixels
+    }
+
+    /// The buffer [`Self::downscale`] lent out, back.
+    pub(super) fn put_back(&mut self, pixels: Vec<u8>) {
+        self.pixels = pixels;
+    }
+
+    /// The working frame of the last tracked frame and its rows that were resampled, `None`
+    /// when the input is not resampled.
+    pub(super) fn image(&self) -> Option<(GreyImage<'_>, Rows)> {
+        if !self.resamples() {
+            return None;
+        }
+        let (w, h) = self.size;
+        let image = GreyImage::new(&self.pixels, w, h, w).ok()?;
+        Some((image, self.rows))
+    }
+
+    /// With a resampled input: the lanes' reports, candidates, windows and points as they are
+    /// now, mapped to input pixels (module docs), into the buffers the accessors hand out.
+    pub(super) fn publish(&mut self, lanes: &Lanes, candidates: &[InitCandidate]) {
+        let s = self.scale;
+        for (out, report) in self.out_lanes.iter_mut().zip(lanes.reports()) {
+            *out = s.report_to_input(report);
+        }
+        self.out_candidates.clear();
+        // Within capacity: as many as the initialiser holds.
+        self.out_candidates
+            .extend(candidates.iter().map(|c| InitCandidate {
+                coeffs: s.coeffs_to_input(c.coeffs),
+                ..*c
+            }));
+        let f = s.factor();
+        for ((spans, points), lane) in self
+            .out_spans
+            .iter_mut()
+            .zip(&mut self.out_points)
+            .zip(lanes.iter())
+        {
+            for (y, span) in spans.iter_mut().enumerate() {
+                *span = lane
+                    .spans
+                    .get(y / f)
+                    .map_or(ColSpan::EMPTY, |&w| s.span_to_input(w));
+            }
+            points.clear();
+            // Within capacity: the lane's own points buffer's.
+            points.extend(lane.points.iter().map(|&(x, y)| {
+                (
+                    s.to_input_px(f64::from(x)) as f32,
+                    s.to_input_px(f64::from(y)) as f32,
+                )
+            }));
+        }
+    }
+
+    /// The published reports (input pixels), left then right.
+    pub(super) fn lanes(&self) -> [LaneReport; 2] {
+        self.out_lanes
+    }
+
+    /// The published candidates (input pixels).
+    pub(super) fn candidates(&self) -> &[InitCandidate] {
+        &self.out_candidates
+    }
+
+    /// The published report, windows and points of lane `i` (0 left, 1 right), input pixels.
+    pub(super) fn lane(&self, i: usize) -> (LaneReport, &[ColSpan], &[(f32, f32)]) {
+        (self.out_lanes[i], &self.out_spans[i], &self.out_points[i])
     }
 }
 

@@ -6,9 +6,12 @@ use hough_init::Parabola;
 use info_filter::{PowerSums, RowNorm};
 use lane_geometry::{FIT_SAMPLES, FitRows};
 use nalgebra::{Matrix3, Vector3};
-use vision_gradient::{EdgeClass, EdgePixel, GreyImage};
+use vision_gradient::{EdgeBuffer, EdgeClass, EdgePixel, GreyImage};
 
-use super::LaneTracker;
+use super::lane::Lane;
+use super::report::Side;
+use super::setup::{Pass, Rows};
+use crate::TrackerConfig;
 
 /// A window pixel during point selection.
 #[derive(Debug, Clone, Copy)]
@@ -93,7 +96,7 @@ fn mark_centre(row: &[u8], lo: u16, hi: u16, slope: f64) -> Option<(f64, f64)> {
     Some((a as f64 + c, spread / (sw * sw)))
 }
 
-/// [`LaneTracker::lane_fit_rows`] of `points` (with `weights`, or 1 each when `weights` is
+/// [`super::LaneTracker::lane_fit_rows`] of `points` (with `weights`, or 1 each when `weights` is
 /// shorter) over `rows` `[first, last]`.
 pub(super) fn fit_profile(points: &[(f32, f32)], weights: &[f64], rows: [f64; 2]) -> FitRows {
     let mut sum_w = [0.0; FIT_SAMPLES];
@@ -427,22 +430,45 @@ pub(super) const BANDS: usize = 3;
 /// Largest window half-width accepted by the configuration, px.
 pub(crate) const MAX_WINDOW_HALF_WIDTH: usize = 200;
 
-impl LaneTracker {
-    /// Lane `i`'s measurement for this frame from the window pixels in `self.edges` (windows
-    /// `±w` px) about the predicted `coeffs`: fills `lane.points` (and `lane.weights` with mark
-    /// centres). `refining`: the refinement that follows an initialisation, where wide stripes
+/// Point selection: the residual histograms and the window pixels of one lane, in buffers sized
+/// once.
+#[derive(Debug)]
+pub(super) struct PointSelector {
+    /// The window pixels of the lane's class with their residual bin and row band.
+    scratch: Vec<Candidate>,
+    /// The residual histograms, one per third of the rows searched ([`BANDS`]), bins `0..=2w`
+    /// of a window `±w` px.
+    residual_hist: Box<[[u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]>,
+}
+
+impl PointSelector {
+    /// Buffers for `capacity` window pixels (the edge buffer's).
+    pub(super) fn new(capacity: usize) -> Self {
+        PointSelector {
+            scratch: Vec::with_capacity(capacity),
+            residual_hist: Box::new([[0; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]),
+        }
+    }
+
+    /// The measurement for this frame of the lane on `side` from the window pixels `edges`
+    /// (windows `±w` px over `rows`) about the predicted `coeffs`: fills `lane.points` (and
+    /// `lane.weights` with mark centres). In a refinement ([`Pass::Refinement`]) wide stripes
     /// measure their middles (`track.stripe_middles`).
-    pub(super) fn select_points(
+    #[allow(clippy::too_many_arguments)] // the stage's inputs, each named
+    pub(super) fn select(
         &mut self,
-        i: usize,
+        edges: &EdgeBuffer,
+        lane: &mut Lane,
+        side: Side,
         image: &GreyImage<'_>,
         coeffs: [f64; 3],
         w: i64,
-        refining: bool,
+        pass: Pass,
+        rows: Rows,
+        cfg: &TrackerConfig,
     ) {
-        let (top, bottom) = self.search_rows;
-        let max_points = self.cfg.track.max_points_per_lane;
-        let lane = &mut self.lanes[i];
+        let (top, bottom) = rows;
+        let max_points = cfg.track.max_points_per_lane;
         // Outlier rejection: the residuals r = x − x̂(y) of the window pixels are histogrammed
         // in three row bands; pixels farther than `inlier_half_width_px` from their band's
         // midhinge residual (mean of the quartiles) are dropped (clutter, noise, the edges of a shadow).
@@ -460,13 +486,13 @@ impl LaneTracker {
         self.scratch.clear();
         // Joint initialisation (lanes sided by position, not lean): per row, the edge class of
         // the predicted slope (`/`: dx/dy < 0), either class where the mark is near vertical.
-        let joint = self.cfg.init.candidate_lines > 0;
+        let joint = cfg.init.candidate_lines > 0;
         // Orientation gate (`track.orientation_tolerance_deg`): along x = x̂(y) the tangent is
         // (x̂′, 1) and the normal n = (1, −x̂′); the pixel's stored Sobel gradient
         // g = (gx, gy) (`EdgePixel::gradient`) is within the tolerance τ of ±n iff
         // |g × n| ≤ tan τ · |g · n|, with g × n = −(gx·x̂′ + gy) and g · n = gx − gy·x̂′ (no
         // angle computed).
-        let tolerance_deg = self.cfg.track.orientation_tolerance_deg;
+        let tolerance_deg = cfg.track.orientation_tolerance_deg;
         let gate = tolerance_deg > 0.0;
         let tan_tolerance = tolerance_deg.to_radians().tan() as f32;
         let predicted = Parabola::from_coeffs(coeffs);
@@ -477,23 +503,22 @@ impl LaneTracker {
         // settles on its middle and its edge pixels measure it (and the lines of a double line,
         // each narrow, keep measuring the middle between them); from one edge of a wider one
         // the other edge lies beyond the band, and the edge pixels hold the lane on that edge.
-        let stripe_w = if refining && self.cfg.track.stripe_middles && !self.cfg.track.mark_centres
-        {
-            self.cfg.gradient.stripe_max_width_px
-        } else {
-            0
-        };
+        let stripe_w =
+            if pass == Pass::Refinement && cfg.track.stripe_middles && !cfg.track.mark_centres {
+                cfg.gradient.stripe_max_width_px
+            } else {
+                0
+            };
         // (The configuration keeps the half-width finite and > 0.)
-        let stripe_min_w = self
-            .cfg
+        let stripe_min_w = cfg
             .track
             .inlier_half_width_px
             .floor()
             .min(f64::from(u16::MAX)) as u16;
-        let pass = WindowPass {
+        let window = WindowPass {
             predicted,
             joint,
-            lane_class: lane.class,
+            lane_class: side.edge_class(),
             gate,
             tan_tolerance,
             band_rows,
@@ -503,9 +528,9 @@ impl LaneTracker {
         };
         // (Two copies of the pass: tracked frames run the paper's alone.)
         if stripe_w > 0 {
-            pass.gather::<true>(self.edges.pixels(), hist, &mut self.scratch);
+            window.gather::<true>(edges.pixels(), hist, &mut self.scratch);
         } else {
-            pass.gather::<false>(self.edges.pixels(), hist, &mut self.scratch);
+            window.gather::<false>(edges.pixels(), hist, &mut self.scratch);
         }
         // Band centre = midhinge (mean of the quartiles): with the two edges of a mark it
         // lands between them, where a median would pick one edge.
@@ -534,8 +559,8 @@ impl LaneTracker {
         // |bin − centre| ≤ inlier_half_width_px for an integer difference: ≤ its floor (the
         // configuration keeps it finite and > 0); per band, the bins `lo..=hi`.
         // (Capped at the histogram's width: a wider half-width keeps every bin, as it did.)
-        let inlier = (self.cfg.track.inlier_half_width_px.floor() as i64)
-            .min(2 * MAX_WINDOW_HALF_WIDTH as i64);
+        let inlier =
+            (cfg.track.inlier_half_width_px.floor() as i64).min(2 * MAX_WINDOW_HALF_WIDTH as i64);
         let bounds = centre.map(|c| {
             let lo = (c - inlier).clamp(0, i64::from(u16::MAX)) as u16;
             let hi = (c + inlier).clamp(-1, i64::from(u16::MAX)) as i32;
@@ -551,7 +576,7 @@ impl LaneTracker {
         // background is the measurement.
         lane.points.clear();
         lane.weights.clear();
-        let mark_centres = self.cfg.track.mark_centres;
+        let mark_centres = cfg.track.mark_centres;
         if !mark_centres {
             // The paper's measurement: the inlier edge pixels, uniformly decimated (in row
             // order) down to max_points, spread over the rows and over both edges of a mark.
@@ -630,214 +655,4 @@ impl LaneTracker {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// One row of a mark `[left, right)` (columns, px) drawn with area anti-aliasing, grey 90
-    /// on the floor and 200 on the mark, or a step from 90 up to 200 at `left` when `right` is ∞.
-    fn row(left: f64, right: f64) -> Vec<u8> {
-        (0..40)
-            .map(|x| {
-                let (lo, hi) = (x as f64 - 0.5, x as f64 + 0.5);
-                let cover = (hi.min(right) - lo.max(left)).clamp(0.0, 1.0);
-                (90.0 + 110.0 * cover).round() as u8
-            })
-            .collect()
-    }
-
-    #[test]
-    fn mark_centre_is_within_the_sawtooth_bound_of_the_true_centre() {
-        for width in [1.5, 2.0, 2.7, 4.0, 6.3] {
-            for k in 0..20 {
-                let centre = 17.0 + 0.05 * k as f64;
-                let pixels = row(centre - 0.5 * width, centre + 0.5 * width);
-                let (lo, hi) = ((centre - 0.5 * width) as u16, (centre + 0.5 * width) as u16);
-                let (x, v) = mark_centre(&pixels, lo, hi, 0.3).unwrap();
-                // 1/(8w) px, plus the rounding of the grey levels to integers.
-                let bound = 1.0 / (8.0 * width) + 0.01;
-                assert!(
-                    (x - centre).abs() <= bound,
-                    "width {width}, centre {centre}: {x} (bound {bound})"
-                );
-                assert!(v > 0.0 && v.is_finite());
-            }
-        }
-        // A dark mark on a bright floor is found the same way.
-        let dark: Vec<u8> = row(15.2, 18.9).iter().map(|&p| 255 - p + 35).collect();
-        let (x, _) = mark_centre(&dark, 15, 18, 0.0).unwrap();
-        assert!((x - 17.05).abs() < 0.04, "{x}");
-    }
-
-    /// An edge pixel of `class` at `col` on row 0, rising (`gx > 0`) or falling.
-    fn edge(col: u16, rising: bool, class: EdgeClass) -> EdgePixel {
-        EdgePixel {
-            col_px: col,
-            row_px: 0,
-            magnitude: 300,
-            class,
-            gx: if rising { 150 } else { -150 },
-        }
-    }
-
-    #[test]
-    fn an_edge_pixel_of_a_bright_stripe_on_an_even_floor_measures_the_stripe_middle() {
-        use EdgeClass::{LeftLane as L, RightLane as R};
-        // Each pixel's measured column, for stripes more than `widths.0` and at most
-        // `widths.1` columns wide.
-        let measured = |px: &[EdgePixel], grey: &[u8], widths: (u16, u16)| -> Vec<f32> {
-            (0..px.len())
-                .map(|j| match stripe_middle(px, j, grey, widths) {
-                    Some((col, half)) => f32::from(col) + if half { 0.5 } else { 0.0 },
-                    None => f32::from(px[j].col_px),
-                })
-                .collect()
-        };
-        // A mark [15, 25) on a floor of 90 on both sides: edges at 14/15 and 24/25.
-        let mark = row(15.0, 25.0);
-        let px = [
-            edge(14, true, L),
-            edge(15, true, L),
-            edge(24, false, L),
-            edge(25, false, L),
-        ];
-        assert_eq!(measured(&px, &mark, (0, 16)), [19.0, 19.5, 19.5, 20.0]);
-        // Wider than the widest stripe: each pixel its own column; the nearest partner counts.
-        assert_eq!(measured(&px, &mark, (0, 9)), [14.0, 19.5, 19.5, 25.0]);
-        assert_eq!(measured(&px, &mark, (0, 8)), [14.0, 15.0, 24.0, 25.0]);
-        // Not wider than the narrowest (14–24 and 15–25 are 10 columns apart, 15–24 nine).
-        assert_eq!(measured(&px, &mark, (9, 16)), [19.0, 15.0, 24.0, 20.0]);
-        assert_eq!(measured(&px, &mark, (10, 16)), [14.0, 15.0, 24.0, 25.0]);
-        // The partner must be of the pixel's class.
-        let mixed = [edge(15, true, L), edge(24, false, R)];
-        assert_eq!(measured(&mixed, &mark, (0, 16)), [15.0, 24.0]);
-        // A dark stripe (falling, then rising) is not a mark.
-        let dark = [edge(15, false, L), edge(24, true, L)];
-        assert_eq!(measured(&dark, &mark, (0, 16)), [15.0, 24.0]);
-        // A kerb's face: bright between the road (90) and a pavement of another grey (150 from
-        // column 26 on): a step, whose foot the lane keeps.
-        let mut kerb = mark.clone();
-        for g in &mut kerb[26..] {
-            *g = 150;
-        }
-        assert_eq!(measured(&px, &kerb, (0, 16)), [14.0, 15.0, 24.0, 25.0]);
-        // A pavement of almost the floor's grey is still a floor alike on both sides.
-        for g in &mut kerb[26..] {
-            *g = 110;
-        }
-        assert_eq!(measured(&px, &kerb, (0, 16)), [19.0, 19.5, 19.5, 20.0]);
-        // A stripe whose outside lies beyond the row is not measured; nor a pixel not in it.
-        assert_eq!(
-            measured(&px, &mark[..26], (0, 16)),
-            [14.0, 15.0, 24.0, 25.0]
-        );
-        assert_eq!(stripe_middle(&px, 4, &mark, (0, 16)), None);
-    }
-
-    #[test]
-    fn a_stripe_middle_between_two_columns_is_binned_by_its_rounded_residual() {
-        use EdgeClass::LeftLane as L;
-        // The mark [15, 25): edge pixels 15 and 24, middle 19.5; predicted at 19.9, the
-        // residual −0.4 rounds to 0 (bin w), where the left column's −0.9 would round to −1.
-        let mark = row(15.0, 25.0);
-        let image = GreyImage::new(&mark, mark.len(), 1, mark.len()).expect("a one-row image");
-        let edges = [edge(15, true, L), edge(24, false, L)];
-        let w = 10;
-        let pass = |widths_px| WindowPass {
-            predicted: Parabola::from_coeffs([0.0, 0.0, 19.9]),
-            joint: false,
-            lane_class: L,
-            gate: false,
-            tan_tolerance: 0.0,
-            band_rows: [1, 1],
-            w,
-            image: &image,
-            stripe_widths_px: widths_px,
-        };
-        let mut hist = Box::new([[0u32; 2 * MAX_WINDOW_HALF_WIDTH + 1]; BANDS]);
-        let mut scratch = Vec::with_capacity(4);
-        pass((6, 16)).gather::<true>(&edges, &mut hist, &mut scratch);
-        let got: Vec<_> = scratch.iter().map(|c| (c.point(), c.bin, c.band)).collect();
-        assert_eq!(got, [((19.5, 0.0), 10, 0), ((19.5, 0.0), 10, 0)]);
-        assert_eq!(hist[0][10], 2);
-        // Without middles (or narrower than the narrowest): each its own column and bin.
-        for (widths_px, middles) in [((6, 16), false), ((9, 16), true)] {
-            hist[0].fill(0);
-            scratch.clear();
-            if middles {
-                pass(widths_px).gather::<true>(&edges, &mut hist, &mut scratch);
-            } else {
-                pass(widths_px).gather::<false>(&edges, &mut hist, &mut scratch);
-            }
-            let got: Vec<_> = scratch.iter().map(|c| (c.point(), c.bin)).collect();
-            assert_eq!(got, [((15.0, 0.0), 5), ((24.0, 0.0), 14)]);
-        }
-    }
-
-    #[test]
-    fn the_residual_bin_is_the_rounded_residual_shifted_into_the_window() {
-        // The per-pixel formula the per-row offset replaces: ⌊x − x̂ + w + ½⌋, negative → 0,
-        // capped at 2w.
-        let direct = |x: u16, pred: f64, w: i64| {
-            let v = f64::from(x) - pred;
-            ((v + w as f64 + 0.5).max(0.0) as usize).min(2 * w as usize)
-        };
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for _ in 0..20_000 {
-            let w = 1 + (uniform() * 40.0) as i64;
-            let x = (uniform() * 640.0) as u16;
-            // Predictions near the pixel (in the window and just outside it), on half-pixel
-            // ties, and far away.
-            let pred = match (uniform() * 4.0) as u32 {
-                0 => f64::from(x) + (uniform() - 0.5) * 4.0 * w as f64,
-                1 => f64::from(x) + ((uniform() * 8.0) as i64 - 4) as f64 + 0.5,
-                2 => (uniform() - 0.5) * 1e7,
-                _ => f64::from(x) - w as f64 - 0.5 + (uniform() - 0.5) * 1e-9,
-            };
-            let bin = residual_bin(x, bin_offset(pred, w), 2 * w as i32);
-            assert_eq!(bin, direct(x, pred, w), "x {x}, prediction {pred}, w {w}");
-        }
-        for pred in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300] {
-            for x in [0u16, 17, u16::MAX] {
-                let bin = residual_bin(x, bin_offset(pred, 10), 20);
-                assert_eq!(bin, direct(x, pred, 10), "x {x}, prediction {pred}");
-            }
-        }
-    }
-
-    #[test]
-    fn the_decimation_keeps_the_items_of_the_division_rule() {
-        for total in 0..400usize {
-            for max in [1usize, 3, 7, 150, 399] {
-                let mut decimation = Decimation::new(max, total);
-                let kept: Vec<usize> = (0..total).filter(|_| decimation.keep()).collect();
-                let expected: Vec<usize> = (0..total)
-                    .filter(|&j| total <= max || (j + 1) * max / total > j * max / total)
-                    .collect();
-                assert_eq!(kept, expected, "total {total}, max {max}");
-                assert_eq!(kept.len(), total.min(max));
-            }
-        }
-    }
-
-    #[test]
-    fn a_single_step_edge_is_located_exactly() {
-        for k in 0..20 {
-            let edge = 20.0 + 0.05 * k as f64;
-            let up = row(edge, f64::INFINITY);
-            let (x, _) = mark_centre(&up, edge as u16, edge as u16 + 1, 0.5).unwrap();
-            assert!((x - edge).abs() < 0.01, "rising {edge}: {x}");
-            let down: Vec<u8> = up.iter().rev().copied().collect();
-            let mirrored = 39.0 - edge;
-            let (x, _) = mark_centre(&down, mirrored as u16, mirrored as u16 + 1, 0.5).unwrap();
-            assert!((x - mirrored).abs() < 0.01, "falling {mirrored}: {x}");
-        }
-        // No contrast, no point.
-        assert!(mark_centre(&[100; 40], 10, 12, 0.0).is_none());
-    }
-}
+mod tests;

@@ -1,0 +1,204 @@
+//! What the tracker reports: per lane and per frame ([`LaneReport`], [`TrackReport`]), its
+//! counters ([`TrackerCounters`]), the candidates of a joint initialisation ([`InitCandidate`])
+//! and what an overlay draws ([`LaneView`]). Every figure is in the input's pixels.
+
+use hough_init::Parabola;
+use serde::Serialize;
+use vision_gradient::{ColSpan, EdgeClass};
+
+/// Which lane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Side {
+    /// The left lane mark (edge class [`EdgeClass::LeftLane`], a `/` in the image).
+    Left,
+    /// The right lane mark (edge class [`EdgeClass::RightLane`], a `\` in the image).
+    Right,
+}
+
+impl Side {
+    /// Both sides, left then right (the order of every per-lane array).
+    pub const BOTH: [Side; 2] = [Side::Left, Side::Right];
+
+    /// The side's index in per-lane arrays (`[left, right]`).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The other side.
+    pub fn other(self) -> Side {
+        match self {
+            Side::Left => Side::Right,
+            Side::Right => Side::Left,
+        }
+    }
+
+    /// The edge class of this side's mark seen as the paper sees it: [`EdgeClass::LeftLane`]
+    /// (`/`) on the left, [`EdgeClass::RightLane`] (`\\`) on the right.
+    pub(crate) fn edge_class(self) -> EdgeClass {
+        match self {
+            Side::Left => EdgeClass::LeftLane,
+            Side::Right => EdgeClass::RightLane,
+        }
+    }
+}
+
+/// Per-lane state, reported every frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LaneState {
+    /// No estimate yet: the first initialisation has not succeeded.
+    Initialising,
+    /// Updated from this frame's points (or initialised on this frame).
+    Tracking,
+    /// Too few points (or a gated update) this frame, for fewer than
+    /// `track.lost_after_frames` frames in a row: the reported coefficients are the prediction
+    /// (shifted to a kerb's foot where the lane has one, `init.kerb_foot`).
+    Coasting,
+    /// Too many missed frames in a row: no coefficients are reported and the lane is
+    /// re-initialised (Hough + LS over the whole region of interest) every frame until it is found.
+    Lost,
+}
+
+impl LaneState {
+    /// Lowercase name, as in the JSON output.
+    pub fn name(self) -> &'static str {
+        match self {
+            LaneState::Initialising => "initialising",
+            LaneState::Tracking => "tracking",
+            LaneState::Coasting => "coasting",
+            LaneState::Lost => "lost",
+        }
+    }
+}
+
+/// The recursive estimator of the lane coefficients.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Estimator {
+    /// Kalman information filter, positive-definite form (paper eqs. 6–12, 24). The default.
+    #[default]
+    Kif,
+    /// Exponentially weighted recursive least squares (paper eqs. 25–27), λ =
+    /// `filter.wrls_lambda`, applied once per frame.
+    Wrls,
+}
+
+/// One lane's result for one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LaneReport {
+    /// Which lane.
+    pub side: Side,
+    /// Its state after this frame.
+    pub state: LaneState,
+    /// `[a1, a2, a3]` of `x = a1·y² + a2·y + a3` (x column, y row, pixels of the input image);
+    /// `None` when the lane is [`LaneState::Initialising`] or [`LaneState::Lost`].
+    pub coeffs: Option<[f64; 3]>,
+    /// `[y_min, y_max]`, rows (px) of the points behind the estimate (last update or initialisation).
+    pub rows: [f64; 2],
+    /// Points used this frame (filter update, or LS fit of an initialisation; after an
+    /// initialisation's refinement with `init.stripe_trace`, its points and the traced stripe's
+    /// middles, so beyond `track.max_points_per_lane`); 0 when missed,
+    /// also for an initialisation whose refinement missed (the LS parabola is kept, reported
+    /// [`LaneState::Tracking`] and `initialised`).
+    pub points: usize,
+    /// `true` if the lane was (re-)initialised by Hough + LS on this frame.
+    pub initialised: bool,
+}
+
+impl LaneReport {
+    /// Column of the reported parabola at `row_px`, if there is one.
+    pub fn col_at_row(&self, row_px: f64) -> Option<f64> {
+        self.coeffs
+            .map(|c| Parabola::from_coeffs(c).col_at_row(row_px))
+    }
+}
+
+/// The tracker's result for one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrackReport {
+    /// Left then right.
+    pub lanes: [LaneReport; 2],
+    /// `true` if the full region of interest went through the gradient (an initialisation was
+    /// attempted); `false` on a pure tracking frame (gradient inside the windows only).
+    pub full_gradient: bool,
+}
+
+/// Counters over the tracker's life.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct TrackerCounters {
+    /// Frames processed.
+    pub frames: u64,
+    /// Successful initialisations per lane (left, right), the first one included.
+    pub initialisations: [u64; 2],
+    /// Updates rejected by the jump gate, per lane.
+    pub gated_jumps: [u64; 2],
+    /// Estimates rejected because the lanes crossed, per lane.
+    pub gated_crossings: [u64; 2],
+    /// Frames on which the tracked pair had lost an ego lane's shape and both lanes were
+    /// initialised again (the pair gate; joint initialisation only).
+    pub gated_pairs: u64,
+    /// Re-validations (`track.revalidate_every_frames`, `track.revalidate_below_points`):
+    /// frames on which the tracked pair was weighed against a fresh initialisation's
+    /// candidates.
+    pub revalidations: u64,
+    /// Tracked lanes the joint choice replaced by a candidate off their mark (with
+    /// re-validation on: in a re-validation, or when the other side was initialised again),
+    /// or a weak lane it set aside replaced by the frame's searches
+    /// (`track.revalidate_below_points`), per lane.
+    pub revalidation_switches: [u64; 2],
+    /// Weak lanes set aside while the frame's second search looked for their side
+    /// (`track.revalidate_below_points`: weak on two frames in a row, kept nothing of by the
+    /// ROI's choice), per lane; those the search replaced count in `revalidation_switches`
+    /// too, the others were put back as they were.
+    pub set_asides: [u64; 2],
+    /// Lane changes: a tracked boundary the joint initialisation or a re-validation put on the
+    /// other side of the pair (the camera crossed it), handed over to that side.
+    pub lane_changes: u64,
+    /// Filter failures, per lane: any set-up, prediction or update the filter refused (a
+    /// non-positive-definite matrix, or an input it rejects, such as a variance or forgetting
+    /// factor out of range).
+    pub filter_failures: [u64; 2],
+}
+
+/// Most Hough candidate lines per angle band in the joint initialisation
+/// (`init.candidate_lines` is validated to at most this).
+pub(crate) const MAX_CANDIDATE_LINES: usize = 8;
+
+/// One Hough candidate line of the last joint initialisation (`init.candidate_lines > 0`) as the
+/// choice of the ego pair weighed it: for overlays, and for finding at which stage a lane is lost
+/// (`lane_eval::labelled::census_lanes`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct InitCandidate {
+    /// The angle band whose pixels voted for it: [`Side::Left`] the `/` band, [`Side::Right`]
+    /// the `\` band (on a curve a boundary may lean either way; the choice puts it on a side by
+    /// position).
+    pub band: Side,
+    /// `[a1, a2, a3]` of `x = a1·y² + a2·y + a3`, px: the least-squares parabola the choice
+    /// weighed (`init.candidate_coverage`), else the Hough line itself (`a1 = 0`).
+    pub coeffs: [f64; 3],
+    /// Its support in the choice: the row coverage net of the clutter beside it
+    /// (`init.candidate_coverage`), else its Hough votes; counted in the working frame
+    /// ([`super::LaneTracker::working_size`]) like every count the tracker reports.
+    pub support: f64,
+    /// The side the choice gave it, if any. A side without an estimate, or whose competing
+    /// tracked lane (re-validation on) lies off this candidate's mark, is then initialised from
+    /// this candidate's line refitted by least squares and refined in the windows
+    /// (`track.refine_passes`), unless the fit or the sanity checks refuse it; a candidate on
+    /// the tracked lane's own mark is marked but leaves the lane as it is. A side the choice
+    /// gave a tracked lane's own chord has no chosen candidate.
+    pub chosen: Option<Side>,
+}
+
+/// What an overlay needs of one lane: its windows, its points and its estimate. The windows
+/// and the points are those of the edge the filter tracks; on a kerb (`init.kerb_foot`) the
+/// reported boundary lies on the kerb's foot, a few pixels from them.
+#[derive(Debug, Clone, Copy)]
+pub struct LaneView<'a> {
+    /// The lane's report for the last frame.
+    pub report: LaneReport,
+    /// Window of interest per image row (empty spans outside it) used on the last frame; all
+    /// empty if the lane was not tracked on it.
+    pub spans: &'a [ColSpan],
+    /// The points fed to the filter or the LS fit on the last frame, `(col_px, row_px)`.
+    pub points: &'a [(f32, f32)],
+}
