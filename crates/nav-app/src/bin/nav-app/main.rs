@@ -1,11 +1,13 @@
 //! `nav-app`: the product binary — the lane tracker at the terminal (`lane.rs`), the INS/SD log
 //! replay (`nav-app ins`, `ins.rs`) and the INS/SD paper's Monte Carlo (`nav-app monte-carlo`,
 //! `monte_carlo.rs`). Each is a thin layer of argument parsing and printing over the library
-//! (`nav_app::lane`, crates `ins-sim` and `ins-monte-carlo`).
+//! crates (`lane-tracker` and `lane-io` for the lanes, `ins-sim` and `ins-monte-carlo` for the
+//! INS).
 //!
 //! ```text
-//! nav-app [--input PATH | --device PATH] [--config outdoor|indoor|FILE.toml] [--estimator kif|wrls]
-//!         [--json] [--overlay DIR|FILE.y4m] [--max-frames N] [--loop]
+//! nav-app [--input PATH | --device PATH] [--config default|outdoor|indoor|FILE.toml]
+//!         [--estimator kif|wrls] [--json] [--overlay DIR|FILE.y4m] [--max-frames N] [--loop]
+//!         [--dir-fps HZ] [--topic TOPIC] [--mcap-out FILE]
 //!         [--camera robot|highway|FILE.toml [--birdseye DIR]]
 //!         [--input-name NAME | --input-index N] [--std ntsc|pal|…] [--size WxH] [--max-timeouts N]
 //! ```
@@ -16,16 +18,13 @@
 //! ## Live capture (`--device`, feature `capture`)
 //! `--device /dev/video0 --input-name S-Video --std ntsc --size 320x240` streams grey frames from
 //! a V4L2 capture node (the paper's BT848/878 card under `bttv`, or vivid) through
-//! `nav_app::capture_source`. The driver's size and format are used; ERROR-flagged buffers are
+//! `lane_io::capture_source`. The driver's size and format are used; ERROR-flagged buffers are
 //! dropped and counted, dropped frames counted from sequence gaps, signal loss flagged per frame.
 //! On stderr: frames/s, errored and dropped frames, timeouts and signal loss at the end (and
 //! signal-loss changes as they happen). With `--json` every frame object also carries
 //! `"capture": {"sequence", "timestamp_us", "format", "width_px", "height_px", "missed",
 //! "signal_lost", "mean_grey"}`, and the last line is always (also after an error)
-//! `{"schema": 1, "summary": {"device": {…}|null, "frames", "errored_dropped", "sequence_gaps", "timeouts",
-//! "restarts", "signal_lost_frames", "controls_set", "elapsed_s", "fps", "tracked_frames",
-//! "lost_frames", "skipped_bytes", "exit", "exit_code", "error"}}` with `exit` one of
-//! `max-frames`, `end`, `device-gone`, `timeout`, `error`.
+//! the summary line with the capture counters (`docs/json.md`).
 //!
 //! A frame timeout (no frame within the timeout, 1000 ms) restarts the stream and is reported;
 //! the `--max-timeouts`-th in a row (default 3) ends the run. Built without the `capture` feature,
@@ -60,29 +59,26 @@
 //! ## Damaged input and the summary
 //! A frame that cannot be used — an image of a directory that does not decode, a YUV4MPEG2 stream
 //! damaged where a `FRAME` header should be (the reader skips to the next `FRAME` marker, see
-//! `nav_app::y4m::Y4mSource`), a short last frame — is reported on stderr, counted and skipped;
+//! `lane_io::y4m::Y4mSource`), a short last frame — is reported on stderr, counted and skipped;
 //! the run goes on. The last stderr line says `N frames tracked, L frames lost (B bytes
 //! skipped)`. With `--json` the last stdout line is always (every input, also after an error)
-//! `{"schema": 1, "summary": {"input": …, "tracked_frames", "lost_frames", "skipped_bytes", "exit",
-//! "exit_code", "error"}}` (with `--device`: `"device"` and the capture counters in place of
-//! `"input"`, as above).
+//! the summary line (`docs/json.md`).
 //!
 //! ## Lanes in metres (`--camera`)
-//! With a camera file (`nav_app::camera`) every `--json` frame object also carries `ego_lane`
+//! With a camera file (read by `lane_io::config::load_camera_config`, the model in
+//! `lane_tracker::camera`) every `--json` frame object also carries `ego_lane`
 //! (`lateral_offset_m`, `heading_rad`, `curvature_per_m`, `lane_width_m` and each one's
 //! `*_sigma`; `null` unless both lanes are held) and `lane_cov_px` (each lane's 3×3 covariance
 //! of `[a1, a2, a3]`, rows, or `null`); `--birdseye DIR` writes `birdseye_NNNNNN.png`, the
-//! ground seen from above (`nav_app::birdseye`). The camera file must be for the input's frame
+//! ground seen from above (`lane_io::birdseye`). The camera file must be for the input's frame
 //! size (`image_size_px`).
 //!
 //! ## Exit codes
-//! Of the tracker: 0 success; 1 error (bad input, configuration, capture setup or streaming error); 2 bad
-//! command line; 3 capture device gone (`ENODEV`); 4 `--max-timeouts` frame timeouts in a row;
-//! 5 the run finished but frames of the input were lost (`lost_frames > 0`). Of `ins` and
-//! `monte-carlo`: 0 success, 1 error (named file, line, option or run), 2 bad command line.
+//! `docs/exit-codes.md` (each subcommand's `--help` prints its own).
 
-// The argument structs' doc comments are the `--help` text clap prints verbatim
-// (`[default: OUT_ROOT/<config>-…]`, `[[landmarks]]`), not rustdoc markup.
+// The argument structs' doc comments (in `ins.rs`, `lane.rs`, `monte_carlo.rs`) are the
+// `--help` text clap prints verbatim (`[default: OUT_ROOT/<config>-…]`, `[[landmarks]]`,
+// `[trajectory]`), not rustdoc markup: rustdoc would read those brackets as links.
 #![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 
 use std::process::ExitCode;
