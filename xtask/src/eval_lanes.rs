@@ -220,7 +220,7 @@ fn render_census(censuses: &[(String, StageCensus)]) -> String {
 }
 
 /// Frames `0..dev_count(n)` of a set of `n` are the development part.
-fn dev_count(n: usize) -> usize {
+pub(crate) fn dev_count(n: usize) -> usize {
     (DEV_FRACTION * n as f64).ceil() as usize
 }
 
@@ -318,7 +318,7 @@ struct PeerFrame {
 }
 
 /// The labelled sets under `dir`, sorted by name.
-fn find_sets(dir: &Path) -> Result<Vec<(PathBuf, LabelSet)>> {
+pub(crate) fn find_sets(dir: &Path) -> Result<Vec<(PathBuf, LabelSet)>> {
     let mut dirs: Vec<PathBuf> = std::fs::read_dir(dir)
         .with_context(|| format!("cannot read {}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
+mod ablation;
 mod eval_lanes;
 mod fixtures;
 mod halves;
@@ -53,6 +54,9 @@ enum Cmd {
     /// Score the lane tracker on the real labelled sets (--data, default ../shared/data/lanes),
     /// beside the ceiling, the best of the default's candidates, the presets and the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
     EvalLanes(eval_lanes::EvalLanesArgs),
+    /// Each lane mechanism beyond the paper off in turn and at other values, per labelled set,
+    /// with its leave-one-set-out gain; writes target/ablation/ablation.md.
+    Ablation(ablation::AblationArgs),
     /// Write a labelled set in TuSimple's or CULane's format as a labels.json that eval-lanes
     /// scores (`--data` its parent directory); the images stay where they are.
     ImportLanes(import_lanes::ImportLanesArgs),
@@ -83,6 +87,7 @@ fn main() -> Result<()> {
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
         Cmd::EvalLanes(args) => eval_lanes::run(args),
+        Cmd::Ablation(args) => ablation::run(args),
         Cmd::ImportLanes(args) => import_lanes::run(args),
         Cmd::ResampleLanes(args) => resample_lanes::run(args),
         Cmd::Python(args) => python::run(args),
