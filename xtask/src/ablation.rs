@@ -193,6 +193,29 @@ fn mechanisms() -> Vec<Mechanism> {
             off: value!("false", |c| c.init.kerb_foot = false),
             others: &[],
         },
+        // The four below the bar one at a time, off together: they interact (measured).
+        Mechanism {
+            name: "together: the refinement's readings",
+            keys: "init.no_turn_back, init.double_line_middle, init.kerb_foot",
+            off: value!("all three false", |c| {
+                c.init.no_turn_back = false;
+                c.init.double_line_middle = false;
+                c.init.kerb_foot = false
+            }),
+            others: &[],
+        },
+        Mechanism {
+            name: "together: the readings and the refinement's window and passes",
+            keys: "the three above, track.refine_window_half_width_px, refine_passes",
+            off: value!("all off", |c| {
+                c.init.no_turn_back = false;
+                c.init.double_line_middle = false;
+                c.init.kerb_foot = false;
+                c.track.refine_window_half_width_px = 0;
+                c.track.refine_passes = 1
+            }),
+            others: &[],
+        },
         Mechanism {
             name: "orientation gate in the windows",
             keys: "track.orientation_tolerance_deg",
