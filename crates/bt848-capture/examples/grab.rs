@@ -141,11 +141,20 @@ fn js(s: &str) -> String {
     out
 }
 
+/// `e` and its causes, `e: cause: …` (a capture error shows only its own message and keeps the
+/// OS error as its source).
+fn shown(e: &CaptureError) -> String {
+    std::iter::successors(Some(e as &dyn std::error::Error), |c| c.source())
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(": ")
+}
+
 fn set_ctrl(cap: &mut Capture, name: &str, value: i32, at_frame: u64) {
     let result = cap.set_control(name, value);
     let err = match &result {
         Ok(()) => "null".to_owned(),
-        Err(e) => js(&e.to_string()),
+        Err(e) => js(&shown(e)),
     };
     println!(
         "{{\"type\":\"ctrl\",\"name\":{},\"value\":{value},\"at_frame\":{at_frame},\"ok\":{},\"error\":{err}}}",
@@ -180,7 +189,7 @@ fn main() -> ExitCode {
                     );
                 }
             }
-            Err(e) => println!("{{\"type\":\"error\",\"error\":{}}}", js(&e.to_string())),
+            Err(e) => println!("{{\"type\":\"error\",\"error\":{}}}", js(&shown(&e))),
         }
     }
     let mut cap = match Capture::open(&args.device, &args.config) {
@@ -193,7 +202,7 @@ fn main() -> ExitCode {
             };
             println!(
                 "{{\"type\":\"summary\",\"frames\":0,\"exit\":\"{exit}\",\"error\":{}}}",
-                js(&e.to_string())
+                js(&shown(&e))
             );
             return ExitCode::from(2);
         }
@@ -259,9 +268,9 @@ fn main() -> ExitCode {
                 }
             }
             Err(e @ CaptureError::DeviceGone { .. }) => {
-                break ("device-gone", 3, Some(e.to_string()));
+                break ("device-gone", 3, Some(shown(&e)));
             }
-            Err(e) => break ("error", 2, Some(e.to_string())),
+            Err(e) => break ("error", 2, Some(shown(&e))),
         }
     };
     let s = cap.stats();

@@ -59,7 +59,7 @@ pub enum CaptureError {
         got: usize,
     },
     /// The device node could not be opened.
-    #[error("cannot open {path}: {source}")]
+    #[error("cannot open {path}")]
     Open {
         /// Device path.
         path: String,
@@ -83,7 +83,7 @@ pub enum CaptureError {
         caps: u32,
     },
     /// An ioctl (or poll/mmap) failed with an unexpected error.
-    #[error("{op} failed: {source}")]
+    #[error("{op} failed")]
     Ioctl {
         /// The operation (`"VIDIOC_S_FMT"`, `"mmap buffer 2"`…).
         op: &'static str,

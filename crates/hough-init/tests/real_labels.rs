@@ -1,6 +1,7 @@
 //! Real geometry: the labelled TuSimple-style frames of MaybeShewill-CV/lanenet-lane-detection
 //! (Apache-2.0), read from the data root beside the checkout (`../shared/data/lanenet`, or
-//! `$ITA_NAV_DATA/lanenet`): third-party, never copied into the repository. The labelled
+//! `$ITA_NAV_DATA/lanenet`): third-party, never copied into the repository; missing, it fails
+//! the test under CI and skips it, saying so, elsewhere. The labelled
 //! pixels of all lanes of one slope sign are one side's candidate set, and the fitted parabola
 //! is scored against the ego lane's per-row centre line.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -10,21 +11,28 @@ use std::path::Path;
 
 use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, Point, init_lane};
 
-/// `lanenet/gt_instance_image` under the data root; panics naming what is missing.
-fn data_dir() -> std::path::PathBuf {
+/// `lanenet/gt_instance_image` under the data root (`$ITA_NAV_DATA`, else `../shared/data`
+/// beside the checkout, as `lane_eval::data`, which this crate cannot depend on); `None`
+/// (skipped, said on stderr) when it is missing outside CI, a failure naming it under CI (`$CI`
+/// set).
+fn data_dir() -> Option<std::path::PathBuf> {
     let root = std::env::var_os("ITA_NAV_DATA").map_or_else(
         || Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
         std::path::PathBuf::from,
     );
     let dir = root.join("lanenet/gt_instance_image");
-    assert!(
-        dir.is_dir(),
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    let missing = format!(
         "{}: missing evaluation data `lanenet/gt_instance_image` (third-party, not in the \
          repository: put the shared data root beside the checkout as ../shared/data, or name it \
          with ITA_NAV_DATA)",
         dir.display()
     );
-    dir
+    assert!(std::env::var_os("CI").is_none(), "{missing}");
+    eprintln!("SKIPPED (outside CI): {missing}");
+    None
 }
 
 /// Pixels per instance grey level.
@@ -59,8 +67,11 @@ fn centre_line(points: &[Point]) -> BTreeMap<i64, f64> {
 /// least 80 % of its labelled rows; with and without refit iterations.
 #[test]
 fn labelled_ego_lanes_are_initialised_within_tusimple_tolerance() {
+    let Some(dir) = data_dir() else {
+        return;
+    };
     for frame in 0..6 {
-        let (w, h, lanes) = instances(&data_dir().join(format!("{frame:04}.png")));
+        let (w, h, lanes) = instances(&dir.join(format!("{frame:04}.png")));
         let mut ws = HoughWorkspace::new(w as usize, h as usize, HoughParams::default()).unwrap();
         // (centre line, lowest row, chord dx/dy) per instance.
         let lines: Vec<(BTreeMap<i64, f64>, i64, f64)> = lanes

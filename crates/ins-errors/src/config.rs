@@ -390,10 +390,18 @@ mod tests {
         let text = "[imu]\naccel_bias_sigma_mg = 3.0\ngyro_drift_sigma_degph = 2.0\n\
                     accel_noise_var_per_sample_mg2 = 1.0\ngyro_noise_var_per_sample_degph2 = 1.0\n\
                     gyro_noise_psd = 3.0\n";
+        // The message names the section; the loader's error, its source, names the key.
         let e = parse_section::<ImuConfig>(text, "imu").unwrap_err();
-        assert!(e.to_string().contains("gyro_noise_psd"), "{e}");
+        assert_eq!(e.to_string(), "TOML section [imu]");
+        let InsError::Toml { source, .. } = &e else {
+            panic!("{e:?}")
+        };
+        assert!(source.to_string().contains("gyro_noise_psd"), "{source}");
         let e = parse_section::<ImuConfig>("[trajectory]\n", "imu").unwrap_err();
-        assert!(e.to_string().contains("section [imu] missing"), "{e}");
+        let InsError::Toml { source, .. } = &e else {
+            panic!("{e:?}")
+        };
+        assert!(source.message.contains("section [imu] missing"), "{source}");
     }
 
     #[test]

@@ -15,7 +15,7 @@ pub enum InsError {
         value: String,
     },
     /// A TOML document or section could not be parsed into the config struct.
-    #[error("TOML section [{section}]: {source}")]
+    #[error("TOML section [{section}]")]
     Toml {
         /// Section name (`trajectory`, `imu`).
         section: String,

@@ -11,7 +11,7 @@ use ins_sim::SimError;
 #[derive(Debug, thiserror::Error)]
 pub enum McError {
     /// A file or directory could not be read, created or written.
-    #[error("{}: {source}", path.display())]
+    #[error("{}", path.display())]
     Io {
         /// The file or directory.
         path: PathBuf,
@@ -36,7 +36,7 @@ pub enum McError {
         reason: String,
     },
     /// A `stats.json` given to `merge` is not a Monte Carlo statistics file.
-    #[error("{}: not a Monte Carlo stats file: {source}", path.display())]
+    #[error("{}: not a Monte Carlo stats file", path.display())]
     StatsFile {
         /// The file.
         path: PathBuf,
@@ -59,7 +59,7 @@ pub enum McError {
     },
     /// A run could not start (the scenario is not runnable or the record buffer is wrong): not a
     /// property of one run, so the whole Monte Carlo stops.
-    #[error("run {index} ({mode}) could not start: {source}")]
+    #[error("run {index} ({mode}) could not start")]
     RunSetup {
         /// Run index.
         index: u64,
@@ -70,10 +70,10 @@ pub enum McError {
         source: Box<SimError>,
     },
     /// The worker pool could not be built.
-    #[error("cannot start the worker threads: {0}")]
+    #[error("cannot start the worker threads")]
     ThreadPool(#[from] rayon::ThreadPoolBuildError),
     /// A figure could not be drawn or encoded.
-    #[error("figure {figure}: {source}")]
+    #[error("figure {figure}")]
     Plot {
         /// The figure, e.g. `fig3_kf_mean` or `sweep`.
         figure: String,
@@ -82,10 +82,10 @@ pub enum McError {
         source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// Serialising a report failed.
-    #[error("cannot serialise a report: {0}")]
+    #[error("cannot serialise a report")]
     Json(#[from] serde_json::Error),
     /// Writing the log export failed (its error names the file).
-    #[error("exporting run 0 ({mode}) to {}: {source}", dir.display())]
+    #[error("exporting run 0 ({mode}) to {}", dir.display())]
     Export {
         /// Configuration exported.
         mode: &'static str,

@@ -220,7 +220,7 @@ mod tests {
         let e = apply(&base, &n.keys, "5.5").unwrap_err().to_string();
         assert!(e.contains("filter.akf_window"), "{e}");
         let bad = parse_sweep("filter.no_such_key=1").unwrap();
-        let e = format!("{:#}", apply(&base, &bad.keys, "1").unwrap_err());
+        let e = crate::tests::shown(&apply(&base, &bad.keys, "1").unwrap_err());
         assert!(e.contains("no_such_key"), "{e}");
         assert!(parse_sweep("akf_window=5").is_err());
         assert!(parse_sweep("filter.akf_window=").is_err());

@@ -11,6 +11,15 @@ use super::*;
 use ins_sim::stats::ShardInfo;
 use ins_sim::{Mode, Sample, Scenario, SimError, SimRunOutcome};
 
+/// `e` and its causes as the binary prints them, `e: cause: …` (each error shows only its own
+/// message and keeps its cause as its source).
+pub(crate) fn shown(e: &dyn std::error::Error) -> String {
+    std::iter::successors(Some(e), |c| c.source())
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(": ")
+}
+
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("nav-app-mc-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -324,7 +333,7 @@ fn bad_arguments_give_clear_errors() {
             .to_string()
             .contains("`ukf` is not one of")
     );
-    let err = |a: RunOptions| resolve(&a).unwrap_err().to_string();
+    let err = |a: RunOptions| shown(&resolve(&a).unwrap_err());
     assert!(err(args(0, 5.0, 1, None)).contains("--runs 0"));
     assert!(err(args(2, 5.0, 0, None)).contains("--threads 0"));
     assert!(err(args(2, 5.0, 1, Some("3/3"))).contains("more shards than runs"));
@@ -352,6 +361,8 @@ fn bad_arguments_give_clear_errors() {
     assert_eq!(field, "filter.r_var_m2");
     assert_eq!(sim.scenario_field(), Some("filter.r_var_m2"));
     assert!(error.line.is_some());
+    // Shown once, file first: the scenario error displays as the located error.
+    assert_eq!(shown(&e), error.to_string());
     assert!(
         e.to_string().starts_with(&path.display().to_string()),
         "{e}"
@@ -390,12 +401,13 @@ fn a_run_that_cannot_start_names_its_index_and_mode_and_keeps_the_sim_error() {
             got: 11
         }
     ));
-    let shown = e.to_string();
+    assert_eq!(e.to_string(), "run 0 (akf) could not start");
+    let chain = shown(&e);
     assert!(
-        shown.starts_with("run 0 (akf) could not start: "),
-        "{shown}"
+        chain.starts_with("run 0 (akf) could not start: "),
+        "{chain}"
     );
-    assert!(shown.contains("needs 12"), "{shown}");
+    assert_eq!(chain.matches("needs 12").count(), 1, "{chain}");
     // The source is the boxed `SimError` itself.
     let inner = std::error::Error::source(&e).unwrap();
     assert!(inner.downcast_ref::<Box<SimError>>().is_some());

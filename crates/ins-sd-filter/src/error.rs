@@ -22,7 +22,7 @@ pub enum FilterError {
     },
     /// The adaptive-Q estimator's configuration (`estimator`: window, forgetting factor, …) is
     /// out of its domain; the estimator's own error names the field.
-    #[error("filter configuration: estimator: {source}")]
+    #[error("filter configuration: estimator")]
     InvalidEstimator {
         /// The estimator's error ([`AkfError::InvalidParameter`]).
         #[source]
@@ -107,10 +107,10 @@ pub enum FilterError {
         t_s: f64,
     },
     /// The INS rejected its initial state or step.
-    #[error("INS: {0}")]
+    #[error("INS")]
     Ins(#[source] InsError),
     /// The sighting model failed for a landmark (geometry: too close, vertical, NaN).
-    #[error("sighting of landmark {landmark} at t = {t_s} s: {source}")]
+    #[error("sighting of landmark {landmark} at t = {t_s} s")]
     Sighting {
         /// Epoch, s.
         t_s: f64,
@@ -120,7 +120,7 @@ pub enum FilterError {
         source: SightingError,
     },
     /// The Kalman filter rejected a matrix (non-finite, S not positive definite, …).
-    #[error("Kalman filter at t = {t_s} s: {source}")]
+    #[error("Kalman filter at t = {t_s} s")]
     Akf {
         /// Time, s.
         t_s: f64,

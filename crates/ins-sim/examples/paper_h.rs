@@ -51,7 +51,12 @@ fn main() {
                 Err(e) => {
                     // Samples before the failure are written; find the last one.
                     let last = out.iter().rposition(|s| s.t_s > 0.0).unwrap_or(0);
-                    failures.push(format!("run {i}: {e}"));
+                    // The run's error and its causes (each error shows only its own message).
+                    let why: Vec<String> =
+                        std::iter::successors(Some(&e as &dyn std::error::Error), |c| c.source())
+                            .map(ToString::to_string)
+                            .collect();
+                    failures.push(format!("run {i}: {}", why.join(": ")));
                     last // exclude the failing second itself
                 }
             };

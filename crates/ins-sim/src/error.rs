@@ -32,14 +32,14 @@ pub enum SimError {
     /// `error` names the file (or the name given to [`crate::Scenario::from_toml_named`]), the
     /// line and the column of the offending key or value, and says what is wrong. Every error
     /// of [`crate::Scenario::from_toml_str`] / [`crate::Scenario::from_toml_named`] is one of
-    /// these.
+    /// these. It displays as `error` itself (file, line and column first), which is therefore
+    /// not also its source: shown once, as with `#[error(transparent)]`.
     #[error("{error}")]
     ScenarioFile {
         /// What [`SimError::ScenarioParse`] or [`SimError::ScenarioInvalid`] would name: the
         /// section (`"(document)"` for a syntax error) or the dotted field.
         field: String,
-        /// The located error.
-        #[source]
+        /// The located error (a leaf: it has no source of its own).
         error: toml_config::TomlError,
     },
     /// A scenario field holds an invalid value (a scenario built or changed in code; from a
@@ -72,10 +72,10 @@ pub enum SimError {
         got: usize,
     },
     /// `ins-errors` rejected an input (trajectory, IMU parameters, initial state).
-    #[error("ins-errors: {0}")]
+    #[error("ins-errors")]
     Ins(#[source] InsError),
     /// The SD model failed (e.g. a landmark behind the camera because the errors exploded).
-    #[error("sighting model at t = {t_s} s: {source}")]
+    #[error("sighting model at t = {t_s} s")]
     Sighting {
         /// Time, s.
         t_s: f64,
@@ -84,7 +84,7 @@ pub enum SimError {
         source: SightingError,
     },
     /// The filter rejected a matrix (non-finite, S not positive definite, …).
-    #[error("filter at t = {t_s} s: {source}")]
+    #[error("filter at t = {t_s} s")]
     Filter {
         /// Time, s.
         t_s: f64,
@@ -94,7 +94,7 @@ pub enum SimError {
     },
     /// The online filter rejected its input (time stamps, landmark ids; not expected from the
     /// simulator).
-    #[error("online filter at t = {t_s} s: {source}")]
+    #[error("online filter at t = {t_s} s")]
     Online {
         /// Time, s (NaN when unknown).
         t_s: f64,
@@ -105,7 +105,7 @@ pub enum SimError {
 
     // ---- logs (`logs`: read, write/export, replay) ----
     /// A log file could not be opened, read or written.
-    #[error("{}: {source}", path.display())]
+    #[error("{}", path.display())]
     LogIo {
         /// The file.
         path: PathBuf,
@@ -125,14 +125,15 @@ pub enum SimError {
         /// What is wrong.
         message: String,
     },
-    /// A TOML log file (landmark table, initial state) is malformed or holds a bad value:
-    /// `error` names the file, the line and the column (crate `toml-config`).
+    /// A TOML log file (landmark table, initial state) or a filter file is malformed or holds a
+    /// bad value: `error` names the file, the line and the column (crate `toml-config`). It
+    /// displays as `error` itself (file, line and column first), which is therefore not also
+    /// its source: shown once, as with `#[error(transparent)]`.
     #[error("{error}")]
     LogToml {
         /// The file.
         path: PathBuf,
-        /// The located error.
-        #[source]
+        /// The located error (a leaf: it has no source of its own).
         error: toml_config::TomlError,
     },
     /// A ROS 2 bag could not be read (file, container, topic, message).
@@ -152,14 +153,14 @@ pub enum SimError {
     },
     /// The settings of a filter file make a filter configuration the filter refuses
     /// ([`crate::filter_file::FilterFile::filter_config`]).
-    #[error("filter file: {source}")]
+    #[error("filter file")]
     FilterFileConfig {
         /// The filter's error.
         #[source]
         source: ins_sd_filter::FilterError,
     },
     /// The filter rejected the record of this line of a log.
-    #[error("{}:{line}: {source}", path.display())]
+    #[error("{}:{line}", path.display())]
     LogFilter {
         /// The file.
         path: PathBuf,
@@ -170,7 +171,7 @@ pub enum SimError {
         source: ins_sd_filter::FilterError,
     },
     /// A TOML log file (landmarks, initial state, scenario) could not be serialised.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: cannot serialise", path.display())]
     LogWrite {
         /// The file.
         path: PathBuf,
@@ -179,7 +180,7 @@ pub enum SimError {
         source: toml::ser::Error,
     },
     /// The simulation of an exported run failed ([`crate::logs::export_run`]).
-    #[error("simulating the run to export: {source}")]
+    #[error("simulating the run to export")]
     ExportRun {
         /// The run's error.
         #[source]
@@ -273,4 +274,18 @@ impl SimError {
             _ => None,
         }
     }
+}
+
+/// `e` and its causes as one line of text, `e: cause: cause's cause…`, for a reason kept as text
+/// (an excluded run's, a located TOML message). Each error of the workspace displays only its own
+/// message and keeps its cause as its source, so each cause appears once.
+pub(crate) fn with_causes(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut next = e.source();
+    while let Some(cause) = next {
+        text.push_str(": ");
+        text.push_str(&cause.to_string());
+        next = cause.source();
+    }
+    text
 }

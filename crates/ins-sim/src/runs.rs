@@ -78,7 +78,7 @@ impl Verdict {
                 Ok(Verdict::Excluded {
                     steps: 0,
                     t_s,
-                    reason: e.to_string(),
+                    reason: crate::error::with_causes(&e),
                 })
             }
         }

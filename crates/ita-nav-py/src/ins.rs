@@ -16,8 +16,11 @@ use ins_sim::{Mode, Sample, Scenario, logs};
 
 use crate::NavError;
 
-fn err(e: impl std::fmt::Display) -> PyErr {
-    NavError::new_err(e.to_string())
+use crate::nav_err as err;
+
+/// A [`NavError`] with a message of this module's own (a file it could not read or create).
+fn message(text: String) -> PyErr {
+    NavError::new_err(text)
 }
 
 /// `None` → the paper's scenario (`configs/paper.toml`, built in); else a scenario TOML path.
@@ -25,7 +28,8 @@ fn load_scenario(config: Option<&str>) -> PyResult<Scenario> {
     match config {
         None => Ok(Scenario::paper_default()),
         Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|e| err(format!("{path}: {e}")))?;
+            let text =
+                std::fs::read_to_string(path).map_err(|e| message(format!("{path}: {e}")))?;
             Scenario::from_toml_named(path, &text).map_err(err)
         }
     }
@@ -51,7 +55,8 @@ fn load_filter_file(path: Option<&str>, preset: Option<&str>) -> PyResult<Filter
             "give filter_file or preset, not both",
         )),
         (Some(path), None) => {
-            let text = std::fs::read_to_string(path).map_err(|e| err(format!("{path}: {e}")))?;
+            let text =
+                std::fs::read_to_string(path).map_err(|e| message(format!("{path}: {e}")))?;
             FilterFile::from_toml_str(&text, path).map_err(err)
         }
         (None, name) => FilterFile::preset(name.unwrap_or("mems")).map_err(err),
@@ -142,7 +147,7 @@ impl InsSdFilter {
         };
         cfg.gate_probability = gate;
         let inner = ins_sd_filter::InsSdFilter::new(cfg, table, init.nav_state(), init.t_s)
-            .map_err(|e| err(format!("{initial}: {e}")))?;
+            .map_err(|e| message(format!("{initial}: {e}")))?;
         Ok(InsSdFilter {
             inner,
             sightings: Vec::new(),
@@ -276,7 +281,7 @@ impl InsSdFilter {
 #[pyo3(signature = (out_dir, config=None, filter="kf", seed=0))]
 pub fn export_run(out_dir: &str, config: Option<&str>, filter: &str, seed: u64) -> PyResult<usize> {
     let scenario = load_scenario(config)?;
-    std::fs::create_dir_all(out_dir).map_err(|e| err(format!("{out_dir}: {e}")))?;
+    std::fs::create_dir_all(out_dir).map_err(|e| message(format!("{out_dir}: {e}")))?;
     let (outcome, _) =
         logs::export_run(&scenario, mode_of(filter)?, seed, Path::new(out_dir)).map_err(err)?;
     Ok(outcome.samples_written)
@@ -486,9 +491,9 @@ pub fn replay<'py>(
         .detach(|| -> Result<logs::ReplaySummary, String> {
             let file = std::fs::File::create(out).map_err(|e| format!("{out}: {e}"))?;
             let mut w = std::io::BufWriter::new(file);
-            logs::replay(&inputs, &mut w, Path::new(out)).map_err(|e| e.to_string())
+            logs::replay(&inputs, &mut w, Path::new(out)).map_err(|e| crate::error_text(&e))
         })
-        .map_err(err)?;
+        .map_err(message)?;
     let d = PyDict::new(py);
     d.set_item("imu_samples", summary.imu_samples)?;
     d.set_item("epochs", summary.epochs)?;
@@ -543,7 +548,7 @@ pub fn write_sightings<'py>(
         seed,
         ..logs::SightingPlan::default()
     };
-    let file = std::fs::File::create(out).map_err(|e| err(format!("{out}: {e}")))?;
+    let file = std::fs::File::create(out).map_err(|e| message(format!("{out}: {e}")))?;
     let w = logs::write_sightings(
         &rows,
         &table,

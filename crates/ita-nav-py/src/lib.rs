@@ -51,8 +51,22 @@ pyo3::create_exception!(
     "A configuration, frame or tracking error from the Rust library (the message names the field, file or frame)."
 );
 
-fn nav_err(e: impl std::fmt::Display) -> PyErr {
-    NavError::new_err(e.to_string())
+/// A [`NavError`] whose message is `e` and its causes, `e: cause: cause's cause…` (each error of
+/// the Rust library displays only its own message and keeps its cause as its source).
+fn nav_err(e: impl std::error::Error + 'static) -> PyErr {
+    NavError::new_err(error_text(&e))
+}
+
+/// `e` and its causes as one line, following [`std::error::Error::source`].
+fn error_text(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut next = e.source();
+    while let Some(cause) = next {
+        text.push_str(": ");
+        text.push_str(&cause.to_string());
+        next = cause.source();
+    }
+    text
 }
 
 /// The lane tracker (one per video stream). Frames must keep the size of the first one.

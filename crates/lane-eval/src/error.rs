@@ -6,7 +6,7 @@ use std::io;
 #[derive(Debug, thiserror::Error)]
 pub enum EvalError {
     /// A file could not be read.
-    #[error("{path}: {source}")]
+    #[error("{path}")]
     Io {
         /// The file.
         path: String,
@@ -34,8 +34,9 @@ pub enum EvalError {
         /// What it is, relative to the data root.
         what: String,
     },
-    /// A `labels.json` is not valid JSON or does not match the schema; serde_json locates it.
-    #[error("{path}:{line}:{column}: bad lane labels: {}", json_reason(source))]
+    /// A `labels.json` is not valid JSON or does not match the schema; serde_json's error (its
+    /// source) says where, by line and column, also kept here.
+    #[error("{path}: bad lane labels")]
     LabelsJson {
         /// The label file.
         path: String,
@@ -55,14 +56,4 @@ pub enum EvalError {
     /// The census's edge detector refused its parameters or a frame (crate `vision-gradient`).
     #[error(transparent)]
     Gradient(#[from] vision_gradient::GradientError),
-}
-
-/// serde_json's message without its own " at line L column C" (the message names them once, in
-/// the `file:line:column` prefix).
-fn json_reason(e: &serde_json::Error) -> String {
-    let msg = e.to_string();
-    match msg.rfind(" at line ") {
-        Some(i) => msg[..i].to_owned(),
-        None => msg,
-    }
 }

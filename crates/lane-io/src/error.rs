@@ -10,7 +10,7 @@ use std::io;
 #[derive(Debug, thiserror::Error)]
 pub enum LaneIoError {
     /// A file or stream could not be opened or read.
-    #[error("{path}: {source}")]
+    #[error("{path}")]
     Io {
         /// File, directory or stream (`stdin`) concerned.
         path: String,
@@ -20,7 +20,7 @@ pub enum LaneIoError {
     },
     /// ffmpeg, needed to decode a video file, could not be started.
     #[error(
-        "{input}: cannot start `{program}` to decode this video ({source}); install ffmpeg (Debian: apt-get install ffmpeg), set ITA_NAV_FFMPEG to its path, or convert the video to .y4m"
+        "{input}: cannot start `{program}` to decode this video; install ffmpeg (Debian: apt-get install ffmpeg), set ITA_NAV_FFMPEG to its path, or convert the video to .y4m"
     )]
     FfmpegMissing {
         /// The video file.
@@ -52,7 +52,7 @@ pub enum LaneIoError {
         source: ros_bag::BagError,
     },
     /// An image message of a bag cannot be turned into a grey frame.
-    #[error("topic {topic}: {problem}")]
+    #[error("topic {topic}")]
     BagImage {
         /// The topic.
         topic: String,
@@ -61,7 +61,7 @@ pub enum LaneIoError {
         problem: BagImageProblem,
     },
     /// A still image could not be decoded (truncated, corrupt or of an unknown format).
-    #[error("{path}: cannot decode image: {source}")]
+    #[error("{path}: cannot decode image")]
     ImageDecode {
         /// The image file.
         path: String,
@@ -95,7 +95,7 @@ pub enum LaneIoError {
     },
     /// A frame buffer could not take the size a source asked for (its `width × height` overflows,
     /// or a buffer of the wrong length).
-    #[error("{name}: {source}")]
+    #[error("{name}")]
     FrameBuffer {
         /// File, stream or device concerned.
         name: String,
@@ -174,8 +174,9 @@ pub enum LaneIoError {
         got: usize,
     },
     /// One frame of a sequence is unusable (unreadable, corrupt, zero size). Not fatal: it is
-    /// reported, counted and skipped; `source` is what reading it gave.
-    #[error("{name}: frame {frame}: skipped: {}", frame_reason(source))]
+    /// reported, counted and skipped; `source` is what reading it gave (it names the file, or
+    /// the bag's topic).
+    #[error("frame {frame}: skipped")]
     BadFrame {
         /// File of the frame.
         name: String,
@@ -216,13 +217,13 @@ pub enum LaneIoError {
     },
     /// The capture device could not be opened or configured, or failed while streaming (bad
     /// device node, unknown input, unsupported standard or format, ioctl failure). Fatal.
-    /// (The capture error is rendered in the message, so it is not repeated as a `source`.)
-    #[error("{device}: {error}")]
+    #[error("{device}")]
     Capture {
         /// The device path.
         device: String,
         /// What the capture layer reported (typed: match on it to tell an unknown input from a
         /// missing format, etc.).
+        #[source]
         error: bt848_capture::CaptureError,
     },
     /// No frame arrived within the capture timeout; the stream has been restarted. Not fatal
@@ -261,7 +262,7 @@ pub enum LaneIoError {
         reason: String,
     },
     /// Writing an overlay or a report failed.
-    #[error("{path}: cannot write: {source}")]
+    #[error("{path}: cannot write")]
     Write {
         /// Output path.
         path: String,
@@ -270,7 +271,7 @@ pub enum LaneIoError {
         source: io::Error,
     },
     /// Encoding and writing an image (a PNG overlay) failed.
-    #[error("{path}: cannot write image: {source}")]
+    #[error("{path}: cannot write image")]
     WriteImage {
         /// Output path.
         path: String,
@@ -333,16 +334,6 @@ impl LaneIoError {
     }
 }
 
-/// The reason a [`LaneIoError::BadFrame`] prints: what reading the frame gave, without repeating
-/// the file name the message already starts with.
-fn frame_reason(source: &LaneIoError) -> String {
-    match source {
-        LaneIoError::Io { source, .. } => source.to_string(),
-        LaneIoError::ImageDecode { source, .. } => format!("cannot decode image: {source}"),
-        other => other.to_string(),
-    }
-}
-
 /// Why one image message of a bag cannot become a grey frame.
 #[derive(Debug, thiserror::Error)]
 pub enum BagImageProblem {
@@ -384,9 +375,9 @@ pub enum BagImageProblem {
         format: String,
     },
     /// The JPEG or PNG does not decode.
-    #[error("cannot decode the compressed image: {0}")]
+    #[error("cannot decode the compressed image")]
     Decode(#[source] image::ImageError),
     /// The frame buffer cannot take the image's size.
-    #[error("frame buffer: {0}")]
+    #[error("frame buffer")]
     FrameBuffer(#[source] grey_frame::FrameError),
 }

@@ -4,14 +4,15 @@
 
 /// Everything that can go wrong in the tracker: a configuration out of range, a frame of the
 /// wrong size, or a component crate refusing its input. Each variant keeps the component's own
-/// typed error as its source.
+/// typed error: as its source, or as itself when the variant is only that error (shown as it is,
+/// `transparent`).
 #[derive(Debug, thiserror::Error)]
 pub enum TrackerError {
     /// A configuration text is not valid TOML, does not match the schema (unknown, missing or
     /// mistyped key), or holds a field out of range: the error names the file, the line and the
     /// column of the offending key or value (see the `toml-config` crate).
-    #[error("{0}")]
-    ConfigFile(#[source] toml_config::TomlError),
+    #[error(transparent)]
+    ConfigFile(toml_config::TomlError),
     /// A configuration field holds a value outside its valid range (a configuration built in
     /// code; from a text it is a [`TrackerError::ConfigFile`] naming the file and line).
     #[error("configuration field `{field}` = {value}: {reason}")]
@@ -25,7 +26,7 @@ pub enum TrackerError {
     },
     /// A configuration field's value was refused by the gradient stage (crate
     /// `vision-gradient`), whose own error is the source.
-    #[error("configuration field `{field}`: {source}")]
+    #[error("configuration field `{field}`")]
     ConfigGradient {
         /// Dotted field name, e.g. `gradient.min_edge_angle_deg`.
         field: &'static str,
@@ -35,7 +36,7 @@ pub enum TrackerError {
     },
     /// A configuration field's value was refused by the initialisation (crate `hough-init`),
     /// whose own error is the source.
-    #[error("configuration field `{field}`: {source}")]
+    #[error("configuration field `{field}`")]
     ConfigHough {
         /// Dotted field name, e.g. `init.ego_pair.min_width_frac`.
         field: &'static str,
@@ -45,7 +46,7 @@ pub enum TrackerError {
     },
     /// A camera file's field was refused by the lane geometry (crate `lane-geometry`), whose
     /// own error is the source.
-    #[error("camera field `{field}`: {source}")]
+    #[error("camera field `{field}`")]
     ConfigGeometry {
         /// Dotted field name, e.g. `mounting.height_m`.
         field: &'static str,
@@ -89,19 +90,19 @@ pub enum TrackerError {
         got_h: usize,
     },
     /// The gradient stage (crate `vision-gradient`) refused its input or parameters.
-    #[error("gradient: {0}")]
+    #[error(transparent)]
     Gradient(#[from] vision_gradient::GradientError),
     /// The Hough + least-squares initialisation (crate `hough-init`) refused its parameters.
-    #[error("hough: {0}")]
+    #[error(transparent)]
     Hough(#[from] hough_init::HoughError),
     /// The information filter (crate `info-filter`) refused its set-up or an update.
-    #[error("kif: {0}")]
+    #[error(transparent)]
     Kif(#[from] info_filter::KifError),
     /// The WRLS estimator (crate `wrls`) refused its set-up or an update.
-    #[error("wrls: {0}")]
+    #[error(transparent)]
     Wrls(#[from] wrls::WrlsError),
     /// The lane geometry (crate `lane-geometry`) refused a camera model.
-    #[error("camera: {0}")]
+    #[error(transparent)]
     Geometry(#[from] lane_geometry::GeometryError),
 }
 
@@ -127,9 +128,9 @@ impl TrackerError {
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum FilterFailure {
     /// The Kalman information filter.
-    #[error("kif: {0}")]
-    Kif(#[source] info_filter::KifError),
+    #[error(transparent)]
+    Kif(info_filter::KifError),
     /// The WRLS estimator.
-    #[error("wrls: {0}")]
-    Wrls(#[source] wrls::WrlsError),
+    #[error(transparent)]
+    Wrls(wrls::WrlsError),
 }

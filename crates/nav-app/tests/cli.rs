@@ -541,3 +541,65 @@ fn ins_replays_exported_logs_prints_truth_errors_and_names_bad_lines() {
     );
     assert_eq!(e.matches(&bad_s).count(), 1, "{e}");
 }
+
+/// Each cause of a nested error is printed once: every error shows only its own message (where
+/// and what failed) and keeps its cause as its source, and the binary prints the chain
+/// `error: cause: cause…` (`error_chain` in main.rs) with no de-duplication. Two chains: a
+/// frame of an image directory that does not decode (skipped: the frame, the file, the
+/// decoder's message), and an IMU log that is not there (the log, the OS error).
+#[test]
+fn each_cause_of_a_nested_error_is_printed_once() {
+    // The lane half: a warning for a non-fatal frame error, three levels deep.
+    let dir = scratch("nested");
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    image::GrayImage::new(320, 240)
+        .save(frames.join("0001.png"))
+        .unwrap();
+    let corrupt = frames.join("0002.png");
+    std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnope").unwrap();
+    let decoder = image::open(&corrupt).unwrap_err().to_string();
+    let o = nav_app(&["--input", frames.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
+    let e = stderr(&o);
+    let warning = e
+        .lines()
+        .find(|l| l.starts_with("nav-app: warning: "))
+        .unwrap_or_else(|| panic!("no warning in {e}"));
+    let corrupt_s = corrupt.display().to_string();
+    assert_eq!(
+        warning,
+        format!("nav-app: warning: frame 1: skipped: {corrupt_s}: cannot decode image: {decoder}")
+    );
+    for cause in [corrupt_s.as_str(), "cannot decode image", decoder.as_str()] {
+        assert_eq!(e.matches(cause).count(), 1, "`{cause}` not once in {e}");
+    }
+
+    // The INS half: a fatal error with the binary's context over the library's error and its
+    // OS error.
+    use ins_sim::logs::{self, names};
+    use ins_sim::{Mode, Scenario};
+    let logs_dir = dir.join("logs");
+    let sc = Scenario::paper_default().truncated(2.0).unwrap();
+    logs::export_run(&sc, Mode::Kf, 7, &logs_dir).unwrap();
+    let p = |n: &str| logs_dir.join(n).display().to_string();
+    let missing = logs_dir.join("absent_imu.csv").display().to_string();
+    let o = nav_app(&[
+        "ins",
+        "--imu",
+        &missing,
+        "--filter",
+        "none",
+        "--init",
+        &p(names::INITIAL),
+        "--out",
+        &p("solution.csv"),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    let os = std::fs::read(&missing).unwrap_err().to_string();
+    assert!(e.starts_with("nav-app ins: error: "), "{e}");
+    for cause in [missing.as_str(), os.as_str()] {
+        assert_eq!(e.matches(cause).count(), 1, "`{cause}` not once in {e}");
+    }
+}

@@ -5,7 +5,7 @@
 #[derive(Debug, thiserror::Error)]
 pub enum BagError {
     /// The file could not be opened, read or written.
-    #[error("{path}: {source}")]
+    #[error("{path}")]
     Io {
         /// The file.
         path: String,
@@ -14,7 +14,7 @@ pub enum BagError {
         source: std::io::Error,
     },
     /// The MCAP container is damaged (truncated, bad CRC, bad record) or could not be written.
-    #[error("{path}: MCAP: {source}")]
+    #[error("{path}: MCAP")]
     Mcap {
         /// The file.
         path: String,
@@ -31,7 +31,7 @@ pub enum BagError {
         what: String,
     },
     /// A message of a topic could not be decoded (its CDR error, with where).
-    #[error("{path}: topic {topic}, message at t = {log_time_ns} ns: {source}")]
+    #[error("{path}: topic {topic}, message at t = {log_time_ns} ns")]
     Message {
         /// The file.
         path: String,
@@ -65,7 +65,7 @@ pub enum BagError {
         encoding: String,
     },
     /// A JSON message could not be serialised.
-    #[error("{path}: topic {topic}: {source}")]
+    #[error("{path}: topic {topic}")]
     Json {
         /// The file.
         path: String,

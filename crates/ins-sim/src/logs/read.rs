@@ -302,7 +302,7 @@ pub fn read_landmarks(path: &Path) -> Result<LandmarkTable, SimError> {
         let at = id
             .and_then(|id| file.landmarks.iter().rposition(|l| l.id == id))
             .map_or_else(|| "landmarks".to_owned(), |i| format!("landmarks[{i}]"));
-        toml_err(path, doc.error_at(&at, e.to_string()))
+        toml_err(path, doc.error_at(&at, crate::error::with_causes(&e)))
     })
 }
 

@@ -1,5 +1,13 @@
 use super::*;
 
+/// `e` and its causes as a binary prints them, `e: cause: …`.
+fn shown(e: &dyn std::error::Error) -> String {
+    std::iter::successors(Some(e), |c| c.source())
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(": ")
+}
+
 #[test]
 fn the_ceiling_of_parabolic_labels_is_exact_and_cut_to_the_rows() {
     let para = |a: [f64; 3]| move |y: f64| a[0] * y * y + a[1] * y + a[2];
@@ -222,9 +230,7 @@ fn a_bad_label_file_is_refused_naming_the_problem() {
             "above the tracker's 16384 px a side",
         ),
     ] {
-        let e = LabelSet::from_json_str("labels.json", &text)
-            .expect_err(needle)
-            .to_string();
+        let e = shown(&LabelSet::from_json_str("labels.json", &text).expect_err(needle));
         assert!(
             e.contains("labels.json") && e.contains(needle),
             "{needle}: {e}"
@@ -235,15 +241,19 @@ fn a_bad_label_file_is_refused_naming_the_problem() {
 #[test]
 fn a_syntax_or_schema_error_names_the_file_line_and_column_once() {
     let text = "{\"schema\": 1,\n \"set\": 5}";
-    let e = LabelSet::from_json_str("labels.json", text)
-        .unwrap_err()
-        .to_string();
-    assert!(e.starts_with("labels.json:2:"), "{e}");
-    assert_eq!(
-        e.matches("line").count(),
-        0,
-        "located once, in file:line:col form: {e}"
-    );
+    let e = LabelSet::from_json_str("labels.json", text).unwrap_err();
+    let EvalError::LabelsJson { line, column, .. } = &e else {
+        panic!("{e:?}")
+    };
+    assert_eq!(*line, 2);
+    let at = format!("line 2 column {column}");
+    // The message names the file; its source, serde_json's error, says what and where.
+    assert_eq!(e.to_string(), "labels.json: bad lane labels");
+    let e = shown(&e);
+    assert!(e.starts_with("labels.json: bad lane labels: "), "{e}");
+    assert_eq!(e.matches("labels.json").count(), 1, "{e}");
+    assert_eq!(e.matches(&at).count(), 1, "located once: {e}");
+    assert_eq!(e.matches("line").count(), 1, "located once: {e}");
 }
 
 #[test]

@@ -110,7 +110,12 @@ fn enodev_maps_to_device_gone_and_the_rest_to_capture_errors() {
         },
     );
     assert!(other.is_fatal());
-    let text = other.to_string();
+    // The device, then the capture layer's error (its source), each once.
+    assert_eq!(other.to_string(), "/dev/video0");
+    let text = std::iter::successors(Some(&other as &dyn std::error::Error), |c| c.source())
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(": ");
     assert!(
         text.starts_with("/dev/video0: no input named \"S-Video\"") && text.contains("Television"),
         "{text}"

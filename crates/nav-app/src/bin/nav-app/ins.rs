@@ -360,24 +360,6 @@ fn run_sightings(args: &SightingsArgs) -> Result<()> {
     Ok(())
 }
 
-/// `e` and its sources as `anyhow`'s `{:#}` shows them (`e: cause: cause`), leaving out a cause
-/// whose text is already shown: `ins_sim::SimError` keeps located errors (the TOML loader's,
-/// the filter's) as typed `#[source]`s and also shows them, and a file, line and column are
-/// to be named once.
-pub(crate) fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut shown = e.to_string();
-    let mut next = e.source();
-    while let Some(cause) = next {
-        let text = cause.to_string();
-        if !shown.contains(&text) {
-            shown.push_str(": ");
-            shown.push_str(&text);
-        }
-        next = cause.source();
-    }
-    shown
-}
-
 /// `nav-app ins …` (`args` from the subcommand's name on); returns the process exit code.
 pub fn main(args: impl IntoIterator<Item = std::ffi::OsString>) -> ExitCode {
     let args: Vec<std::ffi::OsString> = args.into_iter().collect();
@@ -390,7 +372,7 @@ pub fn main(args: impl IntoIterator<Item = std::ffi::OsString>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err((who, e)) => {
-            eprintln!("{who}: error: {}", error_chain(e.as_ref()));
+            eprintln!("{who}: error: {}", crate::error_chain(e.as_ref()));
             ExitCode::from(1)
         }
     }

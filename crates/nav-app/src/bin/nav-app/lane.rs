@@ -378,7 +378,10 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
             Step::Skipped(e) => {
                 stats.lost_frames += e.lost_frames();
                 stats.skipped_bytes += e.skipped_bytes();
-                say(&bar, &format!("nav-app: warning: {e}"));
+                say(
+                    &bar,
+                    &format!("nav-app: warning: {}", crate::error_chain(&e)),
+                );
                 continue;
             }
         };
@@ -524,23 +527,6 @@ fn say(bar: &ProgressBar, line: &str) {
     }
 }
 
-/// The chain of an error as one line, each message once: a cause whose text its parent already
-/// shows (a `LaneIoError::Io` renders its OS error and also returns it as its source) is left out.
-fn error_line(e: &anyhow::Error) -> String {
-    let mut line = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if line.contains(&text) {
-            continue;
-        }
-        if !line.is_empty() {
-            line.push_str(": ");
-        }
-        line.push_str(&text);
-    }
-    line
-}
-
 /// The documented exit code and `exit` name of a failed run.
 fn failure_kind(e: &anyhow::Error) -> (u8, &'static str) {
     match e.downcast_ref::<LaneIoError>() {
@@ -565,7 +551,7 @@ pub fn main() -> ExitCode {
         Ok(()) => (ok_code, "end", None),
         Err(e) => {
             let (code, exit) = failure_kind(e);
-            (code, exit, Some(error_line(e)))
+            (code, exit, Some(crate::error_chain(e.as_ref())))
         }
     };
     if let Some(e) = &error {

@@ -87,6 +87,21 @@ mod ins;
 mod lane;
 mod monte_carlo;
 
+/// `e` and its causes on one line, `e: cause: cause's cause…`, following
+/// [`std::error::Error::source`] (for an `anyhow::Error`, what its `{:#}` prints). Every error of
+/// the workspace displays only its own message (where and what failed) and leaves its cause to
+/// its source, so each cause appears once. The one way the binary prints an error.
+pub(crate) fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut shown = e.to_string();
+    let mut next = e.source();
+    while let Some(cause) = next {
+        shown.push_str(": ");
+        shown.push_str(&cause.to_string());
+        next = cause.source();
+    }
+    shown
+}
+
 fn main() -> ExitCode {
     // Subcommands are dispatched by hand so that the tracker's flags stay at the top level
     // (`nav-app --input …`), as the paper's tool and every earlier release had them.
@@ -94,5 +109,50 @@ fn main() -> ExitCode {
         Some(a) if a == "ins" => ins::main(std::env::args_os().skip(1)),
         Some(a) if a == "monte-carlo" => monte_carlo::main(std::env::args_os().skip(1)),
         _ => lane::main(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::error::Error;
+    use std::fmt;
+
+    /// An error with a message and maybe a cause.
+    #[derive(Debug)]
+    struct Layer(&'static str, Option<Box<Layer>>);
+
+    impl fmt::Display for Layer {
+        fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str(self.0)
+        }
+    }
+
+    impl Error for Layer {
+        fn source(&self) -> Option<&(dyn Error + 'static)> {
+            self.1.as_deref().map(|l| l as &(dyn Error + 'static))
+        }
+    }
+
+    #[test]
+    fn the_chain_is_every_message_in_order_joined_by_colons_and_nothing_left_out() {
+        let leaf = Layer("No such file or directory (os error 2)", None);
+        assert_eq!(
+            super::error_chain(&leaf),
+            "No such file or directory (os error 2)"
+        );
+        // Nothing is left out, not even a message that repeats an earlier one's text: each
+        // error shows only its own message, so a repeat is information, not a duplicate.
+        let chain = Layer(
+            "imu.csv",
+            Some(Box::new(Layer(
+                "imu",
+                Some(Box::new(Layer("imu.csv", None))),
+            ))),
+        );
+        assert_eq!(super::error_chain(&chain), "imu.csv: imu: imu.csv");
+        // Through anyhow's context, as the binary's errors are.
+        let e = anyhow::Error::new(Layer("cause", None)).context("what failed");
+        assert_eq!(super::error_chain(e.as_ref()), "what failed: cause");
+        assert_eq!(super::error_chain(e.as_ref()), format!("{e:#}"));
     }
 }

@@ -176,7 +176,7 @@ pub fn main(args: impl IntoIterator<Item = std::ffi::OsString>) -> ExitCode {
         Err(e) => {
             eprintln!(
                 "nav-app monte-carlo: error: {}",
-                crate::ins::error_chain(e.as_ref())
+                crate::error_chain(e.as_ref())
             );
             ExitCode::from(1)
         }
