@@ -17,6 +17,7 @@ mod ins_real;
 mod monte_carlo;
 mod paths;
 mod python;
+mod readme;
 mod regress;
 mod resample_lanes;
 mod vivid;
@@ -67,6 +68,9 @@ enum Cmd {
     /// INS crate; lane-io and lane-eval no INS, V4L2, CLI or Monte Carlo crate; ins-sim neither
     /// rayon nor plotters.
     Halves,
+    /// Every command the README shows, run as written (but `cargo xtask test` itself and the
+    /// Python install, which the `python` step does in its own environment).
+    Readme,
     /// Build the `ita_nav` Python wheel into target/py-venv and run its pytest suite.
     Python(python::PythonArgs),
     /// The INS/SD paper's Monte Carlo (stand-alone, KF, AKF) on configs/paper.toml: builds the
@@ -91,6 +95,7 @@ fn main() -> Result<()> {
         Cmd::ImportLanes(args) => import_lanes::run(args),
         Cmd::ResampleLanes(args) => resample_lanes::run(args),
         Cmd::Python(args) => python::run(args),
+        Cmd::Readme => readme::run(),
         Cmd::Halves => halves::run(),
         Cmd::MonteCarlo(args) => monte_carlo::run(args),
         Cmd::InsReal(args) => ins_real::run(args),
@@ -162,9 +167,11 @@ const STEPS: &[Step] = &[
         run: Run::Xtask(&["regress"]),
     },
     Step {
-        // The tracker's default on the real labelled sets, against the recorded floors.
-        name: "eval-lanes",
-        run: Run::Xtask(&["eval-lanes", "--check"]),
+        // Every command the README shows, as written: the main job, the lane examples, the
+        // tracker's default on the real labelled sets against the recorded floors
+        // (`eval-lanes --check`, which was a step of its own), the INS examples.
+        name: "readme",
+        run: Run::Xtask(&["readme"]),
     },
     Step {
         // The Python package: wheel built by maturin, pytest against the nav-app binary.

@@ -188,3 +188,32 @@ fn help_states_the_default_input_and_the_exit_codes() {
     assert!(text.contains("configs/paper.toml"), "{text}");
     assert!(text.contains("Exit codes"), "{text}");
 }
+
+#[test]
+fn filters_choose_the_configurations_simulated_and_an_unknown_one_is_refused() {
+    // (clap panicked on every --filters until its value became one list.)
+    let out = temp("filters");
+    let o = nav_app(&[
+        "--config",
+        &paper(),
+        "--runs",
+        "2",
+        "--duration",
+        "12",
+        "--filters",
+        "akf,kf",
+        "--threads",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    ok(&o);
+    let stats = read_stats(&out);
+    let modes: Vec<ins_sim::Mode> = stats.modes().iter().map(|m| m.mode).collect();
+    assert_eq!(modes, [ins_sim::Mode::Kf, ins_sim::Mode::Akf]);
+    let o = nav_app(&["--config", &paper(), "--filters", "kf,bogus", "--runs", "1"]);
+    assert_eq!(o.status.code(), Some(2), "a bad command line");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("`bogus` is not one of"), "{err}");
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -82,13 +82,24 @@ struct RunArgs {
     /// Configurations to simulate, comma-separated, on the same flights (common random
     /// numbers): standalone, kf, akf, akf_sage_husa, akf_structured [default: the paper's
     /// standalone,kf,akf].
-    #[arg(long, value_name = "LIST", value_parser = mc::parse_filters)]
-    filters: Option<Vec<Mode>>,
+    #[arg(long, value_name = "LIST", value_parser = parse_filter_list)]
+    filters: Option<FilterList>,
     /// Sweep a scenario key over values on the same seeds instead of one Monte Carlo:
     /// `section.key[+section.key]=V1,V2,…` (e.g. `filter.akf_window=5,10,20,40`); KF and AKF
     /// unless --filters; writes sweep.md, sweep.csv and sweep_final_error.svg/png.
     #[arg(long, value_name = "KEY=V1,V2,…", value_parser = sweep::parse_sweep)]
     sweep: Option<sweep::Sweep>,
+}
+
+/// `--filters`' value, the configurations in order. (A `Vec` field would tell clap to parse each
+/// value as one `Mode`, and its parser returns the whole list: clap panicked on every
+/// `--filters`.)
+#[derive(Debug, Clone)]
+struct FilterList(Vec<Mode>);
+
+/// `--filters`' parser: `mc::parse_filters`.
+fn parse_filter_list(text: &str) -> Result<FilterList, mc::McError> {
+    mc::parse_filters(text).map(FilterList)
 }
 
 /// Options of `merge`.
@@ -199,7 +210,7 @@ fn simulate(a: &RunArgs) -> Result<()> {
         threads: a.threads,
         shard: a.shard,
         duration_s: a.duration,
-        filters: a.filters.clone(),
+        filters: a.filters.clone().map(|f| f.0),
         ..RunOptions::new(&a.config, &a.out_root)
     };
     let r = mc::resolve(&opts)?;
