@@ -75,7 +75,7 @@
 //! the middle but cost 30 % more instructions per tracked frame (447 k against 344 k: about
 //! 27 µs on the development VM, beyond the 25 µs budget) and scored lower on the stress test
 //! (`cargo xtask eval-lanes --one-sequence`: 65.2 % against 66.9 %). How it was measured:
-//! `docs/lane-tracker-history.md`, "Stripe middles".
+//! `docs/lanes/history/stripe-middles.md`.
 //!
 //! ## Measurement noise (an addition beyond the paper; with `track.mark_centres`)
 //! The centroid's variance depends on the mark: `Var(x_i) ≈ σ_grey²·v_i` with

@@ -2,6 +2,8 @@
 //! that the joint initialisation reads: each Hough line's least-squares parabola and its row
 //! coverage (crate docs), read row by row so that each costs the pixels near the curve, not
 //! every candidate pixel.
+//!
+//! Decisions and figures: `docs/lanes/history/unpaired-pixels.md`, `orientation-hough-vote.md`.
 
 use hough_init::{HoughLine, OrientedPoint, Parabola};
 use vision_gradient::{EdgeBuffer, EdgeClass, EdgePixel, gradient_normal_deg};

@@ -44,6 +44,9 @@
 //! windows that clip the far edge of one line the estimate drifts onto the other within a few
 //! frames (≈ 6 px off the middle on the rendered double line with ±10 px windows). No
 //! allocation.
+//!
+//! Decisions and figures: `docs/lanes/history/double-line.md`; below the ablation's bar one at a
+//! time, kept (`docs/lanes/history/README.md`).
 
 use hough_init::Parabola;
 use nalgebra::Vector3;

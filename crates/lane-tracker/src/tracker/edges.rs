@@ -3,6 +3,9 @@
 //! Over a region the periodic stripes of a crosswalk are dropped
 //! (`gradient.periodic_min_stripes`) and the bright stripes' sides either kept alone or split off
 //! to vote more (`gradient.stripe_paired_votes`).
+//!
+//! Decisions and figures: `docs/lanes/history/stripe-pairing-and-ego-pair.md`,
+//! `periodic-stripes.md`.
 
 use vision_gradient::{
     ColSpan, EdgeBuffer, GradientDetector, GreyImage, Region, drop_periodic_stripes,

@@ -1,6 +1,8 @@
 //! The gates between the two lanes: the pair gate (a tracked pair that lost an ego lane's shape
 //! is dropped and chosen again) and the crossing gate (lanes may not cross nor come too close;
 //! the estimate that changed is undone).
+//!
+//! Decisions and figures: `docs/lanes/history/pair-gate.md`.
 
 use hough_init::pair_shape_is_plausible;
 

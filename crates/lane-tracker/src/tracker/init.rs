@@ -6,6 +6,11 @@
 //! The stage is [`Initialiser`]: the Hough accumulator, the candidate pixels and their index by
 //! row (module `candidates`), and the candidates it weighed on this frame. It reads the edges of
 //! the region searched ([`EdgeStage`]) and writes the lanes it initialises.
+//!
+//! Decisions and figures (`docs/lanes/history/`): `stripe-pairing-and-ego-pair.md` (the joint
+//! choice), `second-search.md`, `ego-meet-top-quarter.md`, `near-vertical-both-bands.md`,
+//! `vertical-marks.md`, `revalidation-period.md`, `revalidation-weak-evidence.md`; whether each
+//! earns its place: `docs/results/ablation.md`.
 
 use hough_init::{
     Chord, HoughLine, HoughWorkspace, LaneInit, Parabola, choose_ego_pair, init_lane,

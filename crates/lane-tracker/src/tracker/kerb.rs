@@ -47,7 +47,7 @@
 //! On the labelled `f1tenth` set (a scale-model city with raised kerbs) the labels of a kerb
 //! lie on its foot in most frames and on its top edge in some (no face visible to the
 //! labeller); measured on the development part, the rule moves 20 lanes closer to their labels
-//! (18 of them now matched) and 5 off them (`docs/lane-tracker-history.md`, "Kerb: boundary on
+//! (18 of them now matched) and 5 off them (`docs/lanes/history/kerb-foot.md`, "Kerb: boundary on
 //! its foot").
 
 use hough_init::Parabola;

@@ -62,7 +62,7 @@
 //! under its forgetting factor). Tracked frames keep the paper's measurement.
 //!
 //! Measured (development part of the real labelled stills, default configuration otherwise;
-//! `docs/lane-tracker-history.md`, "Stripe traced row by row"): `seame`'s near misses on a
+//! `docs/lanes/history/stripe-trace.md`): `seame`'s near misses on a
 //! straight tape beside the mats' texture become matched lanes; lanes whose trace ends at the
 //! image's side or runs onto a neighbouring stripe move by a pixel or two.
 

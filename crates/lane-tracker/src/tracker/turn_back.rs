@@ -16,7 +16,7 @@
 //! that the image does not show — on the development part, a dash or a line seen over the
 //! upper rows whose parabola bends back below it, on the near misses among such lanes 5–39 px
 //! off its tangent at the bottom row, where the labelled lane runs on along its course
-//! (`docs/lane-tracker-history.md`, "No turn back").
+//! (`docs/lanes/history/no-turn-back.md`).
 //!
 //! After an initialisation's windowed refinement, a lane whose vertex lies in `(y_max, y_b]`
 //! (`y_b` the bottom row searched) at a column inside the image is therefore replaced by the

@@ -38,6 +38,8 @@
 //! stay counts of the working frame); with `f = 1` (a frame narrower than 1.5 W, a frame under
 //! 6 px high or wide, or `working_width_px = 0`) nothing is resampled or mapped, and the tracker
 //! is the one it was. `f` is at most a third of either side, so a working frame keeps 3 × 3 px.
+//!
+//! Decisions and figures: `docs/lanes/history/working-resolution.md`.
 
 use nalgebra::Matrix3;
 use vision_gradient::{ColSpan, GreyImage};

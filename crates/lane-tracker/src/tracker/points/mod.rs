@@ -1,6 +1,8 @@
 //! Stage III, point selection: which window pixels measure the lane on this frame (the paper's
 //! inlier edge pixels, or one sub-pixel mark centre per row), and the measurement noise they
 //! carry.
+//!
+//! Decisions and figures: `docs/lanes/history/orientation-gate.md`, `stripe-middles.md`.
 
 use hough_init::Parabola;
 use info_filter::{PowerSums, RowNorm};
