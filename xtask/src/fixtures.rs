@@ -8,7 +8,7 @@ use std::io::BufWriter;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use lane_eval::synth::{SCENES, SceneSource, write_scene_y4m};
+use lane_scenes::{SCENES, SceneSource, write_scene_y4m};
 
 use crate::paths::workspace_root;
 

@@ -1,10 +1,10 @@
 //! Tracking behaviour on rendered sequences with exact ground truth, and on the real udacity
-//! clip (read from the data root, `lane_eval::data`).
+//! clip (read from the data root, `lane_bench::data`).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use lane_eval::eval::{SequenceScore, continuity, run_tracker, score_sequence};
-use lane_eval::synth::{SCENES, SceneRenderer, SceneSpec};
 use lane_io::y4m::Y4mSource;
+use lane_scenes::{SCENES, SceneRenderer, SceneSpec};
 use lane_tracker::{
     Estimator, GreyFrame, LaneState, LaneTracker, Side, TrackReport, TrackerConfig, TrackerError,
 };
@@ -14,7 +14,7 @@ fn run_scene(
     estimator: Estimator,
     w: usize,
     h: usize,
-) -> (Vec<Option<TrackReport>>, lane_eval::synth::SequenceTruth) {
+) -> (Vec<Option<TrackReport>>, lane_scenes::SequenceTruth) {
     let cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
     run_scene_with(spec, &cfg, estimator, w, h)
 }
@@ -26,7 +26,7 @@ fn run_scene_with(
     estimator: Estimator,
     w: usize,
     h: usize,
-) -> (Vec<Option<TrackReport>>, lane_eval::synth::SequenceTruth) {
+) -> (Vec<Option<TrackReport>>, lane_scenes::SequenceTruth) {
     // The presets' pixel parameters are for 320-px-wide frames: a wider frame is tracked on
     // its box average near 320 px wide (`frame.working_width_px`), reported in its own pixels.
     let mut renderer = SceneRenderer::new(spec, w, h);
@@ -373,7 +373,7 @@ fn blank_frames_report_initialising_without_coefficients() {
 
 #[test]
 fn the_real_udacity_clip_keeps_both_lanes_in_its_first_30_frames() {
-    let path = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).unwrap();
+    let path = lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP).unwrap();
     let file = std::io::BufReader::new(std::fs::File::open(&path).unwrap());
     let mut source = Y4mSource::new(file, path.display().to_string()).unwrap();
     let cfg = TrackerConfig::outdoor().unwrap();
@@ -505,7 +505,7 @@ fn every_synthetic_scene_is_tracked_with_the_default_configuration() {
 fn every_real_udacity_frame_initialised_alone_gives_both_lanes_with_the_default() {
     // A still-image check of the initialisation on a real highway with a dashed left mark: a
     // fresh tracker per frame, so nothing is carried over from the previous frame.
-    let path = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).unwrap();
+    let path = lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP).unwrap();
     let file = std::io::BufReader::new(std::fs::File::open(&path).unwrap());
     let mut source = Y4mSource::new(file, path.display().to_string()).unwrap();
     let cfg = TrackerConfig::default_preset().unwrap();
@@ -543,7 +543,7 @@ fn the_real_udacity_clip_as_an_mp4_keeps_both_lanes_on_every_frame() {
         eprintln!("SKIPPED: ffmpeg is not installed");
         return;
     }
-    let clip = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).unwrap();
+    let clip = lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP).unwrap();
     let mp4 = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("udacity.mp4");
     let out = std::process::Command::new("ffmpeg")
         .args(["-hide_banner", "-v", "error", "-y", "-i"])

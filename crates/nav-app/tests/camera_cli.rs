@@ -1,6 +1,6 @@
 //! `nav-app --camera`: the ego lane in metres on every frame with both lanes, a camera for
 //! another frame size refused naming the field, a bad camera field named with its file, line and
-//! column. The input is the real udacity clip from the data root (`lane_eval::data`).
+//! column. The input is the real udacity clip from the data root (`lane_bench::data`).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::process::Command;
@@ -8,7 +8,7 @@ use std::process::Command;
 use lane_tracker::camera::CAMERA_ROBOT_TOML;
 
 fn udacity() -> String {
-    lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP)
+    lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP)
         .unwrap()
         .display()
         .to_string()

@@ -1,4 +1,9 @@
-//! Deterministic synthetic road and corridor sequences with exact ground truth.
+//! # lane-scenes — rendered lane scenes with exact ground truth
+//!
+//! Deterministic synthetic road and corridor sequences with exact ground truth: the `nav-app`
+//! binary's sample input (a [`SceneSource`] when it is given no input), the synthetic regression's
+//! sequences (`lane_eval::regress`) and the tests' inputs; [`road`] renders roads from known 3-D
+//! geometry for the metric round trips.
 //!
 //! ## Scene model (image plane, pixels; x column, y row)
 //! Rows below the horizon `y_h` are ground. With `d = y − y_h` and the bottom row `y_b`:
@@ -524,16 +529,16 @@ impl lane_io::FrameSource for SceneSource {
 /// fixtures` writes, so tests render their inputs instead of reading committed copies.
 ///
 /// # Errors
-/// [`crate::EvalError::Io`] when `out` refuses a write (`name` in the message).
+/// [`WriteError`] when `out` refuses a write (`name` in the message).
 pub fn write_scene_y4m<W: std::io::Write>(
     spec: SceneSpec,
     width: usize,
     height: usize,
     out: W,
     name: &str,
-) -> Result<(), crate::EvalError> {
-    let io = |source| crate::EvalError::Io {
-        path: name.to_owned(),
+) -> Result<(), WriteError> {
+    let io = |source| WriteError {
+        name: name.to_owned(),
         source,
     };
     let mut renderer = SceneRenderer::new(spec, width, height);
@@ -552,4 +557,15 @@ pub fn write_scene_y4m<W: std::io::Write>(
     }
     writer.finish().map_err(io)?;
     Ok(())
+}
+
+/// A rendered scene's YUV4MPEG2 stream could not be written ([`write_scene_y4m`]).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write the rendered scene to {name}")]
+pub struct WriteError {
+    /// Where it was written.
+    pub name: String,
+    /// What the writer said.
+    #[source]
+    pub source: std::io::Error,
 }

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::EvalError;
+use crate::BenchError;
 
 /// Environment variable naming the data root (instead of `../shared/data` beside the checkout).
 pub const DATA_ENV: &str = "ITA_NAV_DATA";
@@ -24,13 +24,13 @@ pub fn data_root() -> PathBuf {
     }
 }
 
-/// `relative` under the data root, or [`EvalError::MissingData`] naming it.
-pub fn data_file(relative: &str) -> Result<PathBuf, EvalError> {
+/// `relative` under the data root, or [`BenchError::MissingData`] naming it.
+pub fn data_file(relative: &str) -> Result<PathBuf, BenchError> {
     let path = data_root().join(relative);
     if path.exists() {
         Ok(path)
     } else {
-        Err(EvalError::MissingData {
+        Err(BenchError::MissingData {
             path: path.display().to_string(),
             what: relative.to_owned(),
         })
