@@ -1,11 +1,11 @@
-//! `cargo xtask eval-lanes`: `nav-app eval-lanes` (the benchmark's protocol, crate `lane-bench`)
-//! with the workspace's defaults — `--out target/eval-lanes`, relative paths from the workspace
+//! `cargo xtask eval-lanes` and `import-lanes`: `nav-app eval-lanes` and `import-lanes` (crate
+//! `lane-bench`) with the workspace's defaults — `--out target/eval-lanes`, relative paths from the workspace
 //! root, the floors of `--check` / `--record` in `fixtures/expectations-lanes-real.json` — and the
 //! classic OpenCV pipeline scored beside the tracker (`bench/opencv_peer.py`, in
 //! `target/opencv-venv`, made from PyPI on first use; `--no-peer` leaves it out). The gate runs
 //! `cargo xtask eval-lanes --check`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use anyhow::{Context as _, Result, bail};
@@ -66,17 +66,27 @@ pub fn run(args: EvalLanesCmd) -> Result<()> {
     let root = workspace_root();
     let floors = root.join("fixtures/expectations-lanes-real.json");
     let ctx = context("cargo xtask eval-lanes", &root, &floors);
-    let mut peer: Option<PathBuf> = None;
-    if !args.no_peer {
+    let mut lanes = args.lanes;
+    if !args.no_peer && lanes.peer.is_none() {
         // The peer's predictions, `peer-<set>.json` per set, beside the reports.
-        let out = args.lanes.out_dir(&ctx);
+        let out = lanes.out_dir(&ctx);
         std::fs::create_dir_all(&out)
             .with_context(|| format!("cannot create {}", out.display()))?;
-        for (dir, set) in lane_bench::protocol::find_sets(&args.lanes.data_dir(&ctx)?)? {
+        for (dir, set) in lane_bench::protocol::find_sets(&lanes.data_dir(&ctx)?)? {
             run_peer(&root, &dir, &out.join(format!("peer-{}.json", set.set)))?;
         }
-        peer = Some(out);
+        lanes.peer = Some(out);
     }
-    lane_bench::cli::eval_lanes(&args.lanes, peer.as_deref(), &ctx)
+    lane_bench::cli::eval_lanes(&lanes, &ctx)
         .map_err(|e| anyhow::Error::new(e).context("eval-lanes"))
+}
+
+/// Run `cargo xtask import-lanes`: `nav-app import-lanes` with relative paths from the workspace
+/// root.
+pub fn import(args: lane_bench::cli::ImportLanesArgs) -> Result<()> {
+    let root = workspace_root();
+    let floors = root.join("fixtures/expectations-lanes-real.json");
+    let ctx = context("cargo xtask import-lanes", &root, &floors);
+    lane_bench::cli::import_lanes(&args, &ctx)
+        .map_err(|e| anyhow::Error::new(e).context("import-lanes"))
 }

@@ -11,7 +11,6 @@ use clap::{Parser, Subcommand};
 mod eval_lanes;
 mod fixtures;
 mod halves;
-mod import_lanes;
 mod ins_real;
 mod monte_carlo;
 mod paths;
@@ -84,7 +83,7 @@ fn main() -> Result<()> {
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
         Cmd::EvalLanes(args) => eval_lanes::run(args),
-        Cmd::ImportLanes(args) => import_lanes::run(args),
+        Cmd::ImportLanes(args) => eval_lanes::import(args),
         Cmd::ResampleLanes(args) => resample_lanes::run(args),
         Cmd::Python(args) => python::run(args),
         Cmd::Halves => halves::run(),

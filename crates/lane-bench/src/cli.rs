@@ -74,6 +74,11 @@ pub struct EvalLanesArgs {
     /// stress test of the tracking path, not an accuracy figure. Not with --check or --record.
     #[arg(long)]
     pub one_sequence: bool,
+    /// A directory of another method's predictions, `peer-<set>.json` per set (`{"frames":
+    /// [{"index": i, "lanes": [left, right]}]}`, each lane `[a1, a2, a3]` of x = a1·y² + a2·y + a3
+    /// or null), scored beside the tracker as `opencv-peer` (cargo xtask: the OpenCV pipeline's).
+    #[arg(long, value_name = "DIR")]
+    pub peer: Option<PathBuf>,
 }
 
 impl EvalLanesArgs {
@@ -106,12 +111,7 @@ impl EvalLanesArgs {
 }
 
 /// Run `eval-lanes`: score the sets, write and print the reports, check or record the floors.
-/// `peer` is a directory of a peer's predictions ([`Options::peer`]).
-pub fn eval_lanes(
-    args: &EvalLanesArgs,
-    peer: Option<&Path>,
-    ctx: &Context<'_>,
-) -> Result<(), BenchError> {
+pub fn eval_lanes(args: &EvalLanesArgs, ctx: &Context<'_>) -> Result<(), BenchError> {
     let command = ctx.command;
     let sets_dir = args.data_dir(ctx)?;
     let out = args.out_dir(ctx);
@@ -144,7 +144,7 @@ pub fn eval_lanes(
         dev_only: args.dev_only,
         census: args.census,
         one_sequence: args.one_sequence,
-        peer: peer.map(Path::to_path_buf),
+        peer: args.peer.as_deref().map(|p| ctx.resolve(p)),
     };
     let evaluation = protocol::evaluate(sets, &options)?;
     for (set, skipped) in &evaluation.skipped {

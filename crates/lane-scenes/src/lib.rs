@@ -559,6 +559,39 @@ pub fn write_scene_y4m<W: std::io::Write>(
     Ok(())
 }
 
+/// Every scene of [`SCENES`] rendered at `width × height` into `out` (created if needed) as
+/// `<name>.y4m` ([`write_scene_y4m`]) and `<name>.json`, its [`SequenceTruth`] (pretty JSON and a
+/// newline: the golden copies under `fixtures/synthetic/` that `cargo xtask regress` checks the
+/// renderer against). Returns each scene with the size of its stream, bytes.
+///
+/// # Errors
+/// [`WriteError`] naming the file that could not be written.
+pub fn write_fixtures(
+    out: &std::path::Path,
+    width: usize,
+    height: usize,
+) -> Result<Vec<(SceneSpec, u64)>, WriteError> {
+    let fail = |path: &std::path::Path| {
+        let name = path.display().to_string();
+        move |source| WriteError { name, source }
+    };
+    std::fs::create_dir_all(out).map_err(fail(out))?;
+    let mut written = Vec::with_capacity(SCENES.len());
+    for spec in SCENES {
+        let y4m = out.join(format!("{}.y4m", spec.name));
+        let file = std::fs::File::create(&y4m).map_err(fail(&y4m))?;
+        let name = y4m.display().to_string();
+        write_scene_y4m(*spec, width, height, std::io::BufWriter::new(file), &name)?;
+        let json = out.join(format!("{}.json", spec.name));
+        let truth = SceneSource::new(*spec, width, height).truth();
+        let text = serde_json::to_string_pretty(&truth).map_err(std::io::Error::from);
+        std::fs::write(&json, text.map_err(fail(&json))? + "\n").map_err(fail(&json))?;
+        let size = std::fs::metadata(&y4m).map_err(fail(&y4m))?.len();
+        written.push((*spec, size));
+    }
+    Ok(written)
+}
+
 /// A rendered scene's YUV4MPEG2 stream could not be written ([`write_scene_y4m`]).
 #[derive(Debug, thiserror::Error)]
 #[error("cannot write the rendered scene to {name}")]

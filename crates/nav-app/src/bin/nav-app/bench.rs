@@ -70,10 +70,7 @@ fn finish(command: &str, result: Result<(), lane_bench::BenchError>) -> ExitCode
 pub fn eval_main(args: impl IntoIterator<Item = OsString>) -> ExitCode {
     let cli = EvalCli::parse_from(args);
     let ctx = context("nav-app eval-lanes");
-    finish(
-        ctx.command,
-        lane_bench::cli::eval_lanes(&cli.args, None, &ctx),
-    )
+    finish(ctx.command, lane_bench::cli::eval_lanes(&cli.args, &ctx))
 }
 
 /// `nav-app import-lanes …` (`args` from the subcommand's name on).
