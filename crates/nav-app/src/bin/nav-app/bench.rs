@@ -13,6 +13,7 @@ use lane_bench::cli::{Context, EvalLanesArgs, ImportLanesArgs};
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app eval-lanes",
+    bin_name = "nav-app eval-lanes",
     about = "Scores the lane tracker on labelled sets (a directory of sets, each a labels.json, \
              such as `nav-app import-lanes` writes from TuSimple or CULane labels) with the \
              TuSimple and Aly rules: per set and overall, development part (the first 70 % of \
@@ -31,6 +32,7 @@ struct EvalCli {
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app import-lanes",
+    bin_name = "nav-app import-lanes",
     about = "Writes labels in TuSimple's or CULane's format as a labels.json that `nav-app \
              eval-lanes --data <its parent>` scores; the images stay where they are (named by \
              absolute path)",
