@@ -1,7 +1,9 @@
 //! `cargo xtask halves`: the crate boundaries hold. The numeric lane tracker (`lane-tracker`)
 //! depends on no image codec (`image`), no V4L2 (`v4l`), no CLI (`clap`), not on the Monte
 //! Carlo's `rayon` and `plotters` and on no INS crate; the lane I/O (`lane-io` without
-//! `capture`) and the evaluation (`lane-eval`) on no INS crate, no V4L2, no CLI, no Monte Carlo;
+//! `capture`), the rendered scenes (`lane-scenes`), the benchmark (`lane-bench` without `cli`)
+//! and the evaluation (`lane-eval`) on no INS crate, no V4L2, no CLI, no Monte Carlo; the
+//! product binary (`nav-app`) not on the evaluation (`lane-eval`);
 //! `lane-tracker` and `lane-io` build cleanly alone; the INS simulation, crate `ins-sim` (used by
 //! the Python package), builds and depends on neither `rayon` nor `plotters` (they belong to
 //! `ins-monte-carlo`). Each check reads `cargo tree -p CRATE -e normal`.
@@ -27,8 +29,8 @@ const NOT_IN_LANE_TRACKER: &[&str] = &[
     "ins-sim",
 ];
 
-/// Crates the lane I/O and evaluation (`lane-io` without `capture`, `lane-eval`) must not
-/// depend on.
+/// Crates the lane I/O, scenes, benchmark and evaluation (`lane-io` without `capture`,
+/// `lane-scenes`, `lane-bench` without `cli`, `lane-eval`) must not depend on.
 const NOT_IN_LANE: &[&str] = &[
     "ins-errors",
     "sighting-model",
@@ -149,7 +151,16 @@ pub fn run() -> Result<()> {
     check_deps(&cargo, "lane-tracker", &[], NOT_IN_LANE_TRACKER)?;
     // Its I/O: no INS, no CLI, no Monte Carlo; no V4L2 without the `capture` feature.
     check_deps(&cargo, "lane-io", &["--no-default-features"], NOT_IN_LANE)?;
-    check_deps(&cargo, "lane-eval", &[], NOT_IN_LANE)?;
+    for lane_crate in ["lane-scenes", "lane-bench", "lane-eval"] {
+        check_deps(&cargo, lane_crate, &[], NOT_IN_LANE)?;
+    }
+    // The product binary: its sample input and the benchmark, not the evaluation crate.
+    check_deps(
+        &cargo,
+        "nav-app",
+        &["--no-default-features"],
+        &["lane-eval"],
+    )?;
     clippy_alone(&cargo, "lane-tracker", &[])?;
     clippy_alone(&cargo, "lane-io", &["--no-default-features"])?;
     // The INS half: the simulation without the Monte Carlo's rayon and plotters.

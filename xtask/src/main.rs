@@ -12,7 +12,6 @@ mod ablation;
 mod eval_lanes;
 mod fixtures;
 mod halves;
-mod import_lanes;
 mod ins_real;
 mod monte_carlo;
 mod paths;
@@ -52,21 +51,22 @@ enum Cmd {
     Fixtures(fixtures::FixturesArgs),
     /// Run the lane tracker over every fixture and compare with the recorded expectations.
     Regress(regress::RegressArgs),
-    /// Score the lane tracker on the real labelled sets (--data, default ../shared/data/lanes),
-    /// beside the ceiling, the best of the default's candidates, the presets and the OpenCV peer; writes summary.md, summary.json and a contact sheet of the worst frames.
-    EvalLanes(eval_lanes::EvalLanesArgs),
+    /// `nav-app eval-lanes` on the real labelled sets (--data, default ../shared/data/lanes) with
+    /// the OpenCV peer beside it; writes summary.md, summary.json, frames.csv and a contact sheet
+    /// of the worst frames into target/eval-lanes.
+    EvalLanes(eval_lanes::EvalLanesCmd),
+    /// `nav-app import-lanes`: a labelled set in TuSimple's or CULane's format as a labels.json
+    /// that eval-lanes scores (`--data` its parent directory); the images stay where they are.
+    ImportLanes(lane_bench::cli::ImportLanesArgs),
     /// Each lane mechanism beyond the paper off in turn and at other values, per labelled set,
     /// with its leave-one-set-out gain; writes target/ablation/ablation.md.
     Ablation(ablation::AblationArgs),
-    /// Write a labelled set in TuSimple's or CULane's format as a labels.json that eval-lanes
-    /// scores (`--data` its parent directory); the images stay where they are.
-    ImportLanes(import_lanes::ImportLanesArgs),
     /// Write the labelled sets enlarged K times (frames bicubic, labels mapped) into
     /// target/lanes-{K}x, for `eval-lanes --data` at another resolution.
     ResampleLanes(resample_lanes::ResampleLanesArgs),
     /// Check the crate boundaries: lane-tracker pulls in no image codec, V4L2, CLI, Monte Carlo or
-    /// INS crate; lane-io and lane-eval no INS, V4L2, CLI or Monte Carlo crate; ins-sim neither
-    /// rayon nor plotters.
+    /// INS crate; lane-io, lane-scenes, lane-bench and lane-eval no INS, V4L2, CLI or Monte Carlo
+    /// crate; nav-app not lane-eval; ins-sim neither rayon nor plotters.
     Halves,
     /// Every command the README shows, run as written (but `cargo xtask test` itself and the
     /// Python install, which the `python` step does in its own environment).
@@ -92,7 +92,7 @@ fn main() -> Result<()> {
         Cmd::Regress(args) => regress::run(args),
         Cmd::EvalLanes(args) => eval_lanes::run(args),
         Cmd::Ablation(args) => ablation::run(args),
-        Cmd::ImportLanes(args) => import_lanes::run(args),
+        Cmd::ImportLanes(args) => eval_lanes::import(args),
         Cmd::ResampleLanes(args) => resample_lanes::run(args),
         Cmd::Python(args) => python::run(args),
         Cmd::Readme => readme::run(),
@@ -149,7 +149,7 @@ const STEPS: &[Step] = &[
         run: Run::Cargo(&["test", "-p", "nav-app", "--no-default-features"]),
     },
     Step {
-        // The crate boundaries: lane-tracker, lane-io, lane-eval and ins-sim pull in nothing they must not.
+        // The crate boundaries: the lane crates and ins-sim pull in nothing they must not.
         name: "halves",
         run: Run::Xtask(&["halves"]),
     },

@@ -8,7 +8,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use lane_eval::synth::road::{ROBOT_ROADS, RoadRenderer};
+use lane_scenes::road::{ROBOT_ROADS, RoadRenderer};
 use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
 
 fn metric_step(c: &mut Criterion) {

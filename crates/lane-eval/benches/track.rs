@@ -9,16 +9,16 @@ use std::hint::black_box;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, init_lane};
 use info_filter::{ParabolaKif, ProcessNoise, RowNorm, ThetaCov};
-use lane_eval::synth::{SCENES, SceneRenderer};
 use lane_io::FrameSource;
 use lane_io::y4m::Y4mSource;
+use lane_scenes::{SCENES, SceneRenderer};
 use lane_tracker::{Estimator, GreyFrame, LaneTracker, Side, TrackerConfig};
 use nalgebra::{Matrix3, Vector3};
 use vision_gradient::{EdgeBuffer, EdgeClass, GradientDetector, GradientParams, GreyImage, Region};
 use wrls::{WrlsFast, WrlsPaper};
 
 fn udacity_frame() -> GreyFrame {
-    let path = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).unwrap();
+    let path = lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP).unwrap();
     let mut src = Y4mSource::new(
         std::io::BufReader::new(std::fs::File::open(&path).unwrap()),
         path.display().to_string(),

@@ -21,7 +21,8 @@ fn main() {
     let n: usize = args
         .next()
         .map_or(100, |s| s.parse().expect("a frame count"));
-    let path = lane_eval::data::data_file(lane_eval::data::UDACITY_CLIP).expect("the udacity clip");
+    let path =
+        lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP).expect("the udacity clip");
     let file = std::fs::File::open(&path).expect("the udacity clip opens");
     let mut src = Y4mSource::new(std::io::BufReader::new(file), path.display().to_string())
         .expect("a y4m stream");

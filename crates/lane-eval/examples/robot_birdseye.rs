@@ -4,9 +4,9 @@
 //! `cargo run --release -p lane-eval --example robot_birdseye -- OUT.png [FRAME]`
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
-use lane_eval::synth::road::{ROBOT_ROADS, RoadRenderer};
 use lane_io::birdseye::BirdseyeView;
 use lane_io::overlay::render_overlay;
+use lane_scenes::road::{ROBOT_ROADS, RoadRenderer};
 use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

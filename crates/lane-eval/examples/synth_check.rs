@@ -1,6 +1,7 @@
 //! Dev check: render every synthetic scene, track it, print the scores.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
-use lane_eval::{eval, synth};
+use lane_eval::eval;
+use lane_scenes as synth;
 use lane_tracker::{Estimator, GreyFrame, LaneTracker};
 
 fn main() {

@@ -8,7 +8,7 @@ use lane_io::frame_loop::{FrameLoop, Step};
 use lane_tracker::{Estimator, GreyFrame, LaneState, TrackReport, TrackerConfig, TrackerCounters};
 
 use crate::EvalError;
-use crate::synth::SequenceTruth;
+use lane_scenes::SequenceTruth;
 
 /// TuSimple's tolerance: a point is correct within 20 px at 1280 px width; scaled to the frame
 /// width here (5 px at 320 px).
@@ -315,7 +315,7 @@ pub fn score_against_instance_label(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::{SequenceTruth, TruthFrame, TruthLane};
+    use lane_scenes::{SequenceTruth, TruthFrame, TruthLane};
     use lane_tracker::{LaneReport, Side, TrackReport};
 
     fn truth(frames: usize, visible: impl Fn(usize) -> bool) -> SequenceTruth {

@@ -3,7 +3,7 @@
 //! against the actual errors.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
-use lane_eval::synth::road::{HIGHWAY_ROADS, ROBOT_ROADS, RoadRenderer, RoadSpec};
+use lane_scenes::road::{HIGHWAY_ROADS, ROBOT_ROADS, RoadRenderer, RoadSpec};
 use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
 
 /// The tracker configuration for the robot camera: the indoor preset with the ROI from 45 % of

@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use alloc_counter::allocations_in;
-use lane_eval::synth::{SCENES, SceneRenderer};
+use lane_scenes::{SCENES, SceneRenderer};
 use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
 
 #[global_allocator]

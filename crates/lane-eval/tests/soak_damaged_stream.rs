@@ -178,13 +178,13 @@ fn a_long_damaged_stream_plays_to_its_end_with_exact_losses_and_flat_memory() {
     );
     // The rendered straight road (deterministic), as the YUV4MPEG2 bytes `cargo xtask fixtures`
     // writes.
-    let spec = lane_eval::synth::SCENES
+    let spec = lane_scenes::SCENES
         .iter()
         .find(|s| s.name == "straight_solid")
         .copied()
         .unwrap();
     let mut fixture = Vec::new();
-    lane_eval::synth::write_scene_y4m(spec, W, H, &mut fixture, "straight_solid").unwrap();
+    lane_scenes::write_scene_y4m(spec, W, H, &mut fixture, "straight_solid").unwrap();
     let started = Instant::now();
     let mut stream = DamagedStream::new(&fixture);
     drop(fixture);

@@ -1,11 +1,11 @@
 //! Tracking behaviour on rendered sequences with exact ground truth, and on the real udacity
-//! clip (read from the data root, `lane_eval::data`; missing, it fails these tests under CI and
+//! clip (read from the data root, `lane_bench::data`; missing, it fails these tests under CI and
 //! skips them, saying so, elsewhere).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use lane_eval::eval::{SequenceScore, continuity, run_tracker, score_sequence};
-use lane_eval::synth::{SCENES, SceneRenderer, SceneSpec};
 use lane_io::y4m::Y4mSource;
+use lane_scenes::{SCENES, SceneRenderer, SceneSpec};
 use lane_tracker::{
     Estimator, GreyFrame, LaneState, LaneTracker, Side, TrackReport, TrackerConfig, TrackerError,
 };
@@ -15,7 +15,7 @@ fn run_scene(
     estimator: Estimator,
     w: usize,
     h: usize,
-) -> (Vec<Option<TrackReport>>, lane_eval::synth::SequenceTruth) {
+) -> (Vec<Option<TrackReport>>, lane_scenes::SequenceTruth) {
     let cfg = lane_io::config::load_tracker_config(spec.config).unwrap();
     run_scene_with(spec, &cfg, estimator, w, h)
 }
@@ -27,7 +27,7 @@ fn run_scene_with(
     estimator: Estimator,
     w: usize,
     h: usize,
-) -> (Vec<Option<TrackReport>>, lane_eval::synth::SequenceTruth) {
+) -> (Vec<Option<TrackReport>>, lane_scenes::SequenceTruth) {
     // The presets' pixel parameters are for 320-px-wide frames: a wider frame is tracked on
     // its box average near 320 px wide (`frame.working_width_px`), reported in its own pixels.
     let mut renderer = SceneRenderer::new(spec, w, h);
@@ -49,7 +49,8 @@ fn scene(name: &str) -> SceneSpec {
 /// The real udacity clip; `None` (skipped, said on stderr) when it is missing outside CI, a
 /// failure naming it under CI.
 fn udacity_clip() -> Option<std::path::PathBuf> {
-    lane_eval::data::test_data_file(lane_eval::data::UDACITY_CLIP).unwrap_or_else(|e| panic!("{e}"))
+    lane_bench::data::test_data_file(lane_bench::data::UDACITY_CLIP)
+        .unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]

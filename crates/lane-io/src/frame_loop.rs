@@ -1,6 +1,7 @@
 //! The one frame loop: next frame from a [`FrameSource`] → tracker (built on the first frame's
 //! size) → the caller's handling of the report. The `nav-app` binary (JSON, overlays, capture
-//! counters) and the evaluation (`lane_eval::eval::run_tracker`) both drive it, so what a frame
+//! counters), the evaluation (`lane_eval::eval::run_tracker`) and the labelled benchmark
+//! (`lane_bench::labelled::track_label_set`) all drive it, so what a frame
 //! error does, when the tracker is built and what a size change means are decided once.
 //!
 //! ```no_run
@@ -75,6 +76,14 @@ impl FrameLoop {
     /// The tracker, once the first frame has arrived.
     pub fn tracker(&self) -> Option<&LaneTracker> {
         self.tracker.as_ref()
+    }
+
+    /// Forget the tracked lanes ([`LaneTracker::reset`]), keeping the tracker and its buffers: the
+    /// next frame starts a new clip (the labelled benchmark's clips, `lane_bench::labelled`).
+    pub fn reset(&mut self) {
+        if let Some(t) = &mut self.tracker {
+            t.reset();
+        }
     }
 
     /// Reads the next frame of `source` and tracks it.

@@ -9,7 +9,8 @@
 //!
 //! Numeric like `ins-sd-filter`: no file or device I/O and no image codecs. Frames arrive as a
 //! [`GreyFrame`] or as borrowed pixels ([`LaneTracker::track_pixels`]); frame sources, config
-//! files, overlays are the `lane-io` crate, evaluation and synthetic scenes `lane-eval`.
+//! files, overlays are the `lane-io` crate, synthetic scenes `lane-scenes`, the labelled benchmark
+//! `lane-bench`, sequence scores and the regression `lane-eval`.
 //!
 //! ## Model
 //! Each lane mark is the parabola of eq. 1, `x = a1·y² + a2·y + a3` (x column, y row, pixels of
@@ -290,7 +291,8 @@
 //! [`camera`]: a camera configuration (pinhole intrinsics + mounting, or a measured ground-plane
 //! homography) turns the two lanes' parabolas and their KIF covariances
 //! ([`LaneTracker::lane_covariance_px`]) into the ego lane's lateral offset, heading, curvature
-//! and width with standard deviations (`lane-geometry` crate); `lane-io` loads camera files and draws the ground from above, `lane-eval` renders roads from
+//! and width with standard deviations (`lane-geometry` crate); `lane-io` loads camera files and
+//! draws the ground from above, `lane-scenes` renders roads from
 //! known 3-D geometry for the round-trip tests.
 //!
 //! ## Working resolution (an addition beyond the paper; `frame.working_width_px`, default 320)
@@ -309,7 +311,7 @@
 //! frame stays that of a 320-px frame plus the box average. `working_width_px = 0` tracks every
 //! frame at its own size (the paper). [`LaneTracker::working_factor`] gives `f` and
 //! [`LaneTracker::working_frame`] the last frame's working pixels, for diagnostics that must
-//! read the frame as the stages do (`lane_eval::labelled::census_lanes`).
+//! read the frame as the stages do (`lane_bench::labelled::census_lanes`).
 //!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field

@@ -1,6 +1,6 @@
 //! `nav-app --camera`: the ego lane in metres on every frame with both lanes, a camera for
 //! another frame size refused naming the field, a bad camera field named with its file, line and
-//! column. The input is the real udacity clip from the data root (`lane_eval::data`; missing, it
+//! column. The input is the real udacity clip from the data root (`lane_bench::data`; missing, it
 //! fails these tests under CI and skips them, saying so, elsewhere).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
@@ -11,7 +11,7 @@ use lane_tracker::camera::CAMERA_ROBOT_TOML;
 /// The clip's path; `None` (skipped, said on stderr) when it is missing outside CI, a failure
 /// naming it under CI.
 fn udacity() -> Option<String> {
-    lane_eval::data::test_data_file(lane_eval::data::UDACITY_CLIP)
+    lane_bench::data::test_data_file(lane_bench::data::UDACITY_CLIP)
         .unwrap_or_else(|e| panic!("{e}"))
         .map(|p| p.display().to_string())
 }

@@ -20,20 +20,20 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// The project's rendered scene `name` (`lane_eval::synth`, deterministic) as a YUV4MPEG2 file in
+/// The project's rendered scene `name` (`lane_scenes`, deterministic) as a YUV4MPEG2 file in
 /// the test target directory, written once (atomically, tests run in parallel).
 fn rendered(name: &str) -> String {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("rendered");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("{name}.y4m"));
     if !path.exists() {
-        let spec = lane_eval::synth::SCENES
+        let spec = lane_scenes::SCENES
             .iter()
             .find(|s| s.name == name)
             .copied()
             .unwrap();
         let mut bytes = Vec::new();
-        lane_eval::synth::write_scene_y4m(spec, 320, 240, &mut bytes, name).unwrap();
+        lane_scenes::write_scene_y4m(spec, 320, 240, &mut bytes, name).unwrap();
         let tmp = dir.join(format!("{name}.{:?}.tmp", std::thread::current().id()));
         std::fs::write(&tmp, bytes).unwrap();
         std::fs::rename(&tmp, &path).unwrap();

@@ -165,7 +165,7 @@ impl LaneTracker {
     /// written — the rows any stage reads (the ROI, the second search's rows, a row beside
     /// them for the Sobel); the other rows are not (zero). All zero before the first frame.
     /// `None` with `f = 1`: the stages read the input frame as it is. For diagnostics on the
-    /// working frame (`lane_eval::labelled::census_lanes`); no copy.
+    /// working frame (`lane_bench::labelled::census_lanes`); no copy.
     pub fn working_frame(&self) -> Option<(GreyImage<'_>, (usize, usize))> {
         self.frame.image()
     }

@@ -166,7 +166,7 @@ pub(crate) const MAX_CANDIDATE_LINES: usize = 8;
 
 /// One Hough candidate line of the last joint initialisation (`init.candidate_lines > 0`) as the
 /// choice of the ego pair weighed it: for overlays, and for finding at which stage a lane is lost
-/// (`lane_eval::labelled::census_lanes`).
+/// (`lane_bench::labelled::census_lanes`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct InitCandidate {
     /// The angle band whose pixels voted for it: [`Side::Left`] the `/` band, [`Side::Right`]

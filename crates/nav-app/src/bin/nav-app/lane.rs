@@ -8,13 +8,13 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, ValueEnum};
-use lane_eval::synth::{SCENES, SceneSource};
 use lane_io::birdseye::BirdseyeView;
 use lane_io::capture::{InputSelect, PixelFormat, VideoStd};
 use lane_io::capture_source::{
     self, CaptureMonitor, DeviceFrameInfo, DeviceOptions, DeviceSetup, DeviceStats,
     parse_control_spec,
 };
+use lane_scenes::{SCENES, SceneSource};
 use std::io::IsTerminal;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -26,7 +26,7 @@ use lane_tracker::camera::{CameraModel, EgoLaneReport};
 use lane_tracker::{Estimator, LaneReport, LaneState, Side};
 use serde::Serialize;
 
-/// The default input: a scene the project renders itself (`lane_eval::synth`, deterministic), a
+/// The default input: a scene the project renders itself (`lane_scenes`, deterministic), a
 /// curved road with dashed marks, 320×240.
 const SAMPLE_SCENE: &str = "curve_left_dashed";
 const SAMPLE_NAME: &str = "rendered sample (scene curve_left_dashed, 320×240)";
@@ -281,7 +281,7 @@ fn open_source(args: &Args) -> Result<Box<dyn FrameSource>> {
                 .iter()
                 .find(|s| s.name == SAMPLE_SCENE)
                 .copied()
-                .context("the rendered sample scene is missing from lane_eval::synth::SCENES")?;
+                .context("the rendered sample scene is missing from lane_scenes::SCENES")?;
             Ok(Box::new(SceneSource::new(spec, 320, 240)))
         }
     }

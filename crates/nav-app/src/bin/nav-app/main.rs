@@ -1,8 +1,10 @@
-//! `nav-app`: the product binary — the lane tracker at the terminal (`lane.rs`), the INS/SD log
-//! replay (`nav-app ins`, `ins.rs`) and the INS/SD paper's Monte Carlo (`nav-app monte-carlo`,
-//! `monte_carlo.rs`). Each is a thin layer of argument parsing and printing over the library
-//! crates (`lane-tracker` and `lane-io` for the lanes, `ins-sim` and `ins-monte-carlo` for the
-//! INS).
+//! `nav-app`: the product binary — the lane tracker at the terminal (`lane.rs`), the labelled
+//! lane benchmark on a user's own labels (`nav-app eval-lanes`, `nav-app import-lanes`,
+//! `bench.rs`), the INS/SD log replay (`nav-app ins`, `ins.rs`) and the INS/SD paper's Monte
+//! Carlo (`nav-app monte-carlo`, `monte_carlo.rs`). Each is a thin layer of argument parsing and
+//! printing over the library crates (`lane-tracker` and `lane-io` for the lanes, `lane-scenes`
+//! for the rendered sample input, `lane-bench` for the benchmark, `ins-sim` and
+//! `ins-monte-carlo` for the INS).
 //!
 //! ```text
 //! nav-app [--input PATH | --device PATH] [--config default|outdoor|indoor|FILE.toml]
@@ -12,7 +14,7 @@
 //!         [--input-name NAME | --input-index N] [--std ntsc|pal|…] [--size WxH] [--max-timeouts N]
 //! ```
 //! With neither `--input` nor `--device` it runs on a rendered sample (the project's own
-//! deterministic scene `curve_left_dashed`, `lane_eval::synth`). `--input -` reads a YUV4MPEG2
+//! deterministic scene `curve_left_dashed`, `lane_scenes`). `--input -` reads a YUV4MPEG2
 //! stream on stdin.
 //!
 //! ## Live capture (`--device`, feature `capture`)
@@ -29,6 +31,12 @@
 //! A frame timeout (no frame within the timeout, 1000 ms) restarts the stream and is reported;
 //! the `--max-timeouts`-th in a row (default 3) ends the run. Built without the `capture` feature,
 //! `--device` fails saying capture is not in this build.
+//!
+//! ## The labelled lane benchmark
+//! `nav-app import-lanes --format tusimple|culane --out SETS/NAME [--root DIR] [--kind
+//! road|indoor] LABELS…` writes TuSimple or CULane labels as a set; `nav-app eval-lanes --data
+//! SETS [--config NAME|FILE…] [--out DIR] [--dev-only] [--census] [--check|--record --floors
+//! FILE]` scores the tracker on every set under `SETS` (see `lane_bench::protocol`).
 //!
 //! ## INS/SD log replay
 //! `nav-app ins --imu imu.csv [--sightings sightings.csv --landmarks landmarks.toml]
@@ -83,6 +91,7 @@
 
 use std::process::ExitCode;
 
+mod bench;
 mod ins;
 mod lane;
 mod monte_carlo;
@@ -108,6 +117,8 @@ fn main() -> ExitCode {
     match std::env::args_os().nth(1) {
         Some(a) if a == "ins" => ins::main(std::env::args_os().skip(1)),
         Some(a) if a == "monte-carlo" => monte_carlo::main(std::env::args_os().skip(1)),
+        Some(a) if a == "eval-lanes" => bench::eval_main(std::env::args_os().skip(1)),
+        Some(a) if a == "import-lanes" => bench::import_main(std::env::args_os().skip(1)),
         _ => lane::main(),
     }
 }

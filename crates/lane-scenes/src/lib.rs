@@ -1,4 +1,9 @@
-//! Deterministic synthetic road and corridor sequences with exact ground truth.
+//! # lane-scenes — rendered lane scenes with exact ground truth
+//!
+//! Deterministic synthetic road and corridor sequences with exact ground truth: the `nav-app`
+//! binary's sample input (a [`SceneSource`] when it is given no input), the synthetic regression's
+//! sequences (`lane_eval::regress`) and the tests' inputs; [`road`] renders roads from known 3-D
+//! geometry for the metric round trips.
 //!
 //! ## Scene model (image plane, pixels; x column, y row)
 //! Rows below the horizon `y_h` are ground. With `d = y − y_h` and the bottom row `y_b`:
@@ -524,16 +529,16 @@ impl lane_io::FrameSource for SceneSource {
 /// fixtures` writes, so tests render their inputs instead of reading committed copies.
 ///
 /// # Errors
-/// [`crate::EvalError::Io`] when `out` refuses a write (`name` in the message).
+/// [`WriteError`] when `out` refuses a write (`name` in the message).
 pub fn write_scene_y4m<W: std::io::Write>(
     spec: SceneSpec,
     width: usize,
     height: usize,
     out: W,
     name: &str,
-) -> Result<(), crate::EvalError> {
-    let io = |source| crate::EvalError::Io {
-        path: name.to_owned(),
+) -> Result<(), WriteError> {
+    let io = |source| WriteError {
+        name: name.to_owned(),
         source,
     };
     let mut renderer = SceneRenderer::new(spec, width, height);
@@ -552,4 +557,48 @@ pub fn write_scene_y4m<W: std::io::Write>(
     }
     writer.finish().map_err(io)?;
     Ok(())
+}
+
+/// Every scene of [`SCENES`] rendered at `width × height` into `out` (created if needed) as
+/// `<name>.y4m` ([`write_scene_y4m`]) and `<name>.json`, its [`SequenceTruth`] (pretty JSON and a
+/// newline: the golden copies under `fixtures/synthetic/` that `cargo xtask regress` checks the
+/// renderer against). Returns each scene with the size of its stream, bytes.
+///
+/// # Errors
+/// [`WriteError`] naming the file that could not be written.
+pub fn write_fixtures(
+    out: &std::path::Path,
+    width: usize,
+    height: usize,
+) -> Result<Vec<(SceneSpec, u64)>, WriteError> {
+    let fail = |path: &std::path::Path| {
+        let name = path.display().to_string();
+        move |source| WriteError { name, source }
+    };
+    std::fs::create_dir_all(out).map_err(fail(out))?;
+    let mut written = Vec::with_capacity(SCENES.len());
+    for spec in SCENES {
+        let y4m = out.join(format!("{}.y4m", spec.name));
+        let file = std::fs::File::create(&y4m).map_err(fail(&y4m))?;
+        let name = y4m.display().to_string();
+        write_scene_y4m(*spec, width, height, std::io::BufWriter::new(file), &name)?;
+        let json = out.join(format!("{}.json", spec.name));
+        let truth = SceneSource::new(*spec, width, height).truth();
+        let text = serde_json::to_string_pretty(&truth).map_err(std::io::Error::from);
+        std::fs::write(&json, text.map_err(fail(&json))? + "\n").map_err(fail(&json))?;
+        let size = std::fs::metadata(&y4m).map_err(fail(&y4m))?.len();
+        written.push((*spec, size));
+    }
+    Ok(written)
+}
+
+/// A rendered scene's YUV4MPEG2 stream could not be written ([`write_scene_y4m`]).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write the rendered scene to {name}")]
+pub struct WriteError {
+    /// Where it was written.
+    pub name: String,
+    /// What the writer said.
+    #[source]
+    pub source: std::io::Error,
 }

@@ -1,4 +1,4 @@
-//! What a perfect choice among the tracker's own candidates would reach (`cargo xtask
+//! What a perfect choice among the tracker's own candidates would reach (`nav-app
 //! eval-lanes`, the *best of its candidates* rows): a bound that tells the choice's losses from
 //! the detection's.
 //!
@@ -22,7 +22,7 @@ use super::{
     EgoPrediction, LabelSet, LabelSide, NEAR_MISS_FRACTION, ScoringRules, run_label_set,
     scored_points, tusimple_lane_accuracy,
 };
-use crate::EvalError;
+use crate::BenchError;
 
 /// One run of the tracker over a labelled set, with the bounds of its choice (module docs); each
 /// in set order.
@@ -34,21 +34,23 @@ pub struct ChoiceBound {
     pub best: Vec<EgoPrediction>,
     /// `best`, without the lanes below [`NEAR_MISS_FRACTION`] of their label's points.
     pub best_or_none: Vec<EgoPrediction>,
+    /// The frames that could not be tracked (`[None, None]` in the three lists).
+    pub skipped: Vec<super::SkippedFrame>,
 }
 
 /// The tracker's output and the bounds of its choice for every frame of a labelled set (module
 /// docs), from one run.
 ///
 /// # Errors
-/// As [`super::track_label_set`]: a frame that cannot be read or has another size than the set
-/// declares, or a configuration the tracker refuses.
+/// A configuration the tracker refuses (a frame that cannot be read or has another size than
+/// the set declares is skipped and listed, as by [`super::track_label_set`]).
 pub fn choice_bound_set(
     dir: &Path,
     set: &LabelSet,
     cfg: &TrackerConfig,
     estimator: Estimator,
     rules: &ScoringRules,
-) -> Result<ChoiceBound, EvalError> {
+) -> Result<ChoiceBound, BenchError> {
     let y_top = rules.eval_top_fraction * set.height as f64;
     let tus_px = rules.tusimple_px_at_1280 * set.width as f64 / 1280.0;
     let n = set.frames.len();
@@ -56,37 +58,39 @@ pub fn choice_bound_set(
         output: Vec::with_capacity(n),
         best: Vec::with_capacity(n),
         best_or_none: Vec::with_capacity(n),
+        skipped: Vec::new(),
     };
-    run_label_set(
-        dir,
-        set,
-        cfg,
-        estimator,
-        n,
-        |_, labels, tracker, report, _| {
-            let output: EgoPrediction = [report.lanes[0].coeffs, report.lanes[1].coeffs];
-            let (mut best, mut best_or_none) = (output, output);
-            for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
-                let pts = scored_points(labels, side, y_top);
-                if pts.len() < 2 {
-                    continue;
-                }
-                let accuracy = |c: [f64; 3]| tusimple_lane_accuracy(&pts, c, tus_px, &mut 0.0);
-                let mut top = output[k].map_or(0.0, accuracy);
-                for c in tracker.init_candidates() {
-                    let a = accuracy(c.coeffs);
-                    if a > top {
-                        top = a;
-                        best[k] = Some(c.coeffs);
-                    }
-                }
-                best_or_none[k] = best[k].filter(|_| top >= NEAR_MISS_FRACTION);
+    out.skipped = run_label_set(dir, set, cfg, estimator, n, |_, labels, tracked| {
+        let Some(t) = tracked else {
+            // A skipped frame: no output, nothing to choose from.
+            out.output.push([None, None]);
+            out.best.push([None, None]);
+            out.best_or_none.push([None, None]);
+            return Ok(());
+        };
+        let (tracker, report) = (t.tracker, &t.report);
+        let output: EgoPrediction = [report.lanes[0].coeffs, report.lanes[1].coeffs];
+        let (mut best, mut best_or_none) = (output, output);
+        for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
+            let pts = scored_points(labels, side, y_top);
+            if pts.len() < 2 {
+                continue;
             }
-            out.output.push(output);
-            out.best.push(best);
-            out.best_or_none.push(best_or_none);
-            Ok(())
-        },
-    )?;
+            let accuracy = |c: [f64; 3]| tusimple_lane_accuracy(&pts, c, tus_px, &mut 0.0);
+            let mut top = output[k].map_or(0.0, accuracy);
+            for c in tracker.init_candidates() {
+                let a = accuracy(c.coeffs);
+                if a > top {
+                    top = a;
+                    best[k] = Some(c.coeffs);
+                }
+            }
+            best_or_none[k] = best[k].filter(|_| top >= NEAR_MISS_FRACTION);
+        }
+        out.output.push(output);
+        out.best.push(best);
+        out.best_or_none.push(best_or_none);
+        Ok(())
+    })?;
     Ok(out)
 }

@@ -18,7 +18,7 @@
 //! frames, run through one tracker in index order (the tracker is reset between clips).
 //!
 //! Sets labelled in TuSimple's or CULane's format are read into this schema by [`import`]
-//! (`cargo xtask import-lanes`).
+//! (`nav-app import-lanes`, [`crate::import_set`]).
 //!
 //! ## The rules ([`ScoringRules`])
 //! Only the ego lanes are scored, each against the tracker's lane of the same side. The label
@@ -46,9 +46,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackReport, TrackerConfig};
-
-use crate::EvalError;
+use crate::BenchError;
+use crate::error::labels_json;
 
 /// Which boundary a labelled lane is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -89,6 +88,7 @@ pub struct LabelFrame {
 
 /// Scene kind of a set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum SceneKind {
     /// Roads (highway, urban).
@@ -125,27 +125,19 @@ pub const LABEL_SCHEMA: u32 = 1;
 impl LabelSet {
     /// Read and check `dir/labels.json`: schema, sizes, sorted indices, points inside the frame
     /// and sorted by row. The error names the file and what is wrong.
-    pub fn load(dir: &Path) -> Result<Self, EvalError> {
+    pub fn load(dir: &Path) -> Result<Self, BenchError> {
         let path = dir.join("labels.json");
-        let text = std::fs::read_to_string(&path).map_err(|source| EvalError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text = std::fs::read_to_string(&path).map_err(|e| BenchError::io("read", &path, e))?;
         Self::from_json_str(&path.display().to_string(), &text)
     }
 
     /// Parse and check a `labels.json` text; `name` is used in errors.
-    pub fn from_json_str(name: &str, text: &str) -> Result<Self, EvalError> {
-        let bad = |reason: String| EvalError::Labels {
+    pub fn from_json_str(name: &str, text: &str) -> Result<Self, BenchError> {
+        let bad = |reason: String| BenchError::Labels {
             path: name.to_owned(),
             reason,
         };
-        let set: LabelSet = serde_json::from_str(text).map_err(|source| EvalError::LabelsJson {
-            path: name.to_owned(),
-            line: source.line(),
-            column: source.column(),
-            source,
-        })?;
+        let set: LabelSet = serde_json::from_str(text).map_err(|e| labels_json(name, &e))?;
         if set.schema != LABEL_SCHEMA {
             return Err(bad(format!(
                 "schema {} (this reader takes {LABEL_SCHEMA})",
@@ -572,79 +564,6 @@ pub fn score_side(
     t
 }
 
-/// Run a tracker over a labelled set, clip by clip (the tracker is reset at the start of every
-/// clip), and return the ego prediction of every frame in set order. `dir` is the set's directory.
-/// A frame whose image cannot be read, or has another size than the set declares, is an error
-/// naming the file.
-pub fn track_label_set(
-    dir: &Path,
-    set: &LabelSet,
-    cfg: &TrackerConfig,
-    estimator: Estimator,
-) -> Result<Vec<EgoPrediction>, EvalError> {
-    let mut out = Vec::with_capacity(set.frames.len());
-    run_label_set(
-        dir,
-        set,
-        cfg,
-        estimator,
-        set.frames.len(),
-        |_, _, _, r, _| {
-            out.push([r.lanes[0].coeffs, r.lanes[1].coeffs]);
-            Ok(())
-        },
-    )?;
-    Ok(out)
-}
-
-/// Run a tracker over the frames of a labelled set before position `until`, clip by clip (reset
-/// at the start of every clip), calling `on_frame(position in the set, labels, tracker, report,
-/// frame)` after every frame, in set order; its first error stops the run and is returned.
-fn run_label_set(
-    dir: &Path,
-    set: &LabelSet,
-    cfg: &TrackerConfig,
-    estimator: Estimator,
-    until: usize,
-    mut on_frame: impl FnMut(
-        usize,
-        &LabelFrame,
-        &LaneTracker,
-        &TrackReport,
-        &GreyFrame,
-    ) -> Result<(), EvalError>,
-) -> Result<(), EvalError> {
-    let mut tracker = LaneTracker::new(cfg, estimator, set.width, set.height)?;
-    let mut frame = GreyFrame::default();
-    let mut position = 0;
-    for clip in set.clips() {
-        tracker.reset();
-        for f in clip {
-            if position >= until {
-                return Ok(());
-            }
-            let path = LabelSet::frame_path(dir, f);
-            lane_io::sources::decode_image_file(&path, &mut frame)?;
-            if (frame.width(), frame.height()) != (set.width, set.height) {
-                return Err(EvalError::Labels {
-                    path: path.display().to_string(),
-                    reason: format!(
-                        "image is {}×{}, the set declares {}×{}",
-                        frame.width(),
-                        frame.height(),
-                        set.width,
-                        set.height
-                    ),
-                });
-            }
-            let r = tracker.track(&frame)?;
-            on_frame(position, f, &tracker, &r, &frame)?;
-            position += 1;
-        }
-    }
-    Ok(())
-}
-
 /// The **ceiling** of the lane model: for each ego label lane of `frame`, the least-squares
 /// parabola `x = a1·y² + a2·y + a3` of its points on the rows `[top, bottom)` (the tracker's
 /// region of interest), reported as that side's prediction (`None` with fewer than 3 such points
@@ -711,8 +630,11 @@ fn fit_slope(pts: &[[f64; 2]]) -> f64 {
 mod census;
 mod choice_bound;
 pub mod import;
+mod run;
 #[cfg(test)]
 mod tests;
 
 pub use census::{LaneCensus, LaneStage, StageCensus, census_lanes};
 pub use choice_bound::{ChoiceBound, choice_bound_set};
+pub(crate) use run::run_label_set;
+pub use run::{SkippedFrame, TrackedSet, track_label_set};

@@ -1,31 +1,32 @@
-//! `cargo xtask import-lanes`: a labelled set in TuSimple's or CULane's format, written as a
-//! `labels.json` (schema 1) that `cargo xtask eval-lanes --data DIR` scores like the shared sets.
-//! The formats and the ego-pair rule are `lane_eval::labelled::import`'s; this command does the
-//! file work around them.
+//! A labelled set in TuSimple's or CULane's format, written as a `labels.json` (schema 1) that
+//! [`crate::protocol`] scores like the shared sets (`nav-app import-lanes`). The formats and the
+//! ego-pair rule are [`crate::labelled::import`]'s; this module does the file work around them.
 //!
 //! The images are not copied: each frame's `file` is the image's absolute path, so the set
 //! directory holds only `labels.json` and the user's recording stays where it is. Every image's
 //! size is read from its header; the set takes the first one's, and a frame of another size is
 //! skipped and reported, like a label record that cannot be read or an image that is missing.
-//! A `labels.json` already in the set directory is replaced only when this command wrote it.
+//! A `labels.json` already in the set directory is replaced only when this module wrote it.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
-use lane_eval::labelled::import::{
+use crate::BenchError;
+use crate::labelled::import::{
     ImportedFrame, Skipped, assign_sides, culane_lines_file, parse_culane_lines, parse_culane_list,
     parse_tusimple,
 };
-use lane_eval::labelled::{LABEL_SCHEMA, LabelFrame, LabelSet, SceneKind};
+use crate::labelled::{LABEL_SCHEMA, LabelFrame, LabelSet, SceneKind};
 
-use crate::paths::{resolve, workspace_root};
-
-/// The `licence` of a set this command writes: it marks the `labels.json` files it may
+/// The `licence` of a set this module writes: it marks the `labels.json` files it may
 /// overwrite (never another one, such as a shared set's).
-const IMPORTED_LICENCE: &str = "not stated (imported by cargo xtask import-lanes)";
+pub const IMPORTED_LICENCE: &str = "not stated (imported by nav-app import-lanes)";
+/// The mark of the sets written before the import moved into this crate (`cargo xtask
+/// import-lanes`): they too may be overwritten.
+const IMPORTED_LICENCE_BEFORE: &str = "not stated (imported by cargo xtask import-lanes)";
 
-/// The label formats `import-lanes` reads.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+/// The label formats [`import_set`] reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Format {
     /// TuSimple: JSON lines (`label_data_*.json`, `test_label.json`), images under the label
     /// file's directory.
@@ -34,100 +35,24 @@ pub enum Format {
     Culane,
 }
 
-/// Scene kind of the imported set.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    /// Roads.
-    Road,
-    /// Indoor floors and tracks.
-    Indoor,
-}
-
-/// Arguments of `cargo xtask import-lanes`.
-#[derive(clap::Args, Debug)]
-pub struct ImportLanesArgs {
-    /// The labels' format.
-    #[arg(long, value_enum)]
-    format: Format,
-    /// The set directory to write (`labels.json` in it); its name is the set's. Score it with
-    /// `cargo xtask eval-lanes --data <its parent>`. Relative paths from the workspace root.
-    #[arg(long)]
-    out: PathBuf,
-    /// CULane's data root, the directory the list's image paths start from. Default: the list
-    /// file's directory's parent (CULane's own layout, `ROOT/list/test.txt`).
-    #[arg(long)]
-    root: Option<PathBuf>,
-    /// Scene kind written into the set.
-    #[arg(long, value_enum, default_value = "road")]
-    kind: Kind,
-    /// The label files: TuSimple's JSON-lines files (several are one set), or one CULane list.
-    #[arg(required = true)]
-    labels: Vec<PathBuf>,
-}
-
-/// Run `cargo xtask import-lanes`.
-pub fn run(args: ImportLanesArgs) -> Result<()> {
-    let root = workspace_root();
-    let labels: Vec<PathBuf> = args.labels.iter().map(|p| resolve(&root, p)).collect();
-    let out = resolve(&root, &args.out);
-    let kind = match args.kind {
-        Kind::Road => SceneKind::Road,
-        Kind::Indoor => SceneKind::Indoor,
-    };
-    if args.root.is_some() && args.format != Format::Culane {
-        bail!(
-            "import-lanes: --root is CULane's data root (TuSimple's images are under its \
-             label file's directory)"
-        );
-    }
-    let culane_root = args.root.as_deref().map(|r| resolve(&root, r));
-    let (set, skipped) = import(args.format, &labels, culane_root.as_deref(), &out, kind)?;
-    report_skipped(&skipped);
-    println!(
-        "import-lanes: {} frames ({}×{}) into {} ({} skipped); score with \
-         `cargo xtask eval-lanes --no-peer --data {}`",
-        set.frames.len(),
-        set.width,
-        set.height,
-        out.join("labels.json").display(),
-        skipped.len(),
-        out.parent().unwrap_or(&out).display()
-    );
-    Ok(())
-}
-
-/// The skipped records shown one per line, at most this many (a wrong `--root` skips every image).
-const SKIPPED_SHOWN: usize = 20;
-
-/// Print what was skipped: the first [`SKIPPED_SHOWN`] records, then how many more.
-fn report_skipped(skipped: &[Skipped]) {
-    for s in skipped.iter().take(SKIPPED_SHOWN) {
-        eprintln!("import-lanes: skipped {s}");
-    }
-    if skipped.len() > SKIPPED_SHOWN {
-        eprintln!(
-            "import-lanes: … and {} more skipped",
-            skipped.len() - SKIPPED_SHOWN
-        );
-    }
-}
-
 /// Read `labels` in `format`, write `out/labels.json` and return the set and what was skipped.
-pub fn import(
+/// `culane_root` is CULane's data root (default: the list file's directory's parent, CULane's
+/// own layout `ROOT/list/test.txt`); TuSimple's images are under each label file's directory.
+pub fn import_set(
     format: Format,
     labels: &[PathBuf],
     culane_root: Option<&Path>,
     out: &Path,
     kind: SceneKind,
-) -> Result<(LabelSet, Vec<Skipped>)> {
+) -> Result<(LabelSet, Vec<Skipped>), BenchError> {
     let mut skipped = Vec::new();
     // Each frame with the directory its image path is relative to.
     let mut read: Vec<(PathBuf, ImportedFrame)> = Vec::new();
     match format {
         Format::Tusimple => {
             for file in labels {
-                let text = std::fs::read_to_string(file)
-                    .with_context(|| format!("import-lanes: cannot read {}", file.display()))?;
+                let text =
+                    std::fs::read_to_string(file).map_err(|e| BenchError::io("read", file, e))?;
                 let (frames, bad) = parse_tusimple(&file.display().to_string(), &text);
                 skipped.extend(bad);
                 let dir = file.parent().map_or_else(PathBuf::new, Path::to_path_buf);
@@ -136,13 +61,13 @@ pub fn import(
         }
         Format::Culane => {
             let [list] = labels else {
-                bail!(
-                    "import-lanes: --format culane takes one list file, got {}",
+                return Err(BenchError::Refused(format!(
+                    "the CULane format takes one list file, got {}",
                     labels.len()
-                );
+                )));
             };
-            let text = std::fs::read_to_string(list)
-                .with_context(|| format!("import-lanes: cannot read {}", list.display()))?;
+            let text =
+                std::fs::read_to_string(list).map_err(|e| BenchError::io("read", list, e))?;
             let data_root = match culane_root {
                 Some(r) => r.to_path_buf(),
                 None => list
@@ -207,8 +132,7 @@ pub fn import(
     }
     // Set by the first readable image, which is always kept: no size, no frame.
     let Some((width, height)) = size else {
-        report_skipped(&skipped);
-        bail!("import-lanes: no frame could be imported (see the skipped records above)");
+        return Err(BenchError::NothingImported(skipped));
     };
     let name = out.file_name().map_or_else(
         || "imported".to_owned(),
@@ -235,37 +159,40 @@ pub fn import(
         height,
         frames,
     };
-    let text = serde_json::to_string_pretty(&set).context("import-lanes: serialising the set")?;
     let path = out.join("labels.json");
+    let text = serde_json::to_string_pretty(&set).map_err(|source| BenchError::Json {
+        path: path.display().to_string(),
+        source,
+    })?;
     // What eval-lanes will read: checked by its own reader before it is written.
     LabelSet::from_json_str(&path.display().to_string(), &text)
-        .context("import-lanes: the written set does not read back")?;
+        .map_err(|e| e.during("the imported set does not read back"))?;
     if path.exists() {
-        let ours = LabelSet::load(out).is_ok_and(|old| old.licence == IMPORTED_LICENCE);
+        let ours = LabelSet::load(out).is_ok_and(|old| {
+            old.licence == IMPORTED_LICENCE || old.licence == IMPORTED_LICENCE_BEFORE
+        });
         if !ours {
-            bail!(
-                "import-lanes: {} exists and was not written by import-lanes: give another --out",
+            return Err(BenchError::Refused(format!(
+                "{} exists and was not written by import-lanes: give another output directory",
                 path.display()
-            );
+            )));
         }
     }
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("import-lanes: cannot create {}", out.display()))?;
-    std::fs::write(&path, text)
-        .with_context(|| format!("import-lanes: cannot write {}", path.display()))?;
+    std::fs::create_dir_all(out).map_err(|e| BenchError::io("create", out, e))?;
+    std::fs::write(&path, text).map_err(|e| BenchError::io("write", &path, e))?;
     Ok((set, skipped))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lane_eval::labelled::{LabelSide, ScoringRules, score_frame, track_label_set};
+    use crate::labelled::{LabelSide, ScoringRules, score_frame, track_label_set};
     use lane_tracker::{Estimator, TrackerConfig};
 
     /// A fresh scratch directory under the build directory.
     fn scratch(name: &str) -> PathBuf {
-        let dir = crate::paths::target_dir(&workspace_root())
-            .join("xtask-tests")
+        let dir = std::env::temp_dir()
+            .join(format!("lane-bench-tests-{}", std::process::id()))
             .join(name);
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("scratch directory");
@@ -314,7 +241,7 @@ mod tests {
         std::fs::write(&labels, text).expect("labels");
         let out = dir.join("sets/mine");
 
-        let (set, skipped) = import(
+        let (set, skipped) = import_set(
             Format::Tusimple,
             std::slice::from_ref(&labels),
             None,
@@ -349,7 +276,9 @@ mod tests {
         let back = LabelSet::load(&out).expect("written set");
         assert_eq!(back, set);
         let cfg = TrackerConfig::default_preset().expect("default");
-        let predictions = track_label_set(&out, &back, &cfg, Estimator::Kif).expect("tracked");
+        let predictions = track_label_set(&out, &back, &cfg, Estimator::Kif)
+            .expect("tracked")
+            .predictions;
         assert_eq!(predictions.len(), 2);
         // The labels were written on the drawn stripes, so the tracker's two lanes match them.
         for (frame, prediction) in back.frames.iter().zip(&predictions) {
@@ -390,7 +319,7 @@ mod tests {
         let out = dir.join("sets/culane-mine");
 
         // The data root defaults to the list's directory's parent.
-        let (set, skipped) = import(
+        let (set, skipped) = import_set(
             Format::Culane,
             std::slice::from_ref(&list),
             None,
@@ -425,7 +354,7 @@ mod tests {
         // Importing again over its own set is allowed; over a set it did not write, refused,
         // and that set is left as it was.
         assert!(
-            import(
+            import_set(
                 Format::Culane,
                 std::slice::from_ref(&list),
                 None,
@@ -440,7 +369,7 @@ mod tests {
             .expect("labels")
             .replace(IMPORTED_LICENCE, "CC-BY-4.0");
         std::fs::write(theirs.join("labels.json"), &their_text).expect("their labels");
-        let over = import(
+        let over = import_set(
             Format::Culane,
             std::slice::from_ref(&list),
             None,
@@ -457,7 +386,7 @@ mod tests {
             their_text
         );
         // Two list files are refused: one CULane list is one set.
-        let two = import(
+        let two = import_set(
             Format::Culane,
             &[list.clone(), list],
             None,

@@ -1,5 +1,5 @@
 //! Where the ego label lanes are lost, stage by stage: a diagnostic for tuning the
-//! initialisation (`cargo xtask eval-lanes --census`). [`census_lanes`] gives each lane's stage
+//! initialisation (`nav-app eval-lanes --census`). [`census_lanes`] gives each lane's stage
 //! ([`LaneStage`]; `frames.csv`'s `census_stage`), [`StageCensus::count`] their counts (the
 //! `--census` table).
 //!
@@ -45,7 +45,7 @@ use vision_gradient::{EdgeBuffer, GradientDetector, GreyImage, Region};
 use super::{
     LabelSet, LabelSide, ScoringRules, run_label_set, scored_points, tusimple_lane_accuracy,
 };
-use crate::EvalError;
+use crate::BenchError;
 
 /// Counts of scored ego label lanes by the stage where they are lost (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -164,8 +164,9 @@ impl StageCensus {
 /// clip).
 ///
 /// # Errors
-/// As [`super::track_label_set`]: a frame that cannot be read or has another size than the set
-/// declares, or a configuration the tracker refuses.
+/// A configuration the tracker or the edge detector refuses (a frame that cannot be read or has
+/// another size than the set declares is skipped, as by [`super::track_label_set`], and not
+/// classified).
 pub fn census_lanes(
     dir: &Path,
     set: &LabelSet,
@@ -173,7 +174,7 @@ pub fn census_lanes(
     estimator: Estimator,
     frames: Range<usize>,
     rules: &ScoringRules,
-) -> Result<Vec<LaneCensus>, EvalError> {
+) -> Result<Vec<LaneCensus>, BenchError> {
     let mut census = Vec::new();
     let y_top = rules.eval_top_fraction * set.height as f64;
     let tus_px = rules.tusimple_px_at_1280 * set.width as f64 / 1280.0;
@@ -199,10 +200,13 @@ pub fn census_lanes(
         cfg,
         estimator,
         frames.end,
-        |position, labels, tracker, report, frame| {
+        |position, labels, tracked| {
+            // A skipped frame is not classified (the choice bound's run lists it).
+            let Some(t) = tracked else { return Ok(()) };
             if !frames.contains(&position) {
                 return Ok(());
             }
+            let (tracker, report, frame) = (t.tracker, &t.report, t.frame);
             let mut edges_read = false;
             let candidates = tracker.init_candidates();
             for (k, (label_side, side)) in [
@@ -298,7 +302,7 @@ fn mark_edges(
     (top, bottom): (usize, usize),
     edges: &mut EdgeBuffer,
     edge_at: &mut [bool],
-) -> Result<(), EvalError> {
+) -> Result<(), BenchError> {
     let w = image.width();
     detector.detect(
         image,

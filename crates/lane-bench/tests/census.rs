@@ -11,7 +11,7 @@
 
 use std::path::PathBuf;
 
-use lane_eval::labelled::{
+use lane_bench::labelled::{
     LabelSet, LabelSide, LaneCensus, LaneStage, ScoringRules, StageCensus, census_lanes,
     choice_bound_set, score_frame, track_label_set,
 };
@@ -262,7 +262,9 @@ fn the_choice_bound_takes_a_candidate_only_where_it_beats_the_output() {
     let rules = ScoringRules::default();
     let run = choice_bound_set(&dir, &set, &cfg, Estimator::Kif, &rules).unwrap();
     // The same run as the tracker's own.
-    let output = track_label_set(&dir, &set, &cfg, Estimator::Kif).unwrap();
+    let output = track_label_set(&dir, &set, &cfg, Estimator::Kif)
+        .unwrap()
+        .predictions;
     assert_eq!(run.output, output);
     let bound = &run.best;
     assert_eq!(bound.len(), set.frames.len());

@@ -1,6 +1,6 @@
 //! Labels from the two public lane benchmarks' formats, read into this crate's schema, so that a
-//! user's own labelled recordings in either format are scored by `cargo xtask eval-lanes` like
-//! the shared sets (`cargo xtask import-lanes` does the file work around these functions).
+//! user's own labelled recordings in either format are scored by `nav-app eval-lanes` like
+//! the shared sets (`nav-app import-lanes`, [`crate::import_set`], does the file work around these functions).
 //!
 //! ## TuSimple (`label_data_*.json`, `test_label.json`)
 //! One JSON object per line: `{"lanes": [[x₀, x₁, …], …], "h_samples": [y₀, y₁, …],

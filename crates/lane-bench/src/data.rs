@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::EvalError;
+use crate::BenchError;
 
 /// Environment variable naming the data root (instead of `../shared/data` beside the checkout).
 pub const DATA_ENV: &str = "ITA_NAV_DATA";
@@ -25,13 +25,13 @@ pub fn data_root() -> PathBuf {
     }
 }
 
-/// `relative` under the data root, or [`EvalError::MissingData`] naming it.
-pub fn data_file(relative: &str) -> Result<PathBuf, EvalError> {
+/// `relative` under the data root, or [`BenchError::MissingData`] naming it.
+pub fn data_file(relative: &str) -> Result<PathBuf, BenchError> {
     let path = data_root().join(relative);
     if path.exists() {
         Ok(path)
     } else {
-        Err(EvalError::MissingData {
+        Err(BenchError::MissingData {
             path: path.display().to_string(),
             what: relative.to_owned(),
         })
@@ -43,13 +43,13 @@ pub fn data_file(relative: &str) -> Result<PathBuf, EvalError> {
 pub const CI_ENV: &str = "CI";
 
 /// For a test that needs `relative` (under the data root): `Ok(Some(path))` when it is there.
-/// When it is not: under CI (`$CI` set) [`EvalError::MissingData`] naming it, for the test to
+/// When it is not: under CI (`$CI` set) [`BenchError::MissingData`] naming it, for the test to
 /// fail with; elsewhere `Ok(None)` after `SKIPPED: …` naming it on stderr, for the test to
 /// return early.
 ///
 /// # Errors
-/// [`EvalError::MissingData`] under CI when `relative` is missing.
-pub fn test_data_file(relative: &str) -> Result<Option<PathBuf>, EvalError> {
+/// [`BenchError::MissingData`] under CI when `relative` is missing.
+pub fn test_data_file(relative: &str) -> Result<Option<PathBuf>, BenchError> {
     match data_file(relative) {
         Ok(path) => Ok(Some(path)),
         Err(e) if std::env::var_os(CI_ENV).is_some() => Err(e),
