@@ -248,9 +248,16 @@ fn a_syntax_or_schema_error_names_the_file_line_and_column_once() {
     assert_eq!(*line, 2);
     // The message names the file and the place once, then what serde_json said (no source).
     let e = shown(&e);
-    assert!(e.starts_with(&format!("labels.json:2:{column}: bad lane labels: ")), "{e}");
+    assert!(
+        e.starts_with(&format!("labels.json:2:{column}: bad lane labels: ")),
+        "{e}"
+    );
     assert_eq!(e.matches("labels.json").count(), 1, "{e}");
-    assert_eq!(e.matches("line").count(), 0, "located once, in the prefix: {e}");
+    assert_eq!(
+        e.matches("line").count(),
+        0,
+        "located once, in the prefix: {e}"
+    );
 }
 
 #[test]

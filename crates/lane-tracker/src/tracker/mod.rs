@@ -463,7 +463,8 @@ impl LaneTracker {
     /// `track.refine_passes` windowed updates (at least one) from the LS parabola, with the
     /// window's outlier rejection (the Hough band keeps clutter); then the readings of the
     /// image that move it (the stripe trace, no turn back, a double line's middle, a kerb's
-    /// foot). A refinement that missed keeps the LS initialisation as it was.
+    /// foot). A refinement that missed keeps the LS initialisation as it was. Decisions and
+    /// figures: `docs/lanes/history/refinement-window.md` (below the ablation's bar, kept).
     fn refine(&mut self, side: Side, image: &GreyImage<'_>) -> Result<(), TrackerError> {
         for _ in 0..self.setup.cfg.track.refine_passes.max(1) {
             self.track_lane(side, image, Pass::Refinement)?;
