@@ -27,6 +27,7 @@ pub mod config;
 mod error;
 mod frame;
 pub mod frame_loop;
+pub mod lane_frame;
 pub mod mcap_sink;
 pub mod mcap_source;
 pub mod overlay;

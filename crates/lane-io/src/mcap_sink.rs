@@ -2,7 +2,7 @@
 //! `foxglove.RawImage` on `/camera/image`, both lanes drawn on it as polylines
 //! (`foxglove.ImageAnnotations` on `/camera/lanes`: left blue, right orange, over the rows of the
 //! points behind each estimate), and the lane estimate itself as JSON on `/lanes` (the object
-//! `nav-app --json` prints for the frame, with its JSON schema [`LANES_SCHEMA`]). Opening the
+//! `nav-app --json` prints for the frame, [`LaneFrame`], with its JSON schema [`LANES_SCHEMA`]). Opening the
 //! file in Foxglove's Image panel on `/camera/image` with `/camera/lanes` as annotations shows
 //! the camera with the lanes on it; the Plot panel plots `/lanes.lanes[0].coeffs[2]` and the rest.
 
@@ -13,9 +13,9 @@ use ros_bag::out::foxglove::{
     RawImage, Time, image_annotations_schema, raw_image_schema,
 };
 use ros_bag::out::{JsonChannel, JsonMcapWriter, base64_into};
-use serde::Serialize;
 
 use crate::LaneIoError;
+use crate::lane_frame::LaneFrame;
 
 /// Topic of the grey frames.
 pub const IMAGE_TOPIC: &str = "/camera/image";
@@ -27,7 +27,7 @@ pub const LANES_TOPIC: &str = "/lanes";
 pub const LANES_SCHEMA_NAME: &str = "ita_nav.LaneFrame";
 
 /// JSON schema of the `/lanes` messages (`nav-app --json`'s per-frame object, schema 1).
-pub const LANES_SCHEMA: &str = r#"{"title":"ita_nav.LaneFrame","description":"One frame of nav-app's lane tracker (the --json object of the README, schema 1)","type":"object","properties":{"schema":{"type":"integer","const":1},"frame":{"type":"integer","minimum":0},"t_s":{"type":"number"},"lanes":{"type":"array","minItems":2,"maxItems":2,"items":{"type":"object","properties":{"side":{"enum":["left","right"]},"state":{"enum":["initialising","tracking","coasting","lost"]},"coeffs":{"type":["array","null"],"items":{"type":"number"},"minItems":3,"maxItems":3,"description":"[a1, a2, a3] of x = a1 y^2 + a2 y + a3, pixels of the input image"},"rows":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2},"points":{"type":"integer","minimum":0},"initialised":{"type":"boolean"}},"required":["side","state","coeffs","rows","points","initialised"]}},"track_us":{"type":"number"},"ego_lane":{"type":["object","null"]},"lane_cov_px":{"type":["array","null"]}},"required":["schema","frame","t_s","lanes","track_us"]}"#;
+pub const LANES_SCHEMA: &str = r#"{"title":"ita_nav.LaneFrame","description":"One frame of nav-app's lane tracker (lane_io::lane_frame::LaneFrame, the --json object, schema 1)","type":"object","properties":{"schema":{"type":"integer","const":1},"frame":{"type":"integer","minimum":0},"t_s":{"type":"number"},"lanes":{"type":"array","minItems":2,"maxItems":2,"items":{"type":"object","properties":{"side":{"enum":["left","right"]},"state":{"enum":["initialising","tracking","coasting","lost"]},"coeffs":{"type":["array","null"],"items":{"type":"number"},"minItems":3,"maxItems":3,"description":"[a1, a2, a3] of x = a1 y^2 + a2 y + a3, pixels of the input image"},"rows":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2},"points":{"type":"integer","minimum":0},"initialised":{"type":"boolean"}},"required":["side","state","coeffs","rows","points","initialised"]}},"track_us":{"type":"number"},"ego_lane":{"type":["object","null"]},"lane_cov_px":{"type":["array","null"]}},"required":["schema","frame","t_s","lanes","track_us"]}"#;
 
 const COLOURS: [Color; 2] = [
     Color {
@@ -107,7 +107,7 @@ impl LaneMcapSink {
         t_s: f64,
         frame: &GreyFrame,
         report: &TrackReport,
-        lanes_message: &impl Serialize,
+        lanes_message: &LaneFrame<'_>,
     ) -> Result<(), LaneIoError> {
         let t_ns = (t_s.max(0.0) * 1e9).round() as u64;
         let timestamp = Time::from_ns(t_ns);

@@ -11,18 +11,18 @@ use clap::{Parser, ValueEnum};
 use lane_io::birdseye::BirdseyeView;
 use lane_io::capture::{InputSelect, PixelFormat, VideoStd};
 use lane_io::capture_source::{
-    self, CaptureMonitor, DeviceFrameInfo, DeviceOptions, DeviceSetup, DeviceStats,
-    parse_control_spec,
+    self, CaptureMonitor, DeviceOptions, DeviceSetup, DeviceStats, parse_control_spec,
 };
 use lane_scenes::{SCENES, SceneSource};
 use std::io::IsTerminal;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use lane_io::frame_loop::{FrameLoop, Step, Tracked};
+use lane_io::lane_frame::{LANE_FRAME_SCHEMA, LaneFrame};
 use lane_io::overlay::{OverlaySink, render_overlay};
 use lane_io::sources::open_input;
 use lane_io::{FrameSource, LaneIoError};
-use lane_tracker::camera::{CameraModel, EgoLaneReport};
+use lane_tracker::camera::CameraModel;
 use lane_tracker::{Estimator, LaneReport, LaneState, Side};
 use serde::Serialize;
 
@@ -199,30 +199,8 @@ fn device_options(d: &DeviceArgs) -> Result<DeviceOptions> {
     Ok(opts)
 }
 
-/// Version of the per-frame `--json` objects and of the summary line (README, "Per-frame JSON").
-/// Raised when a field changes meaning or disappears; new fields do not raise it.
-const JSON_SCHEMA: u32 = 1;
-
-#[derive(Serialize)]
-struct FrameJson<'a> {
-    /// [`JSON_SCHEMA`].
-    schema: u32,
-    frame: u64,
-    t_s: f64,
-    lanes: &'a [LaneReport; 2],
-    /// Wall time of `LaneTracker::track` on this frame, µs.
-    track_us: f64,
-    /// The ego lane in metres with σ (with `--camera`; `null` unless both lanes are held).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    ego_lane: Option<Option<EgoLaneReport>>,
-    /// Each lane's coefficient covariance in pixels (with `--camera` or `--mcap-out`, whose
-    /// `/lanes` messages always carry it; `null` for a lane without an estimate).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    lane_cov_px: Option<[Option<[[f64; 3]; 3]>; 2]>,
-    /// Device fields (with `--device` only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    capture: Option<DeviceFrameInfo>,
-}
+/// Version of the per-frame `--json` objects and of the summary line ([`LaneFrame`]'s).
+const JSON_SCHEMA: u32 = LANE_FRAME_SCHEMA;
 
 /// The last line of a `--json` run.
 #[derive(Serialize)]
@@ -406,7 +384,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
             }
         }
         if args.json || mcap_out.is_some() {
-            let frame_json = FrameJson {
+            let frame_json = LaneFrame {
                 schema: JSON_SCHEMA,
                 frame: index,
                 t_s: meta.t_s,
