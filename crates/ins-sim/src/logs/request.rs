@@ -3,7 +3,8 @@
 
 use std::path::PathBuf;
 
-use super::read::{imu_nominal_step_s, read_initial};
+use super::imu::ImuLog;
+use super::read::read_initial;
 use super::reference::{initial_from_reference, read_reference};
 use super::replay::{ReplayInputs, SolutionRate};
 use crate::filter_file::FilterFile;
@@ -103,12 +104,12 @@ impl ReplayRequest {
                 ));
             }
         };
+        // The log is opened here once; what the nominal step reads is kept for the replay.
+        let mut imu = ImuLog::new(self.imu.clone(), self.imu_topic.clone());
         let mut config = match &self.settings {
-            FilterSettings::File(f) => f.filter_config(
-                self.mode,
-                imu_nominal_step_s(&self.imu, self.imu_topic.as_deref())?,
-                initial.t_s,
-            )?,
+            FilterSettings::File(f) => {
+                f.filter_config(self.mode, imu.nominal_step_s()?, initial.t_s)?
+            }
             FilterSettings::Scenario(s) => s.online_filter_config(self.mode),
         };
         if let Some(gate) = self.gate {
@@ -126,8 +127,7 @@ impl ReplayRequest {
             }
         };
         Ok(ReplayInputs {
-            imu: self.imu.clone(),
-            imu_topic: self.imu_topic.clone(),
+            imu,
             sightings,
             initial,
             config,

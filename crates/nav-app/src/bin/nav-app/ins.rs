@@ -199,7 +199,7 @@ fn run_ins(args: &InsArgs) -> Result<()> {
     let file = std::fs::File::create(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut out = BufWriter::new(file);
-    let summary = logs::replay(&inputs, &mut out, &args.out)?;
+    let summary = logs::replay(inputs, &mut out, &args.out)?;
     report(args, &summary)
 }
 
