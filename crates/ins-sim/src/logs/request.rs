@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+use toml_config::TomlDoc;
+
 use super::imu::ImuLog;
 use super::read::read_initial;
 use super::reference::{initial_from_reference, read_reference};
@@ -19,6 +21,27 @@ pub enum FilterSettings {
     /// A simulation scenario's `[filter]` (the older way; the scenario's IMU step and time-stamp
     /// tolerance are kept, so an exported run replays to round-off).
     Scenario(Box<Scenario>),
+}
+
+impl FilterSettings {
+    /// The settings in a file: a simulation scenario (the older way) when the document has a
+    /// top-level `trajectory` table (every scenario has one, no filter file may), else a filter
+    /// file. The TOML is parsed once; `path` names the file in errors.
+    ///
+    /// # Errors
+    /// [`SimError::LogToml`] for a TOML syntax error or a bad filter file,
+    /// [`SimError::ScenarioFile`] for a bad scenario, each with its line and column.
+    pub fn from_toml_named(path: &str, text: &str) -> Result<Self, SimError> {
+        let doc = TomlDoc::parse(path, text).map_err(|error| SimError::LogToml {
+            path: path.into(),
+            error,
+        })?;
+        if doc.keys().any(|k| k == "trajectory") {
+            Ok(Self::Scenario(Box::new(Scenario::from_doc(&doc)?)))
+        } else {
+            Ok(Self::File(FilterFile::from_doc(&doc, path)?))
+        }
+    }
 }
 
 /// A replay request ([`ReplayRequest::inputs`]).
