@@ -258,7 +258,7 @@ fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
         let parts: Vec<_> = truth.components().rev().take(2).collect();
         let name: PathBuf = parts.iter().rev().collect();
         let title = format!("--filter {} against {}", args.filter, name.display());
-        let png = ins_monte_carlo::plot::replay_figure(&m.series, &title)?;
+        let png = ins_plot::replay_figure(&m.series, &title)?;
         std::fs::write(path, png).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
