@@ -141,7 +141,7 @@ impl ImuStream {
 
 /// An IMU log (CSV, or a bag's IMU topic) read once per replay. It is opened at the first read;
 /// samples looked at before the replay ([`ImuLog::nominal_step_s`], [`super::align_at_rest`]) are
-/// kept, and [`ImuLog::next`] hands them out first, then reads on: the file is read once, from
+/// kept, and the replay takes them first, then reads on: the file is read once, from
 /// the start, in order, and its errors surface where they did when each step read it anew.
 pub struct ImuLog {
     path: PathBuf,
