@@ -117,6 +117,7 @@
 pub mod driver;
 mod error;
 pub mod export;
+mod notes;
 pub mod options;
 pub mod outputs;
 pub mod plot;
