@@ -6,7 +6,8 @@
 //! product binary (`nav-app`) not on the evaluation (`lane-eval`);
 //! `lane-tracker` and `lane-io` build cleanly alone; the INS simulation, crate `ins-sim` (used by
 //! the Python package), builds and depends on neither `rayon` nor `plotters` (they belong to
-//! `ins-monte-carlo`). Each check reads `cargo tree -p CRATE -e normal`.
+//! `ins-monte-carlo`); the INS figures, crate `ins-plot` (the replay's error figure), do not
+//! depend on the Monte Carlo. Each check reads `cargo tree -p CRATE -e normal`.
 
 use std::process::Command;
 
@@ -45,6 +46,10 @@ const NOT_IN_LANE: &[&str] = &[
 
 /// Crates the INS simulation (`ins-sim`) must not depend on: the Monte Carlo's pool and figures.
 const NOT_IN_INS_SIM: &[&str] = &["rayon", "plotters"];
+
+/// Crates the INS figures (`ins-plot`: the replay's error figure, `nav-app ins --plot`) must not
+/// depend on: the Monte Carlo and its pool.
+const NOT_IN_INS_PLOT: &[&str] = &["ins-monte-carlo", "rayon"];
 
 /// The crates `cargo tree -p PACKAGE -e normal ARGS…` lists (one name per line, no prefix).
 fn normal_deps(cargo: &str, package: &str, args: &[&str]) -> Result<Vec<String>> {
@@ -163,7 +168,9 @@ pub fn run() -> Result<()> {
     )?;
     clippy_alone(&cargo, "lane-tracker", &[])?;
     clippy_alone(&cargo, "lane-io", &["--no-default-features"])?;
-    // The INS half: the simulation without the Monte Carlo's rayon and plotters.
+    // The INS half: the simulation without the Monte Carlo's rayon and plotters; the replay's
+    // figure without the Monte Carlo.
+    check_deps(&cargo, "ins-plot", &[], NOT_IN_INS_PLOT)?;
     check_ins_sim(&cargo)
 }
 

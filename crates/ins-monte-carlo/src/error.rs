@@ -72,15 +72,9 @@ pub enum McError {
     /// The worker pool could not be built.
     #[error("cannot start the worker threads")]
     ThreadPool(#[from] rayon::ThreadPoolBuildError),
-    /// A figure could not be drawn or encoded.
-    #[error("figure {figure}")]
-    Plot {
-        /// The figure, e.g. `fig3_kf_mean` or `sweep`.
-        figure: String,
-        /// The plotting or PNG layer's error.
-        #[source]
-        source: Box<dyn std::error::Error + Send + Sync>,
-    },
+    /// A figure could not be drawn or encoded (the error names the figure).
+    #[error(transparent)]
+    Plot(#[from] ins_plot::PlotError),
     /// Serialising a report failed.
     #[error("cannot serialise a report")]
     Json(#[from] serde_json::Error),

@@ -68,7 +68,8 @@
 //! `fig7_nees_nis` (run-averaged NEES and NIS of the filters vs time, log scale, with their 95 %
 //! bands dashed) and `fig8_position_rms` (RMS over runs of the 3-D position error, every
 //! configuration, log scale). Text in the figures uses DejaVu Sans bundled under
-//! `crates/ins-monte-carlo/assets/` (licence beside it), so PNG and SVG carry the same labels.
+//! `crates/ins-plot/assets/` (licence beside it; crate `ins_plot` draws what these figures share
+//! with the replay's), so PNG and SVG carry the same labels.
 //! `summary.json` is [`summary::SummaryJson`], a serde structure with a `schema` version
 //! ([`summary::SUMMARY_SCHEMA`]).
 //!
@@ -116,6 +117,7 @@
 pub mod driver;
 mod error;
 pub mod export;
+mod notes;
 pub mod options;
 pub mod outputs;
 pub mod plot;

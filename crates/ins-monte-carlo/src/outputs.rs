@@ -93,13 +93,15 @@ pub fn render(stats: &Stats, full: bool) -> Result<Vec<(String, Vec<u8>)>, McErr
             ));
         }
         files.extend(plot::figures(stats)?);
+        // One computation: summary.md is rendered from the structure summary.json serialises.
+        let summary = summary::summary(stats);
         files.push((
             "summary.json".to_string(),
-            summary::summary_json(stats)?.into_bytes(),
+            summary::summary_json(&summary)?.into_bytes(),
         ));
         files.push((
             "summary.md".to_string(),
-            summary::summary_md(stats).into_bytes(),
+            summary::summary_md(stats, &summary).into_bytes(),
         ));
     }
     Ok(files)

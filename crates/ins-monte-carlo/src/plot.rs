@@ -2,18 +2,14 @@
 //! misalignment errors vs time, per configuration), and our Figs. 7 (NEES/NIS vs their bands)
 //! and 8 (3-D RMS position error of every configuration), as SVG and PNG, drawn with plotters.
 //!
-//! Text needs a font: plotters' `ab_glyph` feature with DejaVu Sans bundled in
-//! `crates/ins-monte-carlo/assets/` (Bitstream Vera licence, `DejaVuSans-LICENSE.txt` beside it), so the PNGs
-//! and the SVGs carry the same labels and no system font is looked up. PNGs are rendered into
-//! an RGB buffer (plotters' bitmap backend without its own encoder) and encoded with the
-//! workspace's `image` crate.
+//! The font, the figure size, the time-series panel and the PNG encoding are crate `ins_plot`'s
+//! (shared with the replay's error figure, `nav-app ins --plot`).
 
 use std::error::Error;
-use std::sync::Once;
 
+use ins_plot::{HEIGHT_PX as H, Series, WIDTH_PX as W, encode_png, panel, register_font};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::FontStyle;
 
 use super::McError;
 use super::stats::{ModeStats, Stats, qi};
@@ -23,17 +19,8 @@ fn plot_error(
     figure: impl Into<String>,
     source: impl Into<Box<dyn Error + Send + Sync>>,
 ) -> McError {
-    McError::Plot {
-        figure: figure.into(),
-        source: source.into(),
-    }
+    McError::Plot(ins_plot::plot_error(figure, source))
 }
-
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-static REGISTER: Once = Once::new();
-
-const W: u32 = 1000;
-const H: u32 = 760;
 
 /// Mean or σ figure.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -55,20 +42,6 @@ pub fn figure_number(mode: Mode, kind: Kind) -> Option<u32> {
     Some(if kind == Kind::Mean { base } else { base + 3 })
 }
 
-fn register_font() -> Result<(), McError> {
-    let mut err = None;
-    REGISTER.call_once(|| {
-        if plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_err() {
-            err = Some(plot_error(
-                "(font)",
-                "the bundled DejaVu Sans font could not be parsed",
-            ));
-        }
-    });
-    err.map_or(Ok(()), Err)
-}
-
-type Series = (&'static str, RGBColor, Vec<(f64, f64)>);
 /// A curve with an owned label.
 type Labelled = (String, RGBColor, Vec<(f64, f64)>);
 
@@ -97,64 +70,6 @@ fn series(m: &ModeStats, kind: Kind, qs: [usize; 3], scale: f64) -> Vec<Series> 
             (names[k], colours[k], pts)
         })
         .collect()
-}
-
-fn y_range(all: &[Series]) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (_, _, pts) in all {
-        for &(_, y) in pts {
-            lo = lo.min(y);
-            hi = hi.max(y);
-        }
-    }
-    if !lo.is_finite() || !hi.is_finite() {
-        return (-1.0, 1.0);
-    }
-    let pad = 0.05 * (hi - lo).max(1e-9 * hi.abs().max(1e-9));
-    (lo - pad, hi + pad)
-}
-
-fn panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    caption: &str,
-    y_desc: &str,
-    t_end: f64,
-    data: &[Series],
-) -> Result<(), Box<dyn Error + Send + Sync>>
-where
-    DB::ErrorType: 'static,
-{
-    let (lo, hi) = y_range(data);
-    let mut chart = ChartBuilder::on(area)
-        .caption(caption, ("sans-serif", 20))
-        .margin(12)
-        .margin_right(36)
-        .x_label_area_size(40)
-        .y_label_area_size(80)
-        .build_cartesian_2d(0.0..t_end.max(1.0), lo..hi)?;
-    chart
-        .configure_mesh()
-        .x_desc("time (s)")
-        .y_desc(y_desc)
-        .label_style(("sans-serif", 14))
-        .draw()?;
-    for (name, colour, pts) in data {
-        let c = *colour;
-        let drawn = chart.draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))?;
-        if !name.is_empty() {
-            drawn.label(*name).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
-            });
-        }
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()?;
-    Ok(())
 }
 
 fn draw<DB: DrawingBackend>(
@@ -415,15 +330,6 @@ fn render_both(
     Ok((svg, encode_png(rgb)?))
 }
 
-fn encode_png(rgb: Vec<u8>) -> Result<Vec<u8>, McError> {
-    let img = image::RgbImage::from_raw(W, H, rgb)
-        .ok_or_else(|| plot_error("PNG", "the pixel buffer has the wrong size"))?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .map_err(|e| plot_error("PNG", e))?;
-    Ok(png)
-}
-
 /// All figures: `(file name, bytes)`, e.g. `fig3_kf_mean.svg`.
 // The closures passed to `render_both` are needed: the generic fn items are not general enough
 // over the backends' lifetime (higher-ranked bound), which clippy's suggestion ignores.
@@ -583,95 +489,4 @@ pub fn sweep_figure(
     )
     .map_err(|e| plot_error("PNG sweep figure", e))?;
     Ok((svg, encode_png(rgb)?))
-}
-
-const REPLAY_AXES: [(&str, &str, RGBColor, RGBColor); 3] = [
-    ("N", "±3σ N", RGBColor(200, 30, 30), RGBColor(240, 160, 160)),
-    ("E", "±3σ E", RGBColor(30, 140, 30), RGBColor(150, 215, 150)),
-    ("D", "±3σ D", RGBColor(30, 60, 200), RGBColor(150, 170, 240)),
-];
-
-/// The curves of one block (0 position, 1 velocity, 2 attitude) of a replay: the error on each
-/// axis and its ±3σ envelope, time from the first sample, values × `scale`.
-fn replay_series(series: &[ins_sim::logs::ErrorSample], block: usize, scale: f64) -> Vec<Series> {
-    let t0 = series.first().map_or(0.0, |s| s.t_s);
-    let mut out = Vec::new();
-    for (axis, (name, band, colour, light)) in REPLAY_AXES.iter().enumerate() {
-        let k = 3 * block + axis;
-        let pts = |f: &dyn Fn(&ins_sim::logs::ErrorSample) -> f64| -> Vec<(f64, f64)> {
-            series
-                .iter()
-                .filter(|s| f(s).is_finite())
-                .map(|s| (s.t_s - t0, f(s) * scale))
-                .collect()
-        };
-        out.push((*name, *colour, pts(&|s| s.error[k])));
-        out.push((*band, *light, pts(&|s| 3.0 * s.sigma[k])));
-        out.push(("", *light, pts(&|s| -3.0 * s.sigma[k])));
-    }
-    out.retain(|(_, _, p)| !p.is_empty());
-    out
-}
-
-fn draw_replay<DB: DrawingBackend>(
-    root: DrawingArea<DB, Shift>,
-    series: &[ins_sim::logs::ErrorSample],
-    title: &str,
-    with_attitude: bool,
-) -> Result<(), Box<dyn Error + Send + Sync>>
-where
-    DB::ErrorType: 'static,
-{
-    root.fill(&WHITE)?;
-    let t_end = match (series.first(), series.last()) {
-        (Some(a), Some(b)) => b.t_s - a.t_s,
-        _ => 1.0,
-    };
-    let panels: Vec<(&str, &str, usize, f64)> = if with_attitude {
-        vec![
-            ("position error", "m", 0, 1.0),
-            ("velocity error", "m/s", 1, 1.0),
-            ("attitude error ψ", "mrad", 2, 1e3),
-        ]
-    } else {
-        vec![
-            ("position error", "m", 0, 1.0),
-            ("velocity error", "m/s", 1, 1.0),
-        ]
-    };
-    let areas = root.split_evenly((panels.len(), 1));
-    for (area, (what, unit, block, scale)) in areas.iter().zip(panels) {
-        let data = replay_series(series, block, scale);
-        panel(
-            area,
-            &format!("{title}: {what}"),
-            &format!("{what} ({unit})"),
-            t_end,
-            &data,
-        )?;
-    }
-    root.present()?;
-    Ok(())
-}
-
-/// The errors of a replayed solution against its reference with their ±3σ envelopes (position,
-/// velocity, and attitude when the reference has it), as PNG bytes.
-///
-/// # Errors
-/// [`McError::Plot`] when drawing or encoding fails.
-pub fn replay_figure(
-    series: &[ins_sim::logs::ErrorSample],
-    title: &str,
-) -> Result<Vec<u8>, McError> {
-    register_font()?;
-    let with_attitude = series.iter().any(|s| s.error[6].is_finite());
-    let mut rgb = vec![0u8; (W * H * 3) as usize];
-    draw_replay(
-        BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area(),
-        series,
-        title,
-        with_attitude,
-    )
-    .map_err(|e| plot_error("replay errors", e))?;
-    encode_png(rgb)
 }

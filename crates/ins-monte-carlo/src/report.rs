@@ -6,6 +6,7 @@
 use std::fmt::Write as _;
 
 use super::stats::{ModeStats, Moments, Stats, qi};
+use super::summary::ChiSquare;
 use ins_sim::Mode;
 
 /// Degrees of freedom of the NEES (error-state dimension).
@@ -135,11 +136,6 @@ pub(super) fn paper(mode: Mode) -> Option<&'static PaperFigure> {
     PAPER.iter().find(|p| p.mode == mode)
 }
 
-/// Final 3-D RMS position error, m.
-pub(super) fn final_rms(m: &ModeStats) -> f64 {
-    m.bins.last().map_or(f64::NAN, |b| b[qi::POS_3D].rms())
-}
-
 /// Σ 100 Hz INS steps, steps per second per core (Σ steps / Σ per-run thread CPU time, or Σ
 /// per-run wall time where no CPU clock was available), and aggregate steps per second of wall
 /// time.
@@ -208,12 +204,17 @@ pub fn timeseries_csv(m: &ModeStats) -> String {
 }
 
 /// One word for a consistency result.
-pub(super) fn state(c: &Consistency) -> &'static str {
-    if c.inside >= 0.9 {
+pub(super) fn state(c: &ChiSquare) -> &'static str {
+    let (inside, above, below) = (
+        c.fraction_inside_band,
+        c.fraction_above_band,
+        c.fraction_below_band,
+    );
+    if inside >= 0.9 {
         "consistent"
-    } else if c.above >= 0.05 && c.below >= 0.05 {
+    } else if above >= 0.05 && below >= 0.05 {
         "inconsistent both ways"
-    } else if c.above >= c.below {
+    } else if above >= below {
         "over-confident"
     } else {
         "under-confident"
@@ -221,7 +222,7 @@ pub(super) fn state(c: &Consistency) -> &'static str {
 }
 
 /// How a χ² statistic sits against its band, in words.
-pub(super) fn verdict(c: &Consistency) -> String {
+pub(super) fn verdict(c: &ChiSquare) -> String {
     let span =
         |x: Option<(f64, f64)>| x.map_or(String::new(), |(a, b)| format!(" (t = {a:.0}…{b:.0} s)"));
     let word = match state(c) {
@@ -238,11 +239,11 @@ pub(super) fn verdict(c: &Consistency) -> String {
     };
     format!(
         "run average inside its 95 % band at {:.0} % of the epochs, above at {:.0} %{}, below at {:.0} %{} → {word}",
-        100.0 * c.inside,
-        100.0 * c.above,
-        span(c.above_span),
-        100.0 * c.below,
-        span(c.below_span)
+        100.0 * c.fraction_inside_band,
+        100.0 * c.fraction_above_band,
+        span(c.above_span_s),
+        100.0 * c.fraction_below_band,
+        span(c.below_span_s)
     )
 }
 

@@ -1,6 +1,7 @@
 //! The two summaries of a Monte Carlo: `summary.json` ([`SummaryJson`], a serde structure with a
 //! `schema` version, for programs) and `summary.md` (for people: the tables, the paper beside
-//! ours, the consistency verdicts and the notes on where we differ).
+//! ours, the consistency verdicts and the notes on where we differ, the last two written by the
+//! private module `notes`), the markdown rendered from the structure the JSON serialises.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -9,11 +10,10 @@ use serde::Serialize;
 
 use super::McError;
 use super::report::{
-    NEES_DOF, NIS_DOF, at, band, consistency, f, final_rms, median_final, paper, report_times,
-    state, throughput, verdict, worst_runs,
+    NEES_DOF, NIS_DOF, at, band, consistency, f, median_final, paper, report_times, throughput,
+    verdict, worst_runs,
 };
 use super::stats::{Exclusion, ModeStats, Moments, RunSummary, Stats, missing_ranges, qi};
-use ins_sim::Mode;
 
 /// Version of the `summary.json` layout; raised when a field changes meaning or goes away.
 pub const SUMMARY_SCHEMA: u32 = 1;
@@ -117,8 +117,9 @@ pub struct AtTime {
 }
 
 /// A run-averaged χ² statistic against its two-sided 95 % band (written as `nees_mean`,
-/// `nees_band_95`, `nees_fraction_inside_band`, … and likewise `nis_*`).
-#[derive(Clone, Debug, Serialize)]
+/// `nees_band_95`, `nees_fraction_inside_band`, … and likewise `nis_*`; `epochs` and the spans
+/// are for `summary.md` only).
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct ChiSquare {
     /// Mean over runs and epochs.
     pub mean: f64,
@@ -131,6 +132,15 @@ pub struct ChiSquare {
     pub fraction_above_band: f64,
     /// … below it (under-confident).
     pub fraction_below_band: f64,
+    /// Epochs with a value (not in `summary.json`).
+    #[serde(skip)]
+    pub epochs: usize,
+    /// First and last epoch above the band, s (not in `summary.json`).
+    #[serde(skip)]
+    pub above_span_s: Option<(f64, f64)>,
+    /// First and last epoch below the band, s (not in `summary.json`).
+    #[serde(skip)]
+    pub below_span_s: Option<(f64, f64)>,
 }
 
 /// The paper's figure (Lustosa, Chagas & Waldmann, §6).
@@ -189,6 +199,9 @@ fn chi_square(m: &ModeStats, q: usize, dof: usize) -> Option<ChiSquare> {
         fraction_inside_band: c.inside,
         fraction_above_band: c.above,
         fraction_below_band: c.below,
+        epochs: c.epochs,
+        above_span_s: c.above_span,
+        below_span_s: c.below_span,
     })
 }
 
@@ -269,21 +282,24 @@ pub fn summary(stats: &Stats) -> SummaryJson {
 }
 
 /// `summary.json` as pretty-printed text.
-pub fn summary_json(stats: &Stats) -> Result<String, McError> {
-    Ok(serde_json::to_string_pretty(&summary(stats))? + "\n")
+pub fn summary_json(summary: &SummaryJson) -> Result<String, McError> {
+    Ok(serde_json::to_string_pretty(summary)? + "\n")
 }
 
-/// `summary.md`.
-pub fn summary_md(stats: &Stats) -> String {
+/// `summary.md`, rendered from `summary` (the [`summary()`] of the same `stats`: every number
+/// that `summary.json` holds is taken from it, not computed again); `stats` gives what only the
+/// prose needs (missing run ranges, the checks and the NEES phases over the time bins, the
+/// scenario's assumptions).
+pub fn summary_md(stats: &Stats, summary: &SummaryJson) -> String {
     let mut s = String::new();
-    let runs = stats.runs_covered();
+    let runs = summary.runs_covered;
     let _ = writeln!(s, "# INS/SD Monte Carlo — Lustosa, Chagas & Waldmann, §6\n");
     let missing = missing_ranges(stats);
     if !missing.is_empty() {
         let _ = writeln!(
             s,
             "> **Partial:** {runs} of {} runs; missing run indices {}.\n",
-            stats.runs_total(),
+            summary.runs_total,
             missing
                 .iter()
                 .map(|(a, b)| format!("{a}..{b}"))
@@ -294,12 +310,12 @@ pub fn summary_md(stats: &Stats) -> String {
     let _ = writeln!(
         s,
         "{runs} runs per configuration, master seed {}, {} s of flight, scenario {} (fingerprint {}){}.\n",
-        stats.seed(),
-        stats.duration_s(),
-        stats.scenario_source(),
-        stats.scenario_fingerprint(),
-        if stats.shards().len() > 1 {
-            format!(", merged from {} shards", stats.shards().len())
+        summary.seed,
+        summary.duration_s,
+        summary.scenario_source,
+        summary.scenario_fingerprint,
+        if summary.shards > 1 {
+            format!(", merged from {} shards", summary.shards)
         } else {
             String::new()
         }
@@ -312,34 +328,33 @@ pub fn summary_md(stats: &Stats) -> String {
         "| configuration | runs used | excluded | 3-D error RMS (m) | 3-D error median (m) | horizontal RMS (m) | vertical RMS (m) | distance (km) | 3-D error / distance | paper |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
-    for m in stats.modes() {
-        let last = m.bins.last().copied().unwrap_or_default();
-        let dist = last[qi::DIST].mean();
-        let excluded = stats
-            .exclusions()
-            .iter()
-            .filter(|e| e.mode == m.mode)
-            .count();
+    // In the statistics' order of the configurations (the JSON map is sorted by name).
+    let modes: Vec<(&ModeStats, &ModeSummary)> = stats
+        .modes()
+        .iter()
+        .filter_map(|m| summary.modes.get(m.mode.name()).map(|ms| (m, ms)))
+        .collect();
+    for (m, ms) in &modes {
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} % | {} |",
             m.mode,
-            m.runs_used,
-            excluded,
-            f(last[qi::POS_3D].rms(), 1),
-            f(median_final(stats, m.mode), 1),
-            f(last[qi::POS_H].rms(), 1),
-            f(last[qi::POS_D].rms(), 1),
-            f(dist / 1000.0, 2),
-            f(100.0 * last[qi::POS_3D].rms() / dist, 3),
-            paper(m.mode).map_or("", |p| p.text)
+            ms.runs_used,
+            ms.runs_excluded,
+            f(ms.final_position_error_m, 1),
+            f(ms.final_position_error_median_m, 1),
+            f(ms.final_horizontal_error_m, 1),
+            f(ms.final_vertical_error_m, 1),
+            f(ms.distance_m / 1000.0, 2),
+            f(ms.final_error_percent_of_distance, 3),
+            ms.paper.as_ref().map_or("", |p| p.text)
         );
     }
     s.push('\n');
-    checks(&mut s, stats);
+    super::notes::checks(&mut s, stats, summary);
 
     // Tables per configuration.
-    for m in stats.modes() {
+    for (m, ms) in &modes {
         let _ = writeln!(s, "## {}\n", m.mode);
         let _ = writeln!(
             s,
@@ -350,45 +365,48 @@ pub fn summary_md(stats: &Stats) -> String {
             "| t (s) | horizontal (m) | vertical, down (m) | 3-D RMS (m) | ψ_N (mrad) | ψ_E (mrad) | ψ_D (mrad) | distance (km) | 3-D RMS / distance | NEES avg | NIS avg |"
         );
         let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
-        for t in report_times(stats.duration_s()) {
-            let b = at(m, t);
-            let pm = |q: usize, k: f64, d: usize| {
-                format!("{} ± {}", f(k * b[q].mean(), d), f(k * b[q].std_dev(), d))
+        for t in report_times(summary.duration_s) {
+            let Some(a) = ms.at_time_s.get(&t.to_string()) else {
+                continue;
             };
-            let dist = b[qi::DIST].mean();
+            let pm = |mean: f64, sd: f64, d: usize| format!("{} ± {}", f(mean, d), f(sd, d));
+            let dist = a.distance_m;
+            let [psi_n, psi_e, psi_d] = a.misalignment_mean_rad;
+            let [sd_n, sd_e, sd_d] = a.misalignment_sd_rad;
             let _ = writeln!(
                 s,
                 "| {t} | {} | {} | {} | {} | {} | {} | {} | {} % | {} | {} |",
-                pm(qi::POS_H, 1.0, 1),
-                pm(qi::POS_D, 1.0, 1),
-                f(b[qi::POS_3D].rms(), 1),
-                pm(qi::PSI_N, 1e3, 3),
-                pm(qi::PSI_E, 1e3, 3),
-                pm(qi::PSI_D, 1e3, 3),
+                pm(a.horizontal_error_mean_m, a.horizontal_error_sd_m, 1),
+                pm(a.vertical_down_error_mean_m, a.vertical_down_error_sd_m, 1),
+                f(a.position_error_rms_m, 1),
+                pm(1e3 * psi_n, 1e3 * sd_n, 3),
+                pm(1e3 * psi_e, 1e3 * sd_e, 3),
+                pm(1e3 * psi_d, 1e3 * sd_d, 3),
                 f(dist / 1000.0, 2),
-                f(100.0 * b[qi::POS_3D].rms() / dist, 3),
-                f(b[qi::NEES].mean(), 2),
-                f(b[qi::NIS].mean(), 2),
+                f(100.0 * a.position_error_rms_m / dist, 3),
+                f(a.nees_mean, 2),
+                f(a.nis_mean, 2),
             );
         }
         s.push('\n');
-        for (name, q, dof) in [("NEES", qi::NEES, NEES_DOF), ("NIS", qi::NIS, NIS_DOF)] {
-            if let Some(c) = consistency(m, q, dof) {
-                let (lo, hi) = band(dof, m.runs_used).unwrap_or((f64::NAN, f64::NAN));
+        for (name, c, dof) in [("NEES", &ms.nees, NEES_DOF), ("NIS", &ms.nis, NIS_DOF)] {
+            if let Some(c) = c {
+                let [lo, hi] = c.band_95.unwrap_or([f64::NAN, f64::NAN]);
                 let _ = writeln!(
                     s,
                     "- {name} (n = {dof}): average over {} runs and {} epochs {}; 95 % band for the average of {} runs [{}, {}]; {}.",
-                    m.runs_used,
+                    ms.runs_used,
                     c.epochs,
                     f(c.mean, 2),
-                    m.runs_used,
+                    ms.runs_used,
                     f(lo, 2),
                     f(hi, 2),
-                    verdict(&c)
+                    verdict(c)
                 );
             }
         }
-        let worst = worst_runs(stats, m.mode, 3);
+        // The JSON keeps the five worst, largest first; the text names three.
+        let worst = &ms.worst_runs[..ms.worst_runs.len().min(3)];
         if !worst.is_empty() {
             let _ = writeln!(
                 s,
@@ -413,15 +431,15 @@ pub fn summary_md(stats: &Stats) -> String {
 
     // Exclusions.
     let _ = writeln!(s, "## Runs excluded as non-finite or failed\n");
-    if stats.exclusions().is_empty() {
+    if summary.excluded_runs.is_empty() {
         let _ = writeln!(s, "None: every run stayed finite.\n");
     } else {
         let _ = writeln!(
             s,
             "{} run(s) excluded from their configuration's statistics (never averaged in):\n",
-            stats.exclusions().len()
+            summary.excluded_runs.len()
         );
-        for e in stats.exclusions() {
+        for e in &summary.excluded_runs {
             let _ = writeln!(
                 s,
                 "- {} run {}{}: {}",
@@ -445,238 +463,18 @@ pub fn summary_md(stats: &Stats) -> String {
         "The paper does not give its manoeuvre sequence, initial speed and heading, landmark geometry relative to the flight, initial covariance, the manually tuned Q, nor how many Monte Carlo runs it averaged; all are our choices (listed above, in the config). Position error at 900 s depends mostly on the landmark geometry (range and angles: σ_SD = √40 m at the landmark constrains angles, so position accuracy scales with range) and on the filter's Q (how much it trusts the INS), so only the ordering and the order of magnitude are expected to match.\n"
     );
 
-    differences(&mut s, stats);
+    super::notes::differences(&mut s, stats, summary);
 
-    let (steps, per_core, per_wall) = throughput(stats);
+    let (steps, per_core, per_wall) = (
+        summary.steps,
+        summary.steps_per_s_per_core,
+        summary.steps_per_s_wall,
+    );
     let _ = writeln!(s, "## Throughput\n");
     let _ = writeln!(
         s,
         "{steps} INS steps (100 Hz, all configurations) in {:.2} s of simulation wall time (summed over shards if merged): **{:.0} steps/s per core** (Σ steps / Σ CPU time of the threads that ran them), {:.0} steps/s aggregate over the wall time (lower than threads × per-core when the machine is shared). A run that fails is not counted. For comparison on this machine (docs/ins-sd.md): KF-GINS (C++, 21 states, text I/O) ≈ 40 000 steps/s; pyins (Python, 0.01 s covariance step) ≈ 136 steps/s.",
-        stats.wall_s(),
-        per_core,
-        per_wall
+        summary.wall_s, per_core, per_wall
     );
     s
-}
-
-/// The "what it must show" items, checked on the numbers.
-fn checks(s: &mut String, stats: &Stats) {
-    let get = |mode: Mode| stats.mode(mode);
-    let _ = writeln!(s, "Checks against the paper's claims:\n");
-    if let (Some(sa), Some(kf), Some(akf)) = (get(Mode::Standalone), get(Mode::Kf), get(Mode::Akf))
-    {
-        let (e_sa, e_kf, e_akf) = (final_rms(sa), final_rms(kf), final_rms(akf));
-        let ordered = e_kf < e_akf && e_akf < e_sa;
-        let _ = writeln!(
-            s,
-            "- Ordering KF < AKF < stand-alone at the final time (paper): {} ({} m < {} m < {} m).",
-            if ordered {
-                "**reproduced**"
-            } else if e_kf < e_sa && e_akf < e_sa {
-                "**partly**: both filters beat stand-alone, but the AKF is not worse than the KF"
-            } else {
-                "**not reproduced**"
-            },
-            f(e_kf, 1),
-            f(e_akf, 1),
-            f(e_sa, 1)
-        );
-    }
-    let at_900 = (stats.duration_s() - 900.0).abs() < 0.5;
-    if !at_900 {
-        let _ = writeln!(
-            s,
-            "- The paper's position errors are at 900 s; this run ends at {} s, so they are not compared.",
-            stats.duration_s()
-        );
-    }
-    for m in stats.modes().iter().filter(|_| at_900) {
-        if let Some(p) = paper(m.mode)
-            && let Some(paper_m) = p.error_m
-        {
-            let ratio = final_rms(m) / paper_m;
-            let _ = writeln!(
-                s,
-                "- {}: ours / paper = {} → {}.",
-                m.mode,
-                f(ratio, 2),
-                if (0.316..=3.16).contains(&ratio) {
-                    "same order of magnitude"
-                } else {
-                    "**different order of magnitude**"
-                }
-            );
-        }
-    }
-    if let Some(sa) = get(Mode::Standalone)
-        && let Some(last) = sa.bins.last()
-    {
-        let (v, n, e) = (
-            last[qi::POS_D].rms(),
-            last[qi::POS_N].rms(),
-            last[qi::POS_E].rms(),
-        );
-        let _ = writeln!(
-            s,
-            "- Stand-alone diverges, vertical channel most: RMS N {} m, E {} m, vertical {} m at the final time → {}.",
-            f(n, 1),
-            f(e, 1),
-            f(v, 1),
-            if v > n && v > e {
-                "vertical largest"
-            } else {
-                "**vertical not the largest**"
-            }
-        );
-    }
-    let end = stats.duration_s().round() as usize;
-    if end > 600 {
-        for m in stats.modes() {
-            if m.mode == Mode::Standalone {
-                continue;
-            }
-            let s600 = at(m, 600)[qi::PSI_D].std_dev();
-            let send = at(m, end)[qi::PSI_D].std_dev();
-            let (t_max, s_max) = (600..=end.min(m.bins.len() - 1))
-                .map(|t| (t, m.bins[t][qi::PSI_D].std_dev()))
-                .fold((600, s600), |a, b| if b.1 > a.1 { b } else { a });
-            let _ = writeln!(
-                s,
-                "- {}: azimuth misalignment σ {} mrad at 600 s (manoeuvres end), largest after it {} mrad at {t_max} s, {} mrad at {end} s → {}.",
-                m.mode,
-                f(1e3 * s600, 3),
-                f(1e3 * s_max, 3),
-                f(1e3 * send, 3),
-                if s_max <= 2.0 * s600 {
-                    "bounded after the manoeuvres end (paper: limited azimuth misalignment after 600 s)"
-                } else {
-                    "**not bounded: it grows after the manoeuvres end**"
-                }
-            );
-        }
-    }
-    s.push('\n');
-}
-
-/// Data-driven notes on where and why our filters differ from the paper's figures.
-fn differences(s: &mut String, stats: &Stats) {
-    if (stats.duration_s() - 900.0).abs() >= 0.5 {
-        return;
-    }
-    for m in stats.modes() {
-        let (Some(p), Some(nees)) = (paper(m.mode), consistency(m, qi::NEES, NEES_DOF)) else {
-            continue;
-        };
-        let Some(paper_m) = p.error_m else { continue };
-        let ratio = final_rms(m) / paper_m;
-        let nis = consistency(m, qi::NIS, NIS_DOF).unwrap_or_default();
-        let _ = write!(
-            s,
-            "- **{}**: {} × the paper's error (NEES {}, NIS {}). ",
-            m.mode,
-            f(ratio, 2),
-            state(&nees),
-            state(&nis)
-        );
-        if ratio < 0.316 {
-            let _ = writeln!(
-                s,
-                "Ours is much smaller. Every second the SD gives six image offsets{} at the landmark; a filter whose model matches the simulated errors (its NIS says whether it does) averages them down to metres, and with three landmarks always in view the INS errors stay observable. Read this way, the SD noise alone does not account for the paper's figure: its error budget must contain effects its text does not state (landmark geometry and ranges, its tuning of Q and P₀, or a mismatch between its simulation and its filter model). The README (\"Not reproduced with the paper's stated design\") gives the two explanations we tested and what they measured: the paper's printed sighting Jacobian read literally, and the INS never corrected (`[filter] open_loop_until_s`); we keep the feedback the paper describes.",
-                stats
-                    .sd_noise_sigma_m()
-                    .map_or(String::new(), |sd| format!(" of σ = {} m", f(sd, 1)))
-            );
-        } else if ratio > 3.16 {
-            let _ = writeln!(
-                s,
-                "Ours is much larger: look at the filter's consistency above (a filter whose covariance does not match its errors weighs the SD wrongly) and at the excluded runs."
-            );
-        } else {
-            let _ = writeln!(s, "Same order of magnitude as the paper.");
-        }
-        nees_story(s, m);
-    }
-    s.push('\n');
-}
-
-/// Phases of the flight for the NEES story: open loop, just after the switch to feedback
-/// (195 s), manoeuvres with feedback, straight flight after the manoeuvres end (600 s).
-const PHASES: [(usize, usize, &str); 4] = [
-    (1, 194, "open loop"),
-    (195, 260, "just after the switch to feedback"),
-    (261, 600, "manoeuvres, feedback"),
-    (601, usize::MAX, "straight flight after the manoeuvres"),
-];
-
-/// Why the NEES of one filter mode sits where it does, phase by phase, from its time series.
-fn nees_story(s: &mut String, m: &ModeStats) {
-    let Some((lo, hi)) = m
-        .bins
-        .iter()
-        .map(|b| b[qi::NEES].n)
-        .find(|&n| n > 0)
-        .and_then(|n| band(NEES_DOF, n))
-    else {
-        return;
-    };
-    let mut parts = Vec::new();
-    for (a, b, name) in PHASES {
-        let b = b.min(m.bins.len().saturating_sub(1));
-        let mut pooled = Moments::default();
-        let mut peak: Option<(usize, f64)> = None;
-        for t in a..=b {
-            let x = m.bins[t][qi::NEES];
-            if x.n == 0 {
-                continue;
-            }
-            pooled.merge(&x);
-            if peak.is_none_or(|(_, p)| x.mean() > p) {
-                peak = Some((t, x.mean()));
-            }
-        }
-        let Some((t_peak, peak)) = peak else { continue };
-        let mean = pooled.mean();
-        let word = if mean < lo {
-            "below the band: under-confident (P larger than the errors)"
-        } else if mean > hi {
-            "above the band: over-confident (P smaller than the errors)"
-        } else {
-            "inside the band"
-        };
-        let spike = if peak > 10.0 * hi {
-            format!(
-                "; **the run average peaks at {} at t = {t_peak} s**, a blow-up",
-                f(peak, 0)
-            )
-        } else if peak > hi && mean <= hi {
-            format!(
-                "; above the band at some epochs, peak {} at t = {t_peak} s",
-                f(peak, 1)
-            )
-        } else {
-            String::new()
-        };
-        parts.push(format!(
-            "{a}–{} s ({name}) {}, {word}{spike}",
-            b,
-            f(mean, 1)
-        ));
-    }
-    let _ = writeln!(
-        s,
-        "  NEES by phase (band for one epoch's run average [{}, {}]): {}.",
-        f(lo, 2),
-        f(hi, 2),
-        parts.join("; ")
-    );
-    let reading = if m.mode == Mode::AkfSageHusa {
-        "Reading: Sage–Husa averages the single-update estimates Δx Δxᵀ + P⁺ − Φ P⁺₋ Φᵀ with a forgetting factor (memory ≈ 1/(1 − b) updates) instead of a window of 10; the longer memory smooths the indefinite P⁺ − Φ P⁺₋ Φᵀ term, so less of Q̂ is clipped away by the projection. Where NEES and NIS are below their bands it still over-estimates the process noise (same innovation-based estimate)."
-    } else if m.mode == Mode::AkfStructured {
-        "Reading: the windowed Mohamed–Schwarz Q̂ projected by non-negative least squares onto the model's four noise inputs (Q = Σ q_k B_k): PSD with the model's correlations, but the raw Q̂ sees the noise only through the innovations (rank ≤ 6 per update), so the fitted densities are not the true ones."
-    } else if m.mode == Mode::Kf {
-        "Reading: below the band, P₀ and the doubled white-noise Q (config comment: tuned so) keep P larger than the errors; above it late in open loop and just after the switch to feedback at 195 s, the linearisation residue of the INS error grown in open loop (the linear error model degrades as the uncorrected error grows) is not in P; feedback removes it within about a minute. The NIS, which sees only the six measurement directions, stays consistent."
-    } else {
-        "Reading: the Mohamed–Schwarz Q̂ (innovation-based, fed back into the gain that produces the innovations) does not converge to the true Q; where NEES and NIS are both below their bands it over-estimates the process noise. With the eigenvalue-clipping projection (`[filter] akf_projection = \"eigen_clip\"`) the loop can run away (the README gives the measured runs): with N = 10 < 15 states Q̂ is dominated by the indefinite P⁺ − Φ P⁺ Φᵀ, clipping its large negative eigenvalues adds their magnitude back as positive mass in mixed-unit directions, a larger Q̂ gives a larger P and more clipped mass, and in straight flight after 600 s (level/azimuth weakly observable) this feedback can end in a Q̂ explosion; the diagonal projection (the default) stays bounded."
-    };
-    let _ = writeln!(s, "  {reading}");
 }

@@ -299,11 +299,12 @@ fn non_finite_runs_are_excluded_and_counted() {
     assert!((report::median_final(&st, Mode::Kf) - 201f64.sqrt()).abs() < 1e-12);
     let worst = report::worst_runs(&st, Mode::Kf, 1);
     assert_eq!((worst[0].run_index, worst[0].peak_t_s), (4, 10.0));
-    let md = summary::summary_md(&st);
+    let md = summary::summary_md(&st, &summary::summary(&st));
     assert!(md.contains("2 run(s) excluded"), "{md}");
     assert!(md.contains("kf run 2 at t = 7 s"), "{md}");
     assert!(md.contains("kf run 3 at t = 5 s"), "{md}");
-    let js: serde_json::Value = serde_json::from_str(&summary::summary_json(&st).unwrap()).unwrap();
+    let js: serde_json::Value =
+        serde_json::from_str(&summary::summary_json(&summary::summary(&st)).unwrap()).unwrap();
     assert_eq!(js["schema"], summary::SUMMARY_SCHEMA);
     assert_eq!(js["kf"]["runs_excluded"], 2);
     assert_eq!(js["kf"]["runs_used"], 3);

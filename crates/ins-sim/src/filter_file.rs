@@ -227,6 +227,12 @@ impl FilterFile {
     /// preset, or a value out of range.
     pub fn from_toml_str(text: &str, path: &str) -> Result<Self, SimError> {
         let doc = TomlDoc::parse(path.to_owned(), text).map_err(|e| toml_err(path, e))?;
+        Self::from_doc(&doc, path)
+    }
+
+    /// A filter file from a parsed document (`path` names it in errors; as
+    /// [`FilterFile::from_toml_str`] after the parse).
+    pub(crate) fn from_doc(doc: &TomlDoc<'_>, path: &str) -> Result<Self, SimError> {
         let user: RawFile = doc.deserialize().map_err(|e| toml_err(path, e))?;
         let name = user.preset.as_deref().unwrap_or("mems");
         let Some((_, preset_text)) = PRESETS.iter().find(|(n, _)| *n == name) else {

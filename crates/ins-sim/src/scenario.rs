@@ -65,7 +65,13 @@ impl Scenario {
                 field: "(document)".to_string(),
                 error,
             })?;
-        let f = config::parse(&doc)?;
+        Self::from_doc(&doc)
+    }
+
+    /// A scenario from a parsed document ([`Scenario::from_toml_named`] after the parse; errors
+    /// name the document's path).
+    pub(crate) fn from_doc(doc: &toml_config::TomlDoc<'_>) -> Result<Scenario, SimError> {
+        let f = config::parse(doc)?;
         let s = Scenario {
             trajectory: f.trajectory,
             imu: f.imu,

@@ -53,15 +53,15 @@ fn replay(
     let reference = logs::read_reference(&d.join("truth.csv")).unwrap();
     let start = set.start_s.unwrap_or(reference[0].t_s);
     let initial = logs::initial_from_reference(&reference, start, 1.0).unwrap();
-    let step = logs::imu_nominal_step_s(&d.join("imu.csv"), None).unwrap();
+    let mut imu = logs::ImuLog::new(d.join("imu.csv"), None);
+    let step = imu.nominal_step_s().unwrap();
     let config = FilterFile::preset(preset)
         .unwrap()
         .filter_config(mode, step, initial.t_s)
         .unwrap();
     let level = reference.iter().any(|r| r.att_b_to_n.is_none());
     let inputs = ReplayInputs {
-        imu: d.join("imu.csv"),
-        imu_topic: None,
+        imu,
         sightings: (mode != Mode::Standalone)
             .then(|| (dir.join("sightings.csv"), dir.join("landmarks.toml"))),
         initial,
@@ -75,7 +75,7 @@ fn replay(
     };
     let out = dir.join(format!("solution_{preset}_{}.csv", mode.name()));
     let mut w = std::io::BufWriter::new(std::fs::File::create(&out).unwrap());
-    logs::replay(&inputs, &mut w, &out)
+    logs::replay(inputs, &mut w, &out)
 }
 
 #[test]

@@ -262,3 +262,33 @@ fn scenario_errors_name_the_file_line_and_column() {
     // The path appears once.
     assert_eq!(e.to_string().matches("m.toml").count(), 1);
 }
+
+/// `nav-app ins --config`: a scenario (a top-level `trajectory` table, however it is written)
+/// and a filter file are told apart by parsing, not by searching the text for `[trajectory]`.
+#[test]
+fn settings_files_are_told_apart_by_their_parsed_tables() {
+    use ins_sim::logs::FilterSettings;
+    let scenario = Scenario::paper_default().to_toml_string().unwrap();
+    assert!(matches!(
+        FilterSettings::from_toml_named("s.toml", &scenario),
+        Ok(FilterSettings::Scenario(_))
+    ));
+    // The header written with spaces (valid TOML): no `[trajectory]` in the text.
+    let spaced = scenario.replacen("[trajectory]", "[ trajectory ] # the flight", 1);
+    assert!(!spaced.contains("[trajectory]"));
+    assert!(matches!(
+        FilterSettings::from_toml_named("s.toml", &spaced),
+        Ok(FilterSettings::Scenario(_))
+    ));
+    // A filter file that mentions `[trajectory]` in a comment is still a filter file.
+    let filter = "# not a scenario: no [trajectory]\npreset = \"paper\"\n";
+    assert!(matches!(
+        FilterSettings::from_toml_named("f.toml", filter),
+        Ok(FilterSettings::File(_))
+    ));
+    // A syntax error names the file, line and column.
+    match FilterSettings::from_toml_named("bad.toml", "preset = \n") {
+        Err(e) => assert!(e.to_string().starts_with("bad.toml:1:"), "{e}"),
+        Ok(_) => panic!("a syntax error was accepted"),
+    }
+}

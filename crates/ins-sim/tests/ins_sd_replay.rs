@@ -22,8 +22,7 @@ fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
     let text = std::fs::read_to_string(dir.join(names::SCENARIO)).unwrap();
     let sc = Scenario::from_toml_str(&text).unwrap();
     ReplayInputs {
-        imu: dir.join(names::IMU),
-        imu_topic: None,
+        imu: logs::ImuLog::new(dir.join(names::IMU), None),
         sightings: Some((dir.join(names::SIGHTINGS), dir.join(names::LANDMARKS))),
         initial: logs::read_initial(&dir.join(names::INITIAL)).unwrap(),
         config: sc.online_filter_config(mode),
@@ -36,7 +35,7 @@ fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
     }
 }
 
-fn replay_to(dir: &Path, inp: &ReplayInputs) -> Result<logs::ReplaySummary, SimError> {
+fn replay_to(dir: &Path, inp: ReplayInputs) -> Result<logs::ReplaySummary, SimError> {
     let out_path = dir.join("solution_replayed.csv");
     let mut out = std::io::BufWriter::new(std::fs::File::create(&out_path).unwrap());
     logs::replay(inp, &mut out, &out_path)
@@ -52,7 +51,7 @@ fn replay_of_an_export_reproduces_the_run() {
         let (outcome, records) = logs::export_run(&sc, mode, seed, &dir).unwrap();
         assert_eq!(outcome.samples_written, 261);
         let inp = inputs(&dir, mode);
-        let summary = replay_to(&dir, &inp).unwrap();
+        let summary = replay_to(&dir, inp).unwrap();
         assert_eq!(summary.imu_samples, 26_000);
         assert_eq!(summary.epochs, 260);
         assert_eq!(summary.sightings_used, 780);
@@ -132,7 +131,7 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     let dir = temp_dir("malformed");
     logs::export_run(&sc, Mode::Kf, 1, &dir).unwrap();
     let inp = inputs(&dir, Mode::Kf);
-    let imu_text = std::fs::read_to_string(&inp.imu).unwrap();
+    let imu_text = std::fs::read_to_string(inp.imu.path()).unwrap();
     let lines: Vec<&str> = imu_text.lines().collect();
 
     // A bad number in the third field of line 5 (the 4th sample).
@@ -150,10 +149,9 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     expect_parse(
         replay_to(
             &dir,
-            &ReplayInputs {
-                imu: path.clone(),
-                imu_topic: None,
-                ..inp.clone()
+            ReplayInputs {
+                imu: logs::ImuLog::new(path.clone(), None),
+                ..inputs(&dir, Mode::Kf)
             },
         ),
         &path,
@@ -169,10 +167,9 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     expect_parse(
         replay_to(
             &dir,
-            &ReplayInputs {
-                imu: path.clone(),
-                imu_topic: None,
-                ..inp.clone()
+            ReplayInputs {
+                imu: logs::ImuLog::new(path.clone(), None),
+                ..inputs(&dir, Mode::Kf)
             },
         ),
         &path,
@@ -186,10 +183,9 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     expect_parse(
         replay_to(
             &dir,
-            &ReplayInputs {
-                imu: path.clone(),
-                imu_topic: None,
-                ..inp.clone()
+            ReplayInputs {
+                imu: logs::ImuLog::new(path.clone(), None),
+                ..inputs(&dir, Mode::Kf)
             },
         ),
         &path,
@@ -208,9 +204,9 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     std::fs::write(&path, s_lines.join("\n")).unwrap();
     match replay_to(
         &dir,
-        &ReplayInputs {
+        ReplayInputs {
             sightings: Some((path.clone(), lm_path.clone())),
-            ..inp.clone()
+            ..inputs(&dir, Mode::Kf)
         },
     ) {
         Err(SimError::LogFilter {
@@ -235,9 +231,9 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     expect_parse(
         replay_to(
             &dir,
-            &ReplayInputs {
+            ReplayInputs {
                 sightings: Some((path.clone(), lm_path.clone())),
-                ..inp.clone()
+                ..inputs(&dir, Mode::Kf)
             },
         ),
         &path,
@@ -251,9 +247,9 @@ fn malformed_and_truncated_logs_name_file_line_and_column() {
     std::fs::write(&path, lm.replacen("alt_m", "height_m", 1)).unwrap();
     match replay_to(
         &dir,
-        &ReplayInputs {
+        ReplayInputs {
             sightings: Some((s_path.clone(), path.clone())),
-            ..inp.clone()
+            ..inputs(&dir, Mode::Kf)
         },
     ) {
         Err(e @ SimError::LogToml { .. }) => {
@@ -307,17 +303,21 @@ fn a_jittery_104_hz_log_with_a_gap_replays_to_the_end() {
     }
     let imu = dir.join("imu_jitter.csv");
     std::fs::write(&imu, out.join("\n") + "\n").unwrap();
-    let mut inp = inputs(&dir, Mode::Kf);
-    inp.imu = imu.clone();
-    inp.config.imu_step_s = logs::imu_nominal_step_s(&imu, None).unwrap();
+    let jittery = || {
+        let mut inp = inputs(&dir, Mode::Kf);
+        inp.imu = logs::ImuLog::new(imu.clone(), None);
+        inp.config.imu_step_s = logs::imu_nominal_step_s(&imu, None).unwrap();
+        inp.config.timestamp_tolerance_s = 0.0;
+        inp.rate = SolutionRate::EveryImu;
+        inp
+    };
+    let mut inp = jittery();
     assert!(
         (inp.config.imu_step_s - 1.0 / 104.4).abs() < 1e-3,
         "{}",
         inp.config.imu_step_s
     );
-    inp.config.timestamp_tolerance_s = 0.0;
-    inp.rate = SolutionRate::EveryImu;
-    let summary = replay_to(&dir, &inp).unwrap();
+    let summary = replay_to(&dir, inp).unwrap();
     assert_eq!(summary.gaps, 1, "{summary:?}");
     assert!(
         (summary.longest_gap_s - 0.5).abs() < 0.02,
@@ -338,8 +338,9 @@ fn a_jittery_104_hz_log_with_a_gap_replays_to_the_end() {
     );
 
     // The same gap refused below it, naming the line after the gap.
+    inp = jittery();
     inp.max_gap_s = 0.3;
-    match replay_to(&dir, &inp) {
+    match replay_to(&dir, inp) {
         Err(SimError::LogParse {
             path,
             line,
@@ -376,10 +377,10 @@ fn an_exported_sightings_log_replays_with_another_filter() {
     let sc = Scenario::paper_default().truncated(60.0).unwrap();
     let dir = temp_dir("other-filter");
     logs::export_run(&sc, Mode::Kf, 9, &dir).unwrap();
-    let kf = replay_to(&dir, &inputs(&dir, Mode::Kf)).unwrap();
+    let kf = replay_to(&dir, inputs(&dir, Mode::Kf)).unwrap();
     let mut other = inputs(&dir, Mode::Akf);
     other.config.process_noise.accel_white_m2ps3 *= 10.0;
-    let akf = replay_to(&dir, &other).unwrap();
+    let akf = replay_to(&dir, other).unwrap();
     assert_eq!(kf.epochs, akf.epochs);
     assert_eq!(kf.sightings_used, akf.sightings_used);
     let (a, b) = (
@@ -390,6 +391,68 @@ fn an_exported_sightings_log_replays_with_another_filter() {
     assert!(
         d.fixed_rows::<3>(0).norm() > 1e-6,
         "identical estimates: {d}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The IMU log is read once per replay: a request with a filter file (the nominal step is taken
+/// from the log) and a static alignment replays a log that can be read only once (a named pipe)
+/// to the same solution as the file itself.
+#[cfg(unix)]
+#[test]
+fn a_replay_reads_its_imu_log_once() {
+    use ins_sim::filter_file::FilterFile;
+    let sc = Scenario::paper_default().truncated(20.0).unwrap();
+    let dir = temp_dir("once");
+    logs::export_run(&sc, Mode::Kf, 4, &dir).unwrap();
+    let request = |dir: &Path, imu: PathBuf| logs::ReplayRequest {
+        imu,
+        imu_topic: None,
+        sightings: Some((dir.join(names::SIGHTINGS), dir.join(names::LANDMARKS))),
+        initial: Some(dir.join(names::INITIAL)),
+        reference: Some(dir.join(names::TRUTH)),
+        start_s: None,
+        settings: logs::FilterSettings::File(FilterFile::preset("paper").unwrap()),
+        mode: Mode::Kf,
+        gate: None,
+        align_s: 1.0,
+        max_gap_s: 1.0,
+        rate: SolutionRate::EveryImu,
+        mcap_out: None,
+    };
+    let from_file = replay_to(&dir, request(&dir, dir.join(names::IMU)).inputs().unwrap()).unwrap();
+    let expected = std::fs::read(dir.join("solution_replayed.csv")).unwrap();
+
+    let fifo = dir.join("imu.fifo");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("SKIPPED: mkfifo is not available");
+        return;
+    }
+    let text = std::fs::read(dir.join(names::IMU)).unwrap();
+    let writer_path = fifo.clone();
+    // One writer: a second open of the pipe for reading would wait for a writer that never comes.
+    std::thread::spawn(move || std::fs::write(writer_path, text).unwrap());
+    let (done, result) = std::sync::mpsc::channel();
+    let (dir2, fifo2) = (dir.clone(), fifo.clone());
+    std::thread::spawn(move || {
+        let out_path = dir2.join("solution_fifo.csv");
+        let mut out = std::io::BufWriter::new(std::fs::File::create(&out_path).unwrap());
+        let inputs = request(&dir2, fifo2).inputs().map_err(|e| e.to_string());
+        let summary =
+            inputs.and_then(|i| logs::replay(i, &mut out, &out_path).map_err(|e| e.to_string()));
+        drop(out);
+        let _ = done.send(summary);
+    });
+    let via_fifo = result
+        .recv_timeout(std::time::Duration::from_secs(120))
+        .expect("the replay did not finish: it opened the IMU log more than once")
+        .unwrap();
+    assert_eq!(via_fifo.imu_samples, from_file.imu_samples);
+    assert_eq!(via_fifo.alignment, from_file.alignment);
+    assert_eq!(
+        std::fs::read(dir.join("solution_fifo.csv")).unwrap(),
+        expected
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -202,8 +202,7 @@ fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Res
         Err(e) => return (read, Err(e)),
     };
     let inputs = ReplayInputs {
-        imu: files[0].clone(),
-        imu_topic: None,
+        imu: logs::ImuLog::new(files[0].clone(), None),
         sightings: Some((files[1].clone(), files[2].clone())),
         initial,
         config: sc.online_filter_config(Mode::Kf),
@@ -214,7 +213,7 @@ fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Res
         level: false,
         mcap_out: None,
     };
-    (read, logs::replay(&inputs, &mut w, &out).map(|_| ()))
+    (read, logs::replay(inputs, &mut w, &out).map(|_| ()))
 }
 
 fn case_dir(tag: &str) -> PathBuf {

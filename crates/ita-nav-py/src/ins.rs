@@ -488,10 +488,10 @@ pub fn replay<'py>(
     };
     let inputs = request.inputs().map_err(err)?;
     let summary = py
-        .detach(|| -> Result<logs::ReplaySummary, String> {
+        .detach(move || -> Result<logs::ReplaySummary, String> {
             let file = std::fs::File::create(out).map_err(|e| format!("{out}: {e}"))?;
             let mut w = std::io::BufWriter::new(file);
-            logs::replay(&inputs, &mut w, Path::new(out)).map_err(|e| crate::error_text(&e))
+            logs::replay(inputs, &mut w, Path::new(out)).map_err(|e| crate::error_text(&e))
         })
         .map_err(message)?;
     let d = PyDict::new(py);

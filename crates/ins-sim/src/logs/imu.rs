@@ -1,14 +1,19 @@
 //! The IMU samples of a replay, from a CSV log (increments or rates, by its header) or from a
 //! ROS 2 bag's `sensor_msgs/msg/Imu` topic (rates; ROS's FLU body axes turned into the filter's
 //! FRD, `ros_bag::msgs::Imu::frd`; the time is the message header's stamp).
+//!
+//! A replay opens its log once, as an [`ImuLog`]: what is read before the replay proper (the
+//! nominal step, [`ImuLog::nominal_step_s`]; a static alignment, [`super::align_at_rest`]) is
+//! read ahead and kept, and the replay takes those samples first, then reads on.
 
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
 use ros_bag::bag::{TopicReader, choose_topic, topics};
 use ros_bag::msgs::{IMU, Imu};
 
-use super::read::CsvReader;
+use super::csv::CsvReader;
 use super::{IMU_HEADER, IMU_RATES_HEADER};
 use crate::SimError;
 
@@ -22,7 +27,8 @@ pub(super) struct ImuRecord {
     pub(super) line: usize,
 }
 
-pub(super) enum ImuStream {
+/// The open file: CSV, or a bag's IMU topic.
+enum ImuStream {
     Csv {
         reader: CsvReader,
         rates: bool,
@@ -46,7 +52,7 @@ pub fn is_bag(path: &Path) -> bool {
 
 impl ImuStream {
     /// Opens a CSV log, or a bag's IMU topic (`topic`, or its only `sensor_msgs/msg/Imu`).
-    pub(super) fn open(path: &Path, topic: Option<&str>) -> Result<Self, SimError> {
+    fn open(path: &Path, topic: Option<&str>) -> Result<Self, SimError> {
         if is_bag(path) {
             let name = path.display().to_string();
             let all = topics(&name).map_err(bag_err)?;
@@ -65,32 +71,14 @@ impl ImuStream {
     }
 
     /// True when the samples are rates (else increments).
-    pub(super) fn rates(&self) -> bool {
+    fn rates(&self) -> bool {
         match self {
             ImuStream::Csv { rates, .. } => *rates,
             ImuStream::Bag { .. } => true,
         }
     }
 
-    /// The file.
-    pub(super) fn path(&self) -> PathBuf {
-        match self {
-            ImuStream::Csv { reader, .. } => reader.path.clone(),
-            ImuStream::Bag { path, .. } => path.clone(),
-        }
-    }
-
-    /// An error at `line` (CSV line, or bag message number).
-    pub(super) fn parse_err(&self, line: usize, column: usize, message: String) -> SimError {
-        SimError::LogParse {
-            path: self.path(),
-            line,
-            column,
-            message,
-        }
-    }
-
-    pub(super) fn next(&mut self) -> Result<Option<ImuRecord>, SimError> {
+    fn next(&mut self) -> Result<Option<ImuRecord>, SimError> {
         match self {
             ImuStream::Csv { reader, rates } => {
                 let Some(rec) = reader.next()? else {
@@ -149,4 +137,134 @@ impl ImuStream {
             }
         }
     }
+}
+
+/// An IMU log (CSV, or a bag's IMU topic) read once per replay. It is opened at the first read;
+/// samples looked at before the replay ([`ImuLog::nominal_step_s`], [`super::align_at_rest`]) are
+/// kept, and the replay takes them first, then reads on: the file is read once, from
+/// the start, in order, and its errors surface where they did when each step read it anew.
+pub struct ImuLog {
+    path: PathBuf,
+    topic: Option<String>,
+    stream: Option<ImuStream>,
+    /// Samples read ahead and not yet taken by [`ImuLog::next`].
+    ahead: VecDeque<ImuRecord>,
+}
+
+impl std::fmt::Debug for ImuLog {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ImuLog")
+            .field("path", &self.path)
+            .field("topic", &self.topic)
+            .field("open", &self.stream.is_some())
+            .field("read_ahead", &self.ahead.len())
+            .finish()
+    }
+}
+
+impl ImuLog {
+    /// The log at `path` (CSV increments or rates, declared by its header; or a ROS 2 bag,
+    /// `.mcap`, with its `sensor_msgs/msg/Imu` `topic`, default: the only one). Nothing is read
+    /// yet.
+    pub fn new(path: impl Into<PathBuf>, topic: Option<String>) -> Self {
+        Self {
+            path: path.into(),
+            topic,
+            stream: None,
+            ahead: VecDeque::new(),
+        }
+    }
+
+    /// The file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn stream(&mut self) -> Result<&mut ImuStream, SimError> {
+        let stream = match self.stream.take() {
+            Some(s) => s,
+            None => ImuStream::open(&self.path, self.topic.as_deref())?,
+        };
+        Ok(self.stream.insert(stream))
+    }
+
+    /// True when the samples are rates (else increments).
+    ///
+    /// # Errors
+    /// Opening the log: [`SimError::LogIo`], [`SimError::LogParse`] (header), [`SimError::Bag`].
+    pub(super) fn rates(&mut self) -> Result<bool, SimError> {
+        Ok(self.stream()?.rates())
+    }
+
+    /// The sample `i` places after the next one [`ImuLog::next`] would return (`None` past the
+    /// end), read ahead and kept.
+    pub(super) fn peek(&mut self, i: usize) -> Result<Option<ImuRecord>, SimError> {
+        while self.ahead.len() <= i {
+            let Some(rec) = self.stream()?.next()? else {
+                return Ok(None);
+            };
+            self.ahead.push_back(rec);
+        }
+        Ok(self.ahead.get(i).copied())
+    }
+
+    /// The next sample: one read ahead if any, else the next in the file.
+    pub(super) fn next(&mut self) -> Result<Option<ImuRecord>, SimError> {
+        match self.ahead.pop_front() {
+            Some(rec) => Ok(Some(rec)),
+            None => self.stream()?.next(),
+        }
+    }
+
+    /// An error at `line` (CSV line, or bag message number).
+    pub(super) fn parse_err(&self, line: usize, column: usize, message: String) -> SimError {
+        SimError::LogParse {
+            path: self.path.clone(),
+            line,
+            column,
+            message,
+        }
+    }
+
+    /// The nominal step: the median interval of the first 200 samples, s (the samples are kept
+    /// for the replay).
+    ///
+    /// # Errors
+    /// [`SimError::LogIo`], [`SimError::LogParse`] for a bad header or time field, or fewer than
+    /// two samples.
+    pub fn nominal_step_s(&mut self) -> Result<f64, SimError> {
+        let mut times = Vec::with_capacity(201);
+        let mut line = 1;
+        while times.len() < 201 {
+            let Some(rec) = self.peek(times.len())? else {
+                break;
+            };
+            times.push(rec.t_s);
+            line = rec.line;
+        }
+        let mut dts: Vec<f64> = times
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .filter(|d| *d > 0.0)
+            .collect();
+        if dts.is_empty() {
+            return Err(self.parse_err(
+                line,
+                1,
+                "fewer than two increasing IMU time stamps: no sample rate".into(),
+            ));
+        }
+        dts.sort_by(f64::total_cmp);
+        Ok(dts[dts.len() / 2])
+    }
+}
+
+/// The nominal step of an IMU log (either header, or a bag's IMU `topic`): the median interval
+/// of its first 200 samples, s ([`ImuLog::nominal_step_s`] on a log of its own).
+///
+/// # Errors
+/// [`SimError::LogIo`], [`SimError::LogParse`] for a bad header or time field, or fewer than two
+/// samples.
+pub fn imu_nominal_step_s(path: &Path, topic: Option<&str>) -> Result<f64, SimError> {
+    ImuLog::new(path, topic.map(str::to_owned)).nominal_step_s()
 }

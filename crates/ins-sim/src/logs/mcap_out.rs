@@ -9,7 +9,7 @@ use serde::Serialize;
 use ins_sd_filter::{InsSdFilter, UpdateReport};
 use ros_bag::out::{JsonChannel, JsonMcapWriter};
 
-use super::replay::ErrorSample;
+use super::metrics::ErrorSample;
 use crate::SimError;
 
 const SOLUTION_SCHEMA: &str = r#"{"title":"ita_nav.InsSolution","type":"object","properties":{"t_s":{"type":"number"},"lat_deg":{"type":"number"},"lon_deg":{"type":"number"},"alt_m":{"type":"number"},"vel_ned_mps":{"type":"array","items":{"type":"number"},"minItems":3,"maxItems":3},"roll_pitch_yaw_deg":{"type":"array","items":{"type":"number"},"minItems":3,"maxItems":3},"sigma_pos_ned_m":{"type":["array","null"],"items":{"type":"number"}},"sigma_vel_ned_mps":{"type":["array","null"],"items":{"type":"number"}},"sigma_att_mrad":{"type":["array","null"],"items":{"type":"number"}}},"required":["t_s","lat_deg","lon_deg","alt_m","vel_ned_mps","roll_pitch_yaw_deg"]}"#;

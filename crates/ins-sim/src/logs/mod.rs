@@ -26,7 +26,8 @@
 //!
 //! ## Replay
 //!
-//! [`replay`] reads the IMU log sample by sample and hands each to the online filter
+//! [`replay`] reads the IMU log ([`ImuLog`], opened once per replay) sample by sample and hands
+//! each to the online filter
 //! ([`ins_sd_filter::InsSdFilter`]); a sighting epoch is applied at its own time (the sample that
 //! spans it is cut there), gaps are bridged ([`GAP_FACTOR`]), the solution is written at the
 //! requested rate and compared with a reference on the way ([`ReplayMetrics`]); an optional
@@ -89,8 +90,11 @@ pub mod names {
     pub const SOLUTION: &str = "solution_simulated.csv";
 }
 
+mod align;
+mod csv;
 mod imu;
 mod mcap_out;
+mod metrics;
 mod read;
 mod reference;
 mod replay;
@@ -98,8 +102,10 @@ mod request;
 mod sightings;
 mod write;
 
-pub use imu::is_bag;
+pub use align::*;
+pub use imu::{ImuLog, imu_nominal_step_s, is_bag};
 pub use mcap_out::InsMcapSink;
+pub use metrics::*;
 pub use read::*;
 pub use reference::*;
 pub use replay::*;

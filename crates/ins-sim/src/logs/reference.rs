@@ -7,7 +7,8 @@ use ins_errors::earth::Geodetic;
 use ins_errors::strapdown::NavState;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-use super::read::{CsvReader, InitialState};
+use super::csv::CsvReader;
+use super::read::InitialState;
 use super::{REFERENCE_DEG_HEADER, TRUTH_HEADER};
 use crate::SimError;
 

@@ -3,7 +3,10 @@
 
 use std::path::PathBuf;
 
-use super::read::{imu_nominal_step_s, read_initial};
+use toml_config::TomlDoc;
+
+use super::imu::ImuLog;
+use super::read::read_initial;
 use super::reference::{initial_from_reference, read_reference};
 use super::replay::{ReplayInputs, SolutionRate};
 use crate::filter_file::FilterFile;
@@ -18,6 +21,27 @@ pub enum FilterSettings {
     /// A simulation scenario's `[filter]` (the older way; the scenario's IMU step and time-stamp
     /// tolerance are kept, so an exported run replays to round-off).
     Scenario(Box<Scenario>),
+}
+
+impl FilterSettings {
+    /// The settings in a file: a simulation scenario (the older way) when the document has a
+    /// top-level `trajectory` table (every scenario has one, no filter file may), else a filter
+    /// file. The TOML is parsed once; `path` names the file in errors.
+    ///
+    /// # Errors
+    /// [`SimError::LogToml`] for a TOML syntax error or a bad filter file,
+    /// [`SimError::ScenarioFile`] for a bad scenario, each with its line and column.
+    pub fn from_toml_named(path: &str, text: &str) -> Result<Self, SimError> {
+        let doc = TomlDoc::parse(path, text).map_err(|error| SimError::LogToml {
+            path: path.into(),
+            error,
+        })?;
+        if doc.keys().any(|k| k == "trajectory") {
+            Ok(Self::Scenario(Box::new(Scenario::from_doc(&doc)?)))
+        } else {
+            Ok(Self::File(FilterFile::from_doc(&doc, path)?))
+        }
+    }
 }
 
 /// A replay request ([`ReplayRequest::inputs`]).
@@ -103,12 +127,12 @@ impl ReplayRequest {
                 ));
             }
         };
+        // The log is opened here once; what the nominal step reads is kept for the replay.
+        let mut imu = ImuLog::new(self.imu.clone(), self.imu_topic.clone());
         let mut config = match &self.settings {
-            FilterSettings::File(f) => f.filter_config(
-                self.mode,
-                imu_nominal_step_s(&self.imu, self.imu_topic.as_deref())?,
-                initial.t_s,
-            )?,
+            FilterSettings::File(f) => {
+                f.filter_config(self.mode, imu.nominal_step_s()?, initial.t_s)?
+            }
             FilterSettings::Scenario(s) => s.online_filter_config(self.mode),
         };
         if let Some(gate) = self.gate {
@@ -126,8 +150,7 @@ impl ReplayRequest {
             }
         };
         Ok(ReplayInputs {
-            imu: self.imu.clone(),
-            imu_topic: self.imu_topic.clone(),
+            imu,
             sightings,
             initial,
             config,

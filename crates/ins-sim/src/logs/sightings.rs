@@ -24,7 +24,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
 use super::POINTED_SIGHTINGS_HEADER;
-use super::read::io_err;
+use super::csv::io_err;
 use super::reference::{ReferenceRow, attitude_from_motion, interpolate};
 use crate::SimError;
 

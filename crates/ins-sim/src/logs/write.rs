@@ -10,7 +10,8 @@ use ins_sd_filter::{InsSdFilter, Sighting, UpdateReport};
 use nalgebra::{Vector2, Vector3};
 use sighting_model::NavPose;
 
-use super::read::{InitialState, LandmarkFile, io_err};
+use super::csv::io_err;
+use super::read::{InitialState, LandmarkFile};
 use super::{IMU_HEADER, POINTED_SIGHTINGS_HEADER, SOLUTION_HEADER, TRUTH_HEADER, names};
 use crate::engine::{self, RunObserver};
 use crate::{Mode, Sample, Scenario, SimError, SimRunOutcome};

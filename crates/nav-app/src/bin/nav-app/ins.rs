@@ -8,11 +8,11 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::Parser;
+use ins_sim::Mode;
 use ins_sim::filter_file::FilterFile;
 use ins_sim::logs::{
     self, FilterSettings, ReplayMetrics, ReplaySummary, SightingPlan, SolutionRate,
 };
-use ins_sim::{Mode, Scenario};
 
 /// `nav-app ins`: replay an IMU log through the INS/SD filter.
 #[derive(Parser, Debug)]
@@ -146,16 +146,11 @@ fn filter_settings(args: &InsArgs) -> Result<FilterSettings> {
     if let Some(path) = &args.config {
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        if text.contains("[trajectory]") {
-            // An older scenario file: its [filter] section.
-            let scenario = Scenario::from_toml_str(&text)
-                .with_context(|| format!("scenario {}", path.display()))?;
-            return Ok(FilterSettings::Scenario(Box::new(scenario)));
-        }
-        return Ok(FilterSettings::File(FilterFile::from_toml_str(
-            &text,
+        // A filter file, or an older scenario file (a top-level [trajectory]): its [filter].
+        return Ok(FilterSettings::from_toml_named(
             &path.display().to_string(),
-        )?));
+            &text,
+        )?);
     }
     Ok(FilterSettings::File(FilterFile::preset(
         args.preset.as_deref().unwrap_or("mems"),
@@ -199,7 +194,7 @@ fn run_ins(args: &InsArgs) -> Result<()> {
     let file = std::fs::File::create(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut out = BufWriter::new(file);
-    let summary = logs::replay(&inputs, &mut out, &args.out)?;
+    let summary = logs::replay(inputs, &mut out, &args.out)?;
     report(args, &summary)
 }
 
@@ -263,7 +258,7 @@ fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
         let parts: Vec<_> = truth.components().rev().take(2).collect();
         let name: PathBuf = parts.iter().rev().collect();
         let title = format!("--filter {} against {}", args.filter, name.display());
-        let png = ins_monte_carlo::plot::replay_figure(&m.series, &title)?;
+        let png = ins_plot::replay_figure(&m.series, &title)?;
         std::fs::write(path, png).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())

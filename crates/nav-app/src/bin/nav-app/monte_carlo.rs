@@ -18,6 +18,8 @@ cores; outputs in ./monte-carlo/<config>-seed<S>-runs<N>/ (summary.md, summary.j
 timeseries_<mode>.csv, fig1–fig8 as SVG and PNG). `cargo xtask monte-carlo` runs this on the
 workspace's configs/paper.toml with outputs under target/monte-carlo/.
 
+An option given twice takes its last value (a wrapper such as xtask puts its settings first).
+
 A shard (--shard i/n) writes only stats.json; `nav-app monte-carlo merge DIR…` adds the shards'
 sums and writes the outputs of one run over all indices.
 
@@ -30,7 +32,8 @@ output that could not be written — each named); 2 bad command line.";
     name = "nav-app monte-carlo",
     about = "The INS/SD paper's Monte Carlo (stand-alone INS, KF, AKF): summaries, CSV, Figs. 1–8",
     after_help = AFTER_HELP,
-    args_conflicts_with_subcommands = true
+    args_conflicts_with_subcommands = true,
+    args_override_self = true
 )]
 pub struct McArgs {
     /// `merge DIR…` or `scenarios`.
@@ -43,8 +46,10 @@ pub struct McArgs {
 #[derive(Subcommand, Debug)]
 enum McCmd {
     /// Merge the stats.json of shard directories into the outputs of one run.
+    #[command(args_override_self = true)]
     Merge(MergeArgs),
     /// The matched case and every model-mismatch scenario (KF and AKF, same seeds) in one table.
+    #[command(args_override_self = true)]
     Scenarios(ScenarioArgs),
 }
 
