@@ -3,7 +3,7 @@
 //! the repository), through the product binary exactly as a user runs it: `nav-app ins sightings`
 //! writes landmarks and sightings from each reference (σ 1 m, 1 Hz, seeded;
 //! `ins_sim::real_sets`), then `nav-app ins` replays unaided, KF and AKF with the `mems` preset
-//! and KF and AKF with the `paper` preset. Writes `summary.md` (the table of the README), each
+//! and KF and AKF with the `paper` preset. Writes `summary.md` (the table of docs/results/ins.md), each
 //! run's `--metrics-json`, and the error plots of the KF on the `mems` preset
 //! (`<set>_kf_mems.png`) into `--out` (default `target/ins-real`).
 

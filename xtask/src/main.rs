@@ -255,8 +255,8 @@ fn wall_time(took: Duration) -> String {
 }
 
 /// The gate's closing table: each step's wall time and its share of the whole, then the total, so
-/// a CI run shows which step to make faster when the gate nears its budget (README: well inside
-/// 90 minutes, kept under 45).
+/// a CI run shows which step to make faster when the gate nears its budget (docs/testing.md:
+/// well inside 90 minutes, kept under 45).
 fn timing_table(timings: &[(&str, Duration)], total: Duration) -> String {
     let width = timings
         .iter()

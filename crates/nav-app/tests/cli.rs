@@ -96,7 +96,7 @@ fn json_is_one_object_per_frame_with_the_documented_schema() {
             .ends_with("straight_solid.y4m")
     );
     for (i, v) in frames.iter().enumerate() {
-        // The documented fields, no more (README "Per-frame JSON"), schema 1.
+        // The documented fields, no more (docs/json.md, lane_io::lane_frame::LaneFrame), schema 1.
         let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
         keys.sort_unstable();
         assert_eq!(keys, ["frame", "lanes", "schema", "t_s", "track_us"]);
