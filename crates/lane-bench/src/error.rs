@@ -141,3 +141,16 @@ pub(crate) fn labels_json(path: &str, e: &serde_json::Error) -> BenchError {
         reason,
     }
 }
+
+/// `e` and its causes, one after another (`: ` between them): the text a skipped frame is
+/// reported with (the frame loop's error names the frame; its causes the file and what failed).
+pub(crate) fn with_causes(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut next = e.source();
+    while let Some(cause) = next {
+        text.push_str(": ");
+        text.push_str(&cause.to_string());
+        next = cause.source();
+    }
+    text
+}

@@ -96,7 +96,7 @@ pub(crate) fn run_label_set(
                 Step::Skipped(e) => {
                     skipped.push(SkippedFrame {
                         position,
-                        reason: e.to_string(),
+                        reason: crate::error::with_causes(&e),
                     });
                     on_frame(position, f, None)?;
                 }
