@@ -12,7 +12,7 @@ use std::path::Path;
 use hough_init::{AngleBand, HoughParams, HoughWorkspace, LaneInitParams, Point, init_lane};
 
 /// `lanenet/gt_instance_image` under the data root (`$ITA_NAV_DATA`, else `../shared/data`
-/// beside the checkout, as `lane_eval::data`, which this crate cannot depend on); `None`
+/// beside the checkout, as `lane_bench::data`, which this crate cannot depend on); `None`
 /// (skipped, said on stderr) when it is missing outside CI, a failure naming it under CI (`$CI`
 /// set).
 fn data_dir() -> Option<std::path::PathBuf> {

@@ -352,7 +352,7 @@ fn avx2_and_portable_paths_agree_exactly() {
 }
 
 /// `relative` under the data root (`$ITA_NAV_DATA`, else `../shared/data` beside the checkout,
-/// as `lane_eval::data`, which this crate cannot depend on); `None` (skipped, said on stderr)
+/// as `lane_bench::data`, which this crate cannot depend on); `None` (skipped, said on stderr)
 /// when it is missing outside CI, a failure naming it under CI (`$CI` set).
 fn test_data_file(relative: &str) -> Option<std::path::PathBuf> {
     let root = std::env::var_os("ITA_NAV_DATA").map_or_else(
