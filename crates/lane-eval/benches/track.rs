@@ -53,9 +53,10 @@ fn tracking_frame(c: &mut Criterion) {
     let cases = [
         ("udacity_320x240", udacity_frame()),
         ("synthetic_320x240", synthetic_frame(320, 240)),
-        // Wider frames are tracked on their box average near 320 px wide
-        // (`frame.working_width_px`): 640×480 at 320×240, 1280×720 at 320×180.
+        // Other widths are resampled to 320 px wide (`frame.working_width_px`): 640×480 at
+        // 320×240 and 1280×720 at 320×180 by the box average, 512×288 by the area average.
         ("synthetic_640x480", synthetic_frame(640, 480)),
+        ("synthetic_512x288", synthetic_frame(512, 288)),
         ("synthetic_1280x720", synthetic_frame(1280, 720)),
     ];
     for (name, frame) in &cases {

@@ -126,11 +126,12 @@ fn the_counter_sees_an_allocation() {
 }
 
 #[test]
-fn wide_frames_tracked_on_their_box_average_do_not_allocate() {
-    // The working resolution: the box average, the mapping of every output back to input
-    // pixels and a reset, at 1280×720 (f = 4) and at a size that is no multiple of it.
+fn frames_of_other_widths_tracked_at_the_working_width_do_not_allocate() {
+    // The working resolution: the box average (1280×720, s = 4), the area average (1283×722,
+    // 512×288: s = 4.009, 1.6) and the interpolation up (256×144, s = 0.8), the mapping of every
+    // output back to input pixels and a reset.
     let cfg = TrackerConfig::default_preset().unwrap();
-    for (w, h) in [(1280, 720), (1283, 722)] {
+    for (w, h) in [(1280, 720), (1283, 722), (512, 288), (256, 144)] {
         for scene in ["wall_recovery", "noise"] {
             let (allocs, frames) = allocations_at(Estimator::Kif, scene, &cfg, w, h);
             assert!(frames > 20);

@@ -297,21 +297,22 @@
 //!
 //! ## Working resolution (an addition beyond the paper; `frame.working_width_px`, default 320)
 //! The paper's frames are 320×240, and so are the pixel fields of the default and the presets.
-//! A frame at least 1.5 times as wide as the working width is box-averaged over `f × f` blocks,
-//! `f` the whole number nearest its width over `working_width_px` and at most a third of either
-//! side (a 1280×720 frame is tracked at 320×180),
-//! and every report — coefficients, covariance, rows, windows, points, candidates — is mapped
-//! back to the input's pixels by the exact affine map of the coefficients (module
+//! A frame of another width than the working width is resampled to exactly that width, by
+//! `s = width / working_width_px` input pixels per working pixel, any real (the area average
+//! down, linear interpolation up to 2×; a 1280×720 frame is tracked at 320×180, a 512×288 one
+//! too), and every report — coefficients, covariance, rows, windows, points, candidates — is
+//! mapped back to the input's pixels by the exact affine map of the coefficients (module
 //! `tracker::working`, derivation there; counts such as a report's points stay counts of the
-//! working frame). At the default, frames up to 479 px wide are tracked as they are, bit for
-//! bit as before. Measured on the labelled stills enlarged to 640×360 and 1280×720
-//! (`cargo xtask resample-lanes --factor 2` / `4`, then `cargo xtask eval-lanes --data
-//! target/lanes-2x`): held out 79.0 % and 79.5 % (TuSimple) against 78.8 % at 320×180, where
-//! the same pixel settings used at the input's size reach 66.0 % and 43.9 %; and the work per
-//! frame stays that of a 320-px frame plus the box average. `working_width_px = 0` tracks every
-//! frame at its own size (the paper). [`LaneTracker::working_factor`] gives `f` and
-//! [`LaneTracker::working_frame`] the last frame's working pixels, for diagnostics that must
-//! read the frame as the stages do (`lane_bench::labelled::census_lanes`).
+//! working frame). At the default, frames 320 px wide are tracked as they are, bit for bit as
+//! before, and whole factors (640, 1280 px) by the box average as before. Measured on the
+//! labelled stills enlarged to 640×360 and 1280×720 (`cargo xtask resample-lanes --factor 2` /
+//! `4`, then `cargo xtask eval-lanes --data target/lanes-2x`): held out 79.0 % and 79.5 %
+//! (TuSimple) against 78.8 % at 320×180, where the same pixel settings used at the input's
+//! size reach 66.0 % and 43.9 %; and the work per frame stays that of a 320-px frame plus the
+//! resampling. `working_width_px = 0` tracks every frame at its own size (the paper).
+//! [`LaneTracker::working_scale`] gives `s` and [`LaneTracker::working_frame`] the last
+//! frame's working pixels, for diagnostics that must read the frame as the stages do
+//! (`lane_bench::labelled::census_lanes`).
 //!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field

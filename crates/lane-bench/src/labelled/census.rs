@@ -24,7 +24,7 @@
 //! `r = t + gradient.stripe_max_width_px / 2` columns of the point, `t` the TuSimple tolerance at
 //! this width (the edges of a mark up to a stripe width wide centred within `t` of the label).
 //! The edges are read where the stages read them, on the tracker's working frame
-//! ([`lane_tracker::LaneTracker::working_frame`]: a wide input's box average), the label's
+//! ([`lane_tracker::LaneTracker::working_frame`]: an input of another width resampled to the working width), the label's
 //! points and `t` mapped into its pixels (input `x` is working `(x − (f − 1)/2)/f`), so a set
 //! enlarged `f` times is classified as the working frame is.
 //! No mark detector fits a lane there: the label runs where the image shows nothing this
@@ -180,11 +180,11 @@ pub fn census_lanes(
     let tus_px = rules.tusimple_px_at_1280 * set.width as f64 / 1280.0;
     let joint = cfg.init.candidate_lines > 0;
     // The edges are read where the tracker's stages read them: on its working frame (a wide
-    // input's box average, `frame.working_width_px`), whose pixels the configuration's are.
+    // input resampled to `frame.working_width_px`), whose pixels the configuration's are.
     let (working_w, working_h, factor) = {
         let probe = LaneTracker::new(cfg, estimator, set.width, set.height)?;
         let (w, h) = probe.working_size();
-        (w, h, probe.working_factor() as f64)
+        (w, h, probe.working_scale())
     };
     let (roi_top, roi_bottom) = cfg.roi_rows(working_h);
     let reach_px = tus_px / factor + 0.5 * f64::from(cfg.gradient.stripe_max_width_px);

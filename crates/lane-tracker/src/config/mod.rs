@@ -412,10 +412,10 @@ pub struct FilterConfig {
 
 /// The resolution the tracker works at (an addition beyond the paper, whose frames are the
 /// BT848's 320×240): every pixel-valued field of the configuration is in pixels of the
-/// **working frame**, which for an input frame at least 1.5 times the working width is the
-/// input box-averaged over `f × f` pixel blocks, `f` the whole number nearest `input width /
-/// working_width_px` and at most a third of either side (module `tracker::working`). Reports
-/// stay in input pixels.
+/// **working frame**: the input resampled to exactly `working_width_px` wide, by `s = input
+/// width / working_width_px` input pixels per working pixel along both axes, any real (area
+/// average down, linear interpolation up to 2×; at most a third of either side; module
+/// `tracker::working`). Reports stay in input pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FrameConfig {

@@ -33,6 +33,7 @@ mod kerb;
 mod lane;
 mod points;
 mod report;
+mod resample;
 mod setup;
 mod stripe_trace;
 #[cfg(test)]
@@ -145,26 +146,26 @@ impl LaneTracker {
         self.frame.input_size
     }
 
-    /// The size of the frame the stages work on, px: the input box-averaged over `f × f`
-    /// blocks, `f` the whole number nearest the input width over `frame.working_width_px`
-    /// (module `tracker::working`); the input's own size when `f = 1`. The configuration's
-    /// pixel fields are in these pixels; everything the tracker reports is in input pixels.
+    /// The size of the frame the stages work on, px: the input resampled to
+    /// `frame.working_width_px` wide by `s` input pixels per working pixel (module
+    /// `tracker::working`); the input's own size when `s = 1`. The configuration's pixel fields
+    /// are in these pixels; everything the tracker reports is in input pixels.
     pub fn working_size(&self) -> (usize, usize) {
         (self.setup.width, self.setup.height)
     }
 
-    /// Input pixels per working pixel along each axis (`f ≥ 1`; module `tracker::working`):
-    /// working pixel `c'` is the mean of input pixels `f·c' … f·c' + f − 1`, centred on input
-    /// `x = f·c' + (f − 1)/2`. 1 when the stages work on the input itself.
-    pub fn working_factor(&self) -> usize {
+    /// Input pixels per working pixel along each axis (`s > 0`; module `tracker::working`):
+    /// working pixel `c'` stands for input columns `[s·c', s·(c' + 1))`, centred on input
+    /// `x = s·c' + (s − 1)/2`. 1 when the stages work on the input itself.
+    pub fn working_scale(&self) -> f64 {
         self.frame.scale.factor()
     }
 
-    /// What the stages read of the last frame, when the input is resampled (`f > 1`): the
+    /// What the stages read of the last frame, when the input is resampled (`s ≠ 1`): the
     /// working frame ([`LaneTracker::working_size`]) and the rows `[first, end)` of it that are
     /// written — the rows any stage reads (the ROI, the second search's rows, a row beside
     /// them for the Sobel); the other rows are not (zero). All zero before the first frame.
-    /// `None` with `f = 1`: the stages read the input frame as it is. For diagnostics on the
+    /// `None` with `s = 1`: the stages read the input frame as it is. For diagnostics on the
     /// working frame (`lane_bench::labelled::census_lanes`); no copy.
     pub fn working_frame(&self) -> Option<(GreyImage<'_>, (usize, usize))> {
         self.frame.image()
@@ -173,9 +174,9 @@ impl LaneTracker {
     /// Rows searched, `[top, bottom)`, px of the input (with a resampled input, the input rows
     /// the working ROI's rows average).
     pub fn roi_rows(&self) -> (usize, usize) {
-        let f = self.frame.scale.factor();
-        let roi = self.setup.roi;
-        (f * roi.0, (f * roi.1).min(self.frame.input_size.1))
+        self.frame
+            .scale
+            .rows_to_input(self.setup.roi, self.frame.input_size.1)
     }
 
     /// The configuration in use.

@@ -7,37 +7,40 @@
 //! input's size reach 66.0 % and 43.9 % held out (TuSimple) against 78.8 % at 320×180; scaled
 //! with the width (`TrackerConfig::scale_pixels`) they still lose ground at 4× — a 3×3 Sobel on
 //! a frame four times as sharp sees edges four times as soft — and the work grows with the
-//! area. The tracker therefore works on a frame near the working width `W` (320 px by default),
-//! which reaches 79.0 % and 79.5 % there:
+//! area. The tracker therefore works on a frame exactly the working width `W` (320 px by
+//! default) wide, which reaches 79.0 % and 79.5 % there:
 //!
 //! ```text
-//! f = max(1, round(input width / W)),   working frame: ⌊w/f⌋ × ⌊h/f⌋,
-//! I'(c', r') = (1/f²) · Σ_{i,j < f} I(f·c' + i, f·r' + j)        (rounded to the nearest grey level)
+//! s = input width / W   (input pixels per working pixel, any real > 0),
+//! working frame: ⌊w/s⌋ × ⌊h/s⌋,   working pixel c' ↔ input interval [s·c', s·(c' + 1)),
 //! ```
 //!
-//! a box average over `f × f` blocks (the last `w mod f` columns and `h mod f` rows are not
-//! read). Working pixel `c'` averages input columns `f·c' … f·c' + f − 1`, whose centre is
-//! `x = f·x' + o` with `o = (f − 1)/2`, and rows alike. A working-frame parabola
-//! `x' = b1·y'² + b2·y' + b3` is then, substituting `y' = (y − o)/f`,
+//! the area average of that interval in both axes (down), or linear interpolation at its
+//! centre (up, at most 2×) — module `resample`; a whole `s` is the box average over `s × s`
+//! blocks, computed as such. Rounding `s` to a whole number instead (as before) tracked a
+//! 512-px frame at 256 px, where the pixel settings are 25 % too wide: 11 points lost on
+//! TuSimple stills given at 512 × 288 against the same stills resized to 320 first.
+//! Working pixel `c'` is centred on input `x = s·x' + o` with `o = (s − 1)/2`, and rows alike.
+//! A working-frame parabola `x' = b1·y'² + b2·y' + b3` is then, substituting `y' = (y − o)/s`,
 //!
 //! ```text
-//! x = (b1/f)·(y − o)² + b2·(y − o) + f·b3 + o
-//!   ⇒ a1 = b1/f,   a2 = b2 − 2·o·b1/f,   a3 = b1·o²/f − b2·o + f·b3 + o,
+//! x = (b1/s)·(y − o)² + b2·(y − o) + s·b3 + o
+//!   ⇒ a1 = b1/s,   a2 = b2 − 2·o·b1/s,   a3 = b1·o²/s − b2·o + s·b3 + o,
 //! ```
 //!
 //! the affine map `a = T·b + t` with
 //!
 //! ```text
-//!     ⎡  1/f     0   0 ⎤        ⎡ 0 ⎤
-//! T = ⎢ −2o/f    1   0 ⎥,   t = ⎢ 0 ⎥,   Cov(a) = T·Cov(b)·Tᵀ.
-//!     ⎣  o²/f   −o   f ⎦        ⎣ o ⎦
+//!     ⎡  1/s     0   0 ⎤        ⎡ 0 ⎤
+//! T = ⎢ −2o/s    1   0 ⎥,   t = ⎢ 0 ⎥,   Cov(a) = T·Cov(b)·Tᵀ.
+//!     ⎣  o²/s   −o   s ⎦        ⎣ o ⎦
 //! ```
 //!
 //! Every report, covariance, row profile, window, point and candidate's coefficients leave the
 //! tracker in input pixels by these maps (counts — a report's points, a candidate's support —
-//! stay counts of the working frame); with `f = 1` (a frame narrower than 1.5 W, a frame under
-//! 6 px high or wide, or `working_width_px = 0`) nothing is resampled or mapped, and the tracker
-//! is the one it was. `f` is at most a third of either side, so a working frame keeps 3 × 3 px.
+//! stay counts of the working frame); with `s = 1` (a frame the working width wide, or
+//! `working_width_px = 0`) nothing is resampled or mapped, and the tracker is the one it was.
+//! `s` is at most a third of either side (a working frame keeps 3 × 3 px) and at least 1/2.
 //!
 //! Decisions and figures: `docs/lanes/history/working-resolution.md`.
 
@@ -46,64 +49,101 @@ use vision_gradient::{ColSpan, GreyImage};
 
 use super::lane::Lanes;
 use super::report::{InitCandidate, LaneReport, MAX_CANDIDATE_LINES};
+use super::resample::{AxisTaps, resample_rows};
 use super::setup::Rows;
 
-/// The integer scale between the input frame and the working frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The scale between the input frame and the working frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct WorkingScale {
-    /// Input pixels per working pixel along each axis, ≥ 1.
-    factor: usize,
+    /// Input pixels per working pixel along each axis, `s > 0` (module docs).
+    s: f64,
 }
+
+/// The largest upsampling: a frame is tracked at most twice its own size.
+const MAX_UPSAMPLING: f64 = 2.0;
 
 impl WorkingScale {
     /// The scale for `input_width_px × input_height_px` frames at working width
-    /// `working_width_px` (0: none): the whole number nearest the width over the working width
-    /// (half up: 480 px at 320 → 2, 479 px → 1), at most a third of either side (a working
-    /// frame keeps 3 × 3 px: a 1280 × 8 strip is tracked at 640 × 4), at least 1.
+    /// `working_width_px` (0: none, `s = 1`): `s = input width / working width`, so the working
+    /// frame is the working width wide whatever the input's width, held to a working frame of
+    /// at least 3 × 3 px (`s ≤ min(w, h)/3`: a 1280 × 8 strip is tracked at 480 × 3), at most
+    /// twice the input's size (`s ≥ 1/2`: a 100-px frame is tracked at 200 px) and at most
+    /// `MAX_IMAGE_SIDE_PX` a side.
     pub(crate) fn for_input(
         input_width_px: usize,
         input_height_px: usize,
         working_width_px: usize,
     ) -> Self {
-        let factor = if working_width_px == 0 {
-            1
-        } else {
-            ((2 * input_width_px + working_width_px) / (2 * working_width_px))
-                .min(input_width_px / 3)
-                .min(input_height_px / 3)
-                .max(1)
-        };
-        WorkingScale { factor }
+        if working_width_px == 0 || input_width_px == working_width_px {
+            return WorkingScale { s: 1.0 };
+        }
+        let (w, h) = (input_width_px as f64, input_height_px as f64);
+        let max_side = hough_init::MAX_IMAGE_SIDE_PX as f64;
+        let s = (w / working_width_px as f64)
+            .min(w.min(h) / 3.0)
+            .max(1.0 / MAX_UPSAMPLING)
+            .max(w.max(h) / max_side);
+        // A ratio within rounding of a whole number is that number (the box average's path).
+        let whole = s.round();
+        WorkingScale {
+            s: if (s - whole).abs() < 1e-9 && whole >= 1.0 {
+                whole
+            } else {
+                s
+            },
+        }
     }
 
-    /// Input pixels per working pixel, ≥ 1.
-    pub(crate) fn factor(self) -> usize {
-        self.factor
+    /// Input pixels per working pixel, `s > 0`.
+    pub(crate) fn factor(self) -> f64 {
+        self.s
     }
 
-    /// `true` when the input is resampled (`f > 1`).
+    /// `s` when it is a whole number ≥ 2: the working frame is then the box average over
+    /// `s × s` blocks.
+    pub(crate) fn whole_factor(self) -> Option<usize> {
+        (self.s >= 2.0 && self.s.fract() == 0.0).then_some(self.s as usize)
+    }
+
+    /// `true` when the input is resampled (`s ≠ 1`).
     pub(crate) fn resamples(self) -> bool {
-        self.factor > 1
+        self.s != 1.0
     }
 
-    /// `o = (f − 1)/2`, px: the input coordinate of working pixel 0's centre.
+    /// `o = (s − 1)/2`, px: the input coordinate of working pixel 0's centre.
     fn offset_px(self) -> f64 {
-        (self.factor as f64 - 1.0) / 2.0
+        (self.s - 1.0) / 2.0
     }
 
-    /// A working-frame row or column `v'` in input pixels: `f·v' + o`.
+    /// A working-frame row or column `v'` in input pixels: `s·v' + o`.
     pub(crate) fn to_input_px(self, working_px: f64) -> f64 {
-        self.factor as f64 * working_px + self.offset_px()
+        self.s * working_px + self.offset_px()
     }
 
-    /// The working-frame size of a `width × height` input, px.
+    /// The working-frame size of a `width × height` input, px: `⌊w/s⌋ × ⌊h/s⌋`.
     pub(crate) fn working_size(self, width: usize, height: usize) -> (usize, usize) {
-        (width / self.factor, height / self.factor)
+        let side = |v: usize| (v as f64 / self.s + 1e-9).floor() as usize;
+        (side(width), side(height))
+    }
+
+    /// Working rows `[first, end)` as the input rows they stand for, `[⌊s·first⌉, ⌊s·end⌉)`,
+    /// the end at most `input_height_px`.
+    pub(crate) fn rows_to_input(self, rows: Rows, input_height_px: usize) -> Rows {
+        let edge = |r: usize| (self.s * r as f64).round() as usize;
+        (
+            edge(rows.0).min(input_height_px),
+            edge(rows.1).min(input_height_px),
+        )
+    }
+
+    /// The working row that input row `row_px` falls in, `⌊y/s⌋`.
+    fn working_row(self, row_px: usize) -> usize {
+        (row_px as f64 / self.s + 1e-9).floor() as usize
     }
 
     /// `T` of the module docs.
     fn coeff_map(self) -> Matrix3<f64> {
-        let f = self.factor as f64;
+        let f = self.s;
         let o = self.offset_px();
         Matrix3::new(1.0 / f, 0.0, 0.0, -2.0 * o / f, 1.0, 0.0, o * o / f, -o, f)
     }
@@ -128,42 +168,91 @@ impl WorkingScale {
         t * p * t.transpose()
     }
 
-    /// A working-frame window span as the input columns it covers, `[f·start, f·end)`.
+    /// A working-frame window span as the input columns it covers, `[⌊s·start⌋, ⌈s·end⌉)`.
     pub(crate) fn span_to_input(self, s: ColSpan) -> ColSpan {
-        // `end ≤ working width`, so `f·end ≤ input width ≤ u16::MAX` (`MAX_SIDE_PX`).
-        let f = self.factor as u32;
-        let wide = |c: u16| u16::try_from(u32::from(c) * f).unwrap_or(u16::MAX);
+        let wide = |c: f64| {
+            // `end ≤ working width`, so `s·end ≤ input width ≤ u16::MAX` (`MAX_SIDE_PX`).
+            u16::try_from(c.max(0.0) as u64).unwrap_or(u16::MAX)
+        };
         ColSpan {
-            col_start_px: wide(s.col_start_px),
-            col_end_px: wide(s.col_end_px),
+            col_start_px: wide((self.s * f64::from(s.col_start_px)).floor()),
+            col_end_px: wide((self.s * f64::from(s.col_end_px) - 1e-9).ceil()),
+        }
+    }
+}
+
+/// How the working frame is made of the input (module docs, and module `resample`).
+#[derive(Debug)]
+enum Resampling {
+    /// `s = 1`: the input is the working frame.
+    None,
+    /// A whole factor `f ≥ 2`: the box average over `f × f` blocks, with its column sums
+    /// (`f · working width` entries).
+    Box { factor: usize, sums: Vec<u32> },
+    /// Any other `s`: the area average down, linear interpolation up (module `resample`), with
+    /// the taps of both axes and a row of input-width sums.
+    Taps {
+        cols: AxisTaps,
+        rows: AxisTaps,
+        acc: Vec<f32>,
+    },
+}
+
+impl Resampling {
+    fn new(scale: WorkingScale, input_size: (usize, usize), size: (usize, usize)) -> Self {
+        if !scale.resamples() {
+            return Resampling::None;
+        }
+        if let Some(factor) = scale.whole_factor() {
+            return Resampling::Box {
+                factor,
+                sums: vec![0; input_size.0],
+            };
+        }
+        Resampling::Taps {
+            cols: AxisTaps::new(input_size.0, size.0, scale.factor()),
+            rows: AxisTaps::new(input_size.1, size.1, scale.factor()),
+            acc: vec![0.0; input_size.0],
         }
     }
 
-    /// Box-average rows `rows = [first, end)` of the working frame from `src` into `dst`
-    /// (`working_width` bytes a row, row `r` at `r · working_width`), summing the `f` input rows
-    /// of each working row column by column in `sums` (at least `f · working_width` entries;
-    /// `u32`), then each run of `f` sums. Rows outside `rows` are left as they are.
-    ///
-    /// Needs `src` at least `f·working_width` wide and `f·end` high, `dst` and `sums` large
-    /// enough; the tracker sizes all of them in `LaneTracker::new` and checks the frame's size
-    /// before calling. The common factors are compiled for their constant `f` (the sums of a
-    /// run then vectorise).
-    pub(crate) fn downscale_rows(
-        self,
-        src: &GreyImage<'_>,
-        dst: &mut [u8],
-        working_width: usize,
-        rows: (usize, usize),
-        sums: &mut [u32],
-    ) {
-        match self.factor {
-            2 => box_rows::<2>(src, dst, working_width, rows, sums),
-            3 => box_rows::<3>(src, dst, working_width, rows, sums),
-            4 => box_rows::<4>(src, dst, working_width, rows, sums),
-            5 => box_rows::<5>(src, dst, working_width, rows, sums),
-            6 => box_rows::<6>(src, dst, working_width, rows, sums),
-            f => box_rows_any(f, src, dst, working_width, rows, sums),
+    /// Resample working rows `rows = [first, end)` of `src` into `dst` (`working_width` bytes
+    /// a row); rows outside are left as they are.
+    fn rows(&mut self, src: &GreyImage<'_>, dst: &mut [u8], working_width: usize, rows: Rows) {
+        match self {
+            Resampling::None => {}
+            Resampling::Box { factor, sums } => {
+                downscale_box(*factor, src, dst, working_width, rows, sums)
+            }
+            Resampling::Taps { cols, rows: r, acc } => resample_rows(src, dst, cols, r, rows, acc),
         }
+    }
+}
+
+/// Box-average rows `rows = [first, end)` of the working frame from `src` into `dst`
+/// (`working_width` bytes a row, row `r` at `r · working_width`), summing the `f` input rows
+/// of each working row column by column in `sums` (at least `f · working_width` entries;
+/// `u32`), then each run of `f` sums. Rows outside `rows` are left as they are.
+///
+/// Needs `src` at least `f·working_width` wide and `f·end` high, `dst` and `sums` large
+/// enough; the tracker sizes all of them in `LaneTracker::new` and checks the frame's size
+/// before calling. The common factors are compiled for their constant `f` (the sums of a
+/// run then vectorise).
+fn downscale_box(
+    factor: usize,
+    src: &GreyImage<'_>,
+    dst: &mut [u8],
+    working_width: usize,
+    rows: (usize, usize),
+    sums: &mut [u32],
+) {
+    match factor {
+        2 => box_rows::<2>(src, dst, working_width, rows, sums),
+        3 => box_rows::<3>(src, dst, working_width, rows, sums),
+        4 => box_rows::<4>(src, dst, working_width, rows, sums),
+        5 => box_rows::<5>(src, dst, working_width, rows, sums),
+        6 => box_rows::<6>(src, dst, working_width, rows, sums),
+        f => box_rows_any(f, src, dst, working_width, rows, sums),
     }
 }
 
@@ -179,9 +268,9 @@ pub(super) struct WorkingFrame {
     /// The working frame's size, px.
     size: (usize, usize),
     /// The working frame's pixels, its width a row (empty when the input is not resampled),
-    /// and the column sums of its box average (the input's width).
+    /// and how they are made.
     pixels: Vec<u8>,
-    sums: Vec<u32>,
+    resampling: Resampling,
     /// The working rows any stage reads, `[first, end)`: the regions searched and the Sobel's
     /// row beside them; only these are resampled.
     rows: Rows,
@@ -212,7 +301,7 @@ impl WorkingFrame {
             input_size,
             size,
             pixels: vec![0; if resampled { size.0 * size.1 } else { 0 }],
-            sums: vec![0; if resampled { input_size.0 } else { 0 }],
+            resampling: Resampling::new(scale, input_size, size),
             rows,
             out_lanes: lanes.reports().map(|r| scale.report_to_input(r)),
             out_candidates: Vec::with_capacity(if resampled {
@@ -227,7 +316,7 @@ impl WorkingFrame {
         }
     }
 
-    /// Whether the input is resampled (`f > 1`).
+    /// Whether the input is resampled (`s ≠ 1`).
     pub(super) fn resamples(&self) -> bool {
         self.scale.resamples()
     }
@@ -237,8 +326,8 @@ impl WorkingFrame {
     /// give it back with [`Self::put_back`].
     pub(super) fn downscale(&mut self, input: &GreyImage<'_>) -> Vec<u8> {
         let mut pixels = std::mem::take(&mut self.pixels);
-        self.scale
-            .downscale_rows(input, &mut pixels, self.size.0, self.rows, &mut self.sums);
+        self.resampling
+            .rows(input, &mut pixels, self.size.0, self.rows);
         pixels
     }
 
@@ -272,7 +361,6 @@ impl WorkingFrame {
                 coeffs: s.coeffs_to_input(c.coeffs),
                 ..*c
             }));
-        let f = s.factor();
         for ((spans, points), lane) in self
             .out_spans
             .iter_mut()
@@ -282,7 +370,7 @@ impl WorkingFrame {
             for (y, span) in spans.iter_mut().enumerate() {
                 *span = lane
                     .spans
-                    .get(y / f)
+                    .get(s.working_row(y))
                     .map_or(ColSpan::EMPTY, |&w| s.span_to_input(w));
             }
             points.clear();
@@ -365,29 +453,42 @@ mod tests {
     }
 
     #[test]
-    fn the_factor_is_the_nearest_whole_ratio_and_never_below_one() {
-        let f = |w, ww| WorkingScale::for_input(w, 720, ww).factor();
-        assert_eq!(f(320, 320), 1);
-        assert_eq!(f(479, 320), 1);
-        assert_eq!(f(480, 320), 2);
-        assert_eq!(f(640, 320), 2);
-        assert_eq!(f(1280, 320), 4);
-        assert_eq!(f(1640, 320), 5);
-        assert_eq!(f(160, 320), 1);
-        assert_eq!(f(1280, 0), 1);
+    fn the_scale_is_the_width_over_the_working_width_within_its_bounds() {
+        let s = |w, ww| WorkingScale::for_input(w, 720, ww).factor();
+        assert_eq!(s(320, 320), 1.0);
+        assert_eq!(s(480, 320), 1.5);
+        assert_eq!(s(512, 320), 1.6);
+        assert_eq!(s(640, 320), 2.0);
+        assert_eq!(s(1280, 320), 4.0);
+        assert_eq!(s(1640, 320), 5.125);
+        assert_eq!(s(256, 320), 0.8);
+        // At most twice the input's size; none with working width 0.
+        assert_eq!(s(100, 320), 0.5);
+        assert_eq!(s(1280, 0), 1.0);
+        assert_eq!(
+            WorkingScale::for_input(1280, 720, 320).whole_factor(),
+            Some(4)
+        );
+        assert_eq!(WorkingScale::for_input(512, 288, 320).whole_factor(), None);
+        assert_eq!(
+            WorkingScale::for_input(512, 288, 320).working_size(512, 288),
+            (320, 180)
+        );
+        assert_eq!(
+            WorkingScale::for_input(256, 144, 320).working_size(256, 144),
+            (320, 180)
+        );
         // A short frame keeps a working frame of 3 rows at least.
         let short = |h| WorkingScale::for_input(1280, h, 320);
-        assert_eq!(short(5).factor(), 1);
-        assert_eq!(short(8).factor(), 2);
-        assert_eq!(short(8).working_size(1280, 8), (640, 4));
-        assert_eq!(short(12).factor(), 4);
+        assert_eq!(short(8).working_size(1280, 8), (480, 3));
+        assert_eq!(short(12).factor(), 4.0);
     }
 
     #[test]
     fn mapped_coefficients_pass_through_the_mapped_points() {
         // A working-frame parabola's point (x', y') is the input point (f·x' + o, f·y' + o).
-        for factor_px in [2usize, 3, 4, 5] {
-            let s = WorkingScale { factor: factor_px };
+        for factor_px in [2.0, 3.0, 4.0, 5.0, 1.6, 0.8, 5.125] {
+            let s = WorkingScale { s: factor_px };
             let b = [0.0031, -0.42, 97.5];
             let a = s.coeffs_to_input(b);
             for y_w in [0.0, 17.0, 60.5, 179.0] {
@@ -405,7 +506,7 @@ mod tests {
     fn the_mapped_covariance_is_the_covariance_of_mapped_samples() {
         // Cov(T·b + t) = T·Cov(b)·Tᵀ, checked against the sample covariance of coefficients
         // drawn around a mean and mapped one by one (a fixed lattice: no randomness needed).
-        let s = WorkingScale { factor: 4 };
+        let s = WorkingScale { s: 1.6 };
         let mean = [0.002, 0.3, 150.0];
         let steps = [1e-4, 0.05, 2.0];
         let mut samples = Vec::new();
@@ -454,15 +555,15 @@ mod tests {
         ];
         let src = GreyImage::new(&input, 6, 4, 6).expect("image");
         let s = WorkingScale::for_input(6, 6, 3);
-        assert_eq!(s.factor(), 2);
+        assert_eq!(s.whole_factor(), Some(2));
         let (mut dst, mut acc) = (vec![9u8; 6], vec![0u32; 6]);
-        s.downscale_rows(&src, &mut dst, 3, (0, 2), &mut acc);
+        downscale_box(2, &src, &mut dst, 3, (0, 2), &mut acc);
         // (0+1+1+1)/4 = 0.75 → 1; 41/4 = 10.25 → 10; 1019/4 = 254.75 → 255;
         // 29/4 = 7.25 → 7; 1/4 → 0; 100/4 = 25.
         assert_eq!(dst, vec![1, 10, 255, 7, 0, 25]);
         // Only the rows asked for are written.
         let mut dst = vec![9u8; 6];
-        s.downscale_rows(&src, &mut dst, 3, (1, 2), &mut acc);
+        downscale_box(2, &src, &mut dst, 3, (1, 2), &mut acc);
         assert_eq!(dst, vec![9, 9, 9, 7, 0, 25]);
     }
 
@@ -476,10 +577,10 @@ mod tests {
             .collect();
         let src = GreyImage::new(&input, w, h, w).expect("image");
         for f in 2..=9 {
-            let s = WorkingScale { factor: f };
+            let s = WorkingScale { s: f as f64 };
             let (ww, wh) = s.working_size(w, h);
             let (mut dst, mut sums) = (vec![0u8; ww * wh], vec![0u32; w]);
-            s.downscale_rows(&src, &mut dst, ww, (0, wh), &mut sums);
+            downscale_box(f, &src, &mut dst, ww, (0, wh), &mut sums);
             for r in 0..wh {
                 for c in 0..ww {
                     let mut sum = 0u32;
@@ -500,11 +601,15 @@ mod tests {
 
     #[test]
     fn spans_cover_the_input_columns_of_their_working_columns() {
-        let s = WorkingScale { factor: 4 };
-        let span = s.span_to_input(ColSpan {
-            col_start_px: 10,
-            col_end_px: 21,
-        });
-        assert_eq!((span.col_start_px, span.col_end_px), (40, 84));
+        let span = |s: f64| {
+            let c = WorkingScale { s }.span_to_input(ColSpan {
+                col_start_px: 10,
+                col_end_px: 21,
+            });
+            (c.col_start_px, c.col_end_px)
+        };
+        assert_eq!(span(4.0), (40, 84));
+        // Input columns [16, 33.6): every column any of the working columns reads.
+        assert_eq!(span(1.6), (16, 34));
     }
 }
