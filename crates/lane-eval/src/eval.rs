@@ -355,6 +355,11 @@ mod tests {
         TrackReport {
             lanes: [lane(Side::Left, 100.0), lane(Side::Right, 250.0)],
             full_gradient: false,
+            road: lane_tracker::RoadReport {
+                bottom_row_px: 240.0,
+                search_rows_px: [148.0, 240.0],
+                horizon_row_px: None,
+            },
         }
     }
 
@@ -434,6 +439,11 @@ mod tests {
         let r = TrackReport {
             lanes: [lane(Side::Left, 410.5), lane(Side::Right, 930.5)],
             full_gradient: true,
+            road: lane_tracker::RoadReport {
+                bottom_row_px: 240.0,
+                search_rows_px: [148.0, 240.0],
+                horizon_row_px: None,
+            },
         };
         let s = score_against_instance_label(&r, &label, 300, 10);
         assert_eq!(s.points, 2 * 42);

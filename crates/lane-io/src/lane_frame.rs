@@ -2,8 +2,8 @@
 //! the MCAP `/lanes` channel carries ([`crate::mcap_sink`]), one type for both, described by the
 //! JSON schema [`crate::mcap_sink::LANES_SCHEMA`] (`docs/json.md` documents its fields).
 
-use lane_tracker::LaneReport;
 use lane_tracker::camera::EgoLaneReport;
+use lane_tracker::{LaneReport, RoadReport};
 use serde::Serialize;
 
 use crate::capture_source::DeviceFrameInfo;
@@ -23,6 +23,9 @@ pub struct LaneFrame<'a> {
     pub t_s: f64,
     /// Left then right.
     pub lanes: &'a [LaneReport; 2],
+    /// The road region the frame was searched in: the road's bottom row, the rows searched and
+    /// the horizon the ego lanes show (`lane_tracker::RoadReport`).
+    pub road: RoadReport,
     /// Wall time of `LaneTracker::track` on this frame, µs.
     pub track_us: f64,
     /// The ego lane in metres with σ (with a camera; `null` unless both lanes are held; absent
@@ -82,6 +85,11 @@ mod tests {
             frame: 7,
             t_s: 0.28,
             lanes: &lanes,
+            road: RoadReport {
+                bottom_row_px: 240.0,
+                search_rows_px: [148.0, 240.0],
+                horizon_row_px: Some(96.5),
+            },
             track_us: 31.0,
             ego_lane: Some(None),
             lane_cov_px: Some([Some([[1.0; 3]; 3]), None]),

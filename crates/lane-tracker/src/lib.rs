@@ -358,12 +358,12 @@ mod wrls_lane;
 
 pub use config::{
     DEFAULT_TOML, DEFAULT_WORKING_WIDTH_PX, FilterConfig, FrameConfig, GradientConfig, INDOOR_TOML,
-    InitConfig, OUTDOOR_TOML, RoiConfig, TrackConfig, TrackerConfig,
+    InitConfig, OUTDOOR_TOML, RoadBottom, RoiConfig, TrackConfig, TrackerConfig,
 };
 pub use error::{FilterFailure, TrackerError};
 /// The workspace's one grey frame (crate `grey-frame`).
 pub use grey_frame::{FrameError, GreyFrame};
 pub use tracker::{
-    Estimator, InitCandidate, LaneReport, LaneState, LaneTracker, LaneView, Side, TrackReport,
-    TrackerCounters,
+    Estimator, InitCandidate, LaneReport, LaneState, LaneTracker, LaneView, RoadReport, Side,
+    TrackReport, TrackerCounters,
 };

@@ -96,6 +96,23 @@ pub struct RoiConfig {
     /// absent) = no second search.
     #[serde(default)]
     pub fallback_top_row_fraction: Option<f64>,
+    /// Beyond the paper: where the road's lowest row is (absent = `"frame"`, the paper's: the
+    /// frame's last row). `"found"`: found on every frame that initialises both lanes — the
+    /// edge of a bonnet or a dashboard in view — and the fractions above taken of the road's
+    /// rows, not the frame's (module `tracker::road`).
+    #[serde(default)]
+    pub road_bottom: RoadBottom,
+}
+
+/// Where the road's lowest row is taken from (`roi.road_bottom`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RoadBottom {
+    /// The frame's last row (the paper's camera sees road down to it).
+    #[default]
+    Frame,
+    /// Found on each frame that initialises both lanes (module `tracker::road`).
+    Found,
 }
 
 /// Stage II: Hough + least-squares (re-)initialisation (see the `hough-init` crate). The ranges

@@ -21,7 +21,7 @@ use nalgebra::Matrix3;
 use vision_gradient::{ColSpan, GreyImage};
 
 use crate::error::FilterFailure;
-use crate::{GreyFrame, TrackerConfig, TrackerError};
+use crate::{GreyFrame, RoadBottom, TrackerConfig, TrackerError};
 
 mod candidates;
 mod chosen_fit;
@@ -34,18 +34,21 @@ mod lane;
 mod points;
 mod report;
 mod resample;
+mod road;
 mod setup;
 mod stripe_trace;
 #[cfg(test)]
 mod tests;
 mod turn_back;
 mod update;
+mod view;
 mod windows;
 mod working;
 
 pub(crate) use report::MAX_CANDIDATE_LINES;
 pub use report::{
-    Estimator, InitCandidate, LaneReport, LaneState, LaneView, Side, TrackReport, TrackerCounters,
+    Estimator, InitCandidate, LaneReport, LaneState, LaneView, RoadReport, Side, TrackReport,
+    TrackerCounters,
 };
 
 use edges::EdgeStage;
@@ -53,9 +56,11 @@ use init::Initialiser;
 use kerb::KerbReader;
 use lane::{Health, LaneFilter, Lanes};
 use points::PointSelector;
+use road::RoadFinder;
 use setup::{Pass, Setup};
 use stripe_trace::StripeTracer;
-use working::{WorkingFrame, WorkingScale};
+use view::AxisMap;
+use working::{WorkingFrame, working_scale, working_size};
 
 /// The lane tracker for frames of one size. Build once; [`LaneTracker::track`] per frame does
 /// not allocate.
@@ -65,6 +70,8 @@ pub struct LaneTracker {
     setup: Setup,
     /// The input's size and the working frame (module `working`).
     frame: WorkingFrame,
+    /// Where the road ends at the bottom (`roi.road_bottom`, module `road`).
+    road: RoadFinder,
     /// Stage I.
     edges: EdgeStage,
     /// Stage II.
@@ -102,8 +109,8 @@ impl LaneTracker {
             .into());
         }
         let input_size = (width, height);
-        let scale = WorkingScale::for_input(width, height, cfg.frame.working_width_px);
-        let (width, height) = scale.working_size(width, height);
+        let scale = working_scale(width, height, cfg.frame.working_width_px);
+        let (width, height) = working_size(width, height, scale);
         if width < 3 || height < 3 {
             return Err(TrackerError::ZeroSize {
                 width: input_size.0,
@@ -129,6 +136,7 @@ impl LaneTracker {
         let frame = WorkingFrame::new(scale, input_size, (width, height), work_rows, &lanes);
         Ok(LaneTracker {
             frame,
+            road: RoadFinder::new(width, height),
             edges,
             init,
             points: PointSelector::new(capacity),
@@ -158,7 +166,7 @@ impl LaneTracker {
     /// working pixel `c'` stands for input columns `[s·c', s·(c' + 1))`, centred on input
     /// `x = s·c' + (s − 1)/2`. 1 when the stages work on the input itself.
     pub fn working_scale(&self) -> f64 {
-        self.frame.scale.factor()
+        self.frame.view.cols.scale
     }
 
     /// What the stages read of the last frame, when the input is resampled (`s ≠ 1`): the
@@ -175,7 +183,7 @@ impl LaneTracker {
     /// the working ROI's rows average).
     pub fn roi_rows(&self) -> (usize, usize) {
         self.frame
-            .scale
+            .view
             .rows_to_input(self.setup.roi, self.frame.input_size.1)
     }
 
@@ -201,6 +209,7 @@ impl LaneTracker {
         }
         self.init.found.clear();
         self.health = Health::default();
+        self.road.reset();
         // What the accessors hand out with a resampled input: the cleared lanes, mapped.
         if self.frame.resamples() {
             self.frame.publish(&self.lanes, &self.init.found);
@@ -241,7 +250,7 @@ impl LaneTracker {
         }?;
         // In input pixels: `T·P·Tᵀ` (module `working`).
         Some(if self.frame.resamples() {
-            self.frame.scale.cov_to_input(&p)
+            self.frame.view.cov_to_input(&p)
         } else {
             p
         })
@@ -256,7 +265,7 @@ impl LaneTracker {
         let lane = &self.lanes[side];
         let mut fit = lane.fit;
         for r in &mut fit.rows_px {
-            *r = self.frame.scale.to_input_px(*r);
+            *r = self.frame.view.rows.to_input_px(*r);
         }
         lane.has_estimate().then_some(fit)
     }
@@ -319,27 +328,68 @@ impl LaneTracker {
             });
         }
         let input = GreyImage::new(data, width, height, stride_px)?;
-        if !self.frame.resamples() {
-            return self.track_working(input);
+        if self.setup.cfg.roi.road_bottom == RoadBottom::Found
+            && !self.lanes.iter().any(|l| l.has_estimate())
+        {
+            self.place_road(&input);
         }
-        // The working frame (module `working`), in a buffer lent out of the stage for the
-        // frame and put back whatever happens.
-        let pixels = self.frame.downscale(&input);
-        let (w, h) = (self.setup.width, self.setup.height);
-        let tracked = GreyImage::new(&pixels, w, h, w)
-            .map_err(TrackerError::from)
-            .and_then(|image| self.track_working(image));
-        self.frame.put_back(pixels);
-        // Published whatever happened, so the accessors read this frame's state as they do
-        // without resampling (also after an error part-way through).
-        self.frame.publish(&self.lanes, &self.init.found);
-        let mut report = tracked?;
-        report.lanes = self.frame.lanes();
-        Ok(report)
+        let (lanes, full_gradient) = if self.frame.resamples() {
+            // The working frame (module `working`), in a buffer lent out of the stage for the
+            // frame and put back whatever happens.
+            let pixels = self.frame.resample(&input);
+            let (w, h) = (self.setup.width, self.setup.height);
+            let tracked = GreyImage::new(&pixels, w, h, w)
+                .map_err(TrackerError::from)
+                .and_then(|image| self.track_working(image));
+            self.frame.put_back(pixels);
+            // Published whatever happened, so the accessors read this frame's state as they
+            // do without resampling (also after an error part-way through).
+            self.frame.publish(&self.lanes, &self.init.found);
+            (self.frame.lanes(), tracked?)
+        } else {
+            let full_gradient = self.track_working(input)?;
+            (self.lanes.reports(), full_gradient)
+        };
+        let view = self.frame.view;
+        let search = view.rows_to_input(self.setup.roi, height);
+        let bottom = view.rows_to_input((0, self.setup.height), height).1;
+        Ok(TrackReport {
+            lanes,
+            full_gradient,
+            road: RoadReport::of(&lanes, [search.0 as f64, search.1 as f64], bottom as f64),
+        })
     }
 
-    /// [`LaneTracker::track_pixels`] on the working frame: the pipeline.
-    fn track_working(&mut self, image: GreyImage<'_>) -> Result<TrackReport, TrackerError> {
+    /// The working rows for this frame (`roi.road_bottom = "found"`, module `road`): the road's
+    /// bottom found on the square view, and the rows above it stretched over the working
+    /// height; the square view's when the road reaches the frame's bottom.
+    fn place_road(&mut self, input: &GreyImage<'_>) {
+        let square = self.frame.square_view();
+        self.frame.set_rows(square.rows);
+        let h = self.setup.height;
+        let bottom = if square.is_identity() {
+            self.road.find(input, (0, input.height()))
+        } else {
+            let pixels = self.frame.resample(input);
+            let w = self.setup.width;
+            let rows = self.frame.resampled_rows();
+            let found = GreyImage::new(&pixels, w, h, w)
+                .ok()
+                .and_then(|image| self.road.find(&image, rows));
+            self.frame.put_back(pixels);
+            found
+        };
+        if let Some(b) = bottom.filter(|&b| b < (h - 1) as f64) {
+            self.frame.set_rows(AxisMap {
+                scale: square.rows.scale * b / h as f64,
+                start_px: 0.0,
+            });
+        }
+    }
+
+    /// [`LaneTracker::track_pixels`] on the working frame: the pipeline. `true` when the whole
+    /// ROI went through the gradient ([`TrackReport::full_gradient`]).
+    fn track_working(&mut self, image: GreyImage<'_>) -> Result<bool, TrackerError> {
         self.health.counters.frames += 1;
         self.init.found.clear();
         // III. Each lane with an estimate tracked in its windows.
@@ -399,10 +449,7 @@ impl LaneTracker {
                     .recheck_kerb_foot(lane, side, &image, rows, &self.setup.cfg);
             }
         }
-        Ok(TrackReport {
-            lanes: self.lanes.reports(),
-            full_gradient: need_init || revalidate,
-        })
+        Ok(need_init || revalidate)
     }
 
     /// Whether the tracked pair is re-validated on this frame (`track.revalidate_every_frames`,

@@ -121,6 +121,55 @@ pub struct TrackReport {
     /// `true` if the full region of interest went through the gradient (an initialisation was
     /// attempted); `false` on a pure tracking frame (gradient inside the windows only).
     pub full_gradient: bool,
+    /// The road region the frame was searched in.
+    pub road: RoadReport,
+}
+
+/// The road region of a frame, rows of the input (module `tracker::road`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RoadReport {
+    /// One past the lowest row of road, px: the frame's height when the road reaches its
+    /// bottom; the edge of a bonnet or a dashboard when one was found (`roi.road_bottom =
+    /// "found"`).
+    pub bottom_row_px: f64,
+    /// The rows searched for lanes, `[top, bottom)`, px (the ROI, placed in the road's rows).
+    pub search_rows_px: [f64; 2],
+    /// The horizon as the ego lanes show it: the row where the two reported lanes' tangents at
+    /// the top of their rows meet, px; `None` unless both lanes are reported and close in
+    /// upwards, or where that row would lie below the road's bottom (refused: not a road).
+    pub horizon_row_px: Option<f64>,
+}
+
+impl RoadReport {
+    /// The region of `lanes` reported on a frame searched in `search_rows_px`, the road ending
+    /// at `bottom_row_px` (module docs of [`RoadReport::horizon_row_px`]).
+    pub(crate) fn of(
+        lanes: &[LaneReport; 2],
+        search_rows_px: [f64; 2],
+        bottom_row_px: f64,
+    ) -> Self {
+        RoadReport {
+            bottom_row_px,
+            search_rows_px,
+            horizon_row_px: horizon_row_px(lanes).filter(|&y| y < bottom_row_px),
+        }
+    }
+}
+
+/// Where the tangents of both lanes at the lower of their top rows meet, px: `y_t − g/(m_r −
+/// m_l)` with `g = x_r(y_t) − x_l(y_t) > 0` the gap and `m = dx/dy = 2·a1·y_t + a2` the slopes,
+/// the gap closing upwards (`m_r > m_l`); `None` otherwise.
+fn horizon_row_px(lanes: &[LaneReport; 2]) -> Option<f64> {
+    let (Some(l), Some(r)) = (lanes[0].coeffs, lanes[1].coeffs) else {
+        return None;
+    };
+    let y_t = lanes[0].rows[0].max(lanes[1].rows[0]);
+    let x = |c: [f64; 3]| c[0] * y_t * y_t + c[1] * y_t + c[2];
+    let m = |c: [f64; 3]| 2.0 * c[0] * y_t + c[1];
+    let (gap, closing) = (x(r) - x(l), m(r) - m(l));
+    (gap > 0.0 && closing > 1e-6)
+        .then(|| y_t - gap / closing)
+        .filter(|y| y.is_finite())
 }
 
 /// Counters over the tracker's life.

@@ -1,10 +1,10 @@
-//! # Resampling by any factor (module `working`'s fractional scale)
+//! # Resampling by any factor (module `view`'s axes)
 //!
-//! The working frame is the input resampled by `s` input pixels per working pixel along both
-//! axes, `s` any positive real (module `working`). Working pixel `j` of an axis stands for the
-//! input interval `[s·j, s·(j + 1))` (input pixel `i` covering `[i, i + 1)`), centred on input
-//! coordinate `x_j = s·j + (s − 1)/2`, the pixel-centre convention the coefficient map of
-//! module `working` is derived in. Its value is a weighted sum of input pixels, separable:
+//! The working frame is the input resampled by `s` input pixels per working pixel along each
+//! axis, `s` any positive real (module `view`). Working pixel `j` of an axis stands for the
+//! input interval `[start + s·j, start + s·(j + 1))` (input pixel `i` covering `[i, i + 1)`),
+//! centred on input coordinate `x_j = start + s·j + (s − 1)/2`, the pixel-centre convention the
+//! coefficient map of module `view` is derived in. Its value is a weighted sum of input pixels, separable:
 //!
 //! ```text
 //! I'(c, r) = Σ_i Σ_k  w_x(c, i) · w_y(r, k) · I(i, k),        Σ_i w_x(c, i) = Σ_k w_y(r, k) = 1,
@@ -18,8 +18,15 @@
 //!   at `⌊x_j⌋ + 1` (`t = x_j − ⌊x_j⌋`), clamped to the edge pixels — the area weights would copy
 //!   each input pixel into blocks.
 //!
-//! The taps of both axes are computed once for a frame size ([`AxisTaps::new`]); a frame then
-//! costs one multiply-add per tap and pixel of the rows resampled, into caller-owned buffers.
+//! The taps of both axes are computed once for a frame size ([`AxisTaps::new`]), the rows' again
+//! when the road's rows change ([`AxisTaps::rebuild`], in place); a frame then costs one
+//! multiply-add per tap and pixel of the rows resampled, into caller-owned buffers. A whole
+//! factor on square pixels from the top-left is the box average, summed in integers
+//! ([`downscale_box`]).
+
+use vision_gradient::GreyImage;
+
+use super::view::AxisMap;
 
 /// The input pixels and weights behind each working pixel of one axis.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,55 +39,63 @@ pub(crate) struct AxisTaps {
 }
 
 impl AxisTaps {
-    /// The taps of `out_len` working pixels over `in_len` input pixels at `s` input pixels per
-    /// working pixel (`s > 0`; module docs). Input pixels outside `[0, in_len)` are never read:
-    /// their weight goes to the nearest pixel inside.
-    pub(crate) fn new(in_len: usize, out_len: usize, s: f64) -> Self {
+    /// The taps of `out_len` working pixels over `in_len` input pixels under `map` (module
+    /// docs), with room to be rebuilt ([`Self::rebuild`]) for maps of up to `max_scale` input
+    /// pixels per working pixel without allocating.
+    pub(crate) fn new(in_len: usize, out_len: usize, map: AxisMap, max_scale: f64) -> Self {
+        let per_pixel = max_scale.max(map.scale).ceil() as usize + 2;
         let mut taps = AxisTaps {
             first: Vec::with_capacity(out_len),
             offset: Vec::with_capacity(out_len + 1),
-            weights: Vec::new(),
+            weights: Vec::with_capacity(out_len * per_pixel),
         };
-        taps.offset.push(0);
-        let last = in_len.saturating_sub(1);
-        for j in 0..out_len {
-            let mut pixel_weights: Vec<(usize, f64)> = Vec::with_capacity(4);
-            if s >= 1.0 {
-                let (lo, hi) = (s * j as f64, s * (j + 1) as f64);
-                let mut i = lo.floor().max(0.0) as usize;
-                while (i as f64) < hi {
-                    let overlap = (hi.min(i as f64 + 1.0) - lo.max(i as f64)).max(0.0);
-                    if overlap > 0.0 {
-                        pixel_weights.push((i.min(last), overlap / s));
-                    }
-                    i += 1;
-                }
-            } else {
-                let x = s * j as f64 + (s - 1.0) / 2.0;
-                let i0 = x.floor();
-                let t = x - i0;
-                let clamp = |v: f64| (v.max(0.0) as usize).min(last);
-                pixel_weights.push((clamp(i0), 1.0 - t));
-                pixel_weights.push((clamp(i0 + 1.0), t));
-            }
-            // Merge the clamped duplicates into a run of consecutive pixels.
-            let first = pixel_weights.iter().map(|p| p.0).min().unwrap_or(0);
-            let end = pixel_weights
-                .iter()
-                .map(|p| p.0 + 1)
-                .max()
-                .unwrap_or(first + 1);
-            let total: f64 = pixel_weights.iter().map(|p| p.1).sum();
-            let base = taps.weights.len();
-            taps.weights.resize(base + (end - first), 0.0);
-            for (i, w) in pixel_weights {
-                // Renormalised: a sum of exactly 1 keeps a flat frame flat.
-                taps.weights[base + i - first] += (w / total.max(f64::MIN_POSITIVE)) as f32;
-            }
-            taps.first.push(first);
-            taps.offset.push(taps.weights.len());
-        }
+        taps.rebuild(in_len, out_len, map);
         taps
+    }
+
+    /// The taps for `map`, in the buffers there are. Input pixels outside `[0, in_len)` are
+    /// never read: their weight goes to the nearest pixel inside.
+    pub(crate) fn rebuild(&mut self, in_len: usize, out_len: usize, map: AxisMap) {
+        self.first.clear();
+        self.offset.clear();
+        self.weights.clear();
+        self.offset.push(0);
+        let last = in_len.saturating_sub(1) as f64;
+        let clamp = |v: f64| v.clamp(0.0, last) as usize;
+        let s = map.scale;
+        for j in 0..out_len {
+            let base = self.weights.len();
+            if s >= 1.0 {
+                let (lo, hi) = (
+                    map.start_px + s * j as f64,
+                    map.start_px + s * (j + 1) as f64,
+                );
+                let (first, end) = (clamp(lo.floor()), clamp((hi - 1e-9).ceil() - 1.0) + 1);
+                self.weights.resize(base + end.max(first + 1) - first, 0.0);
+                let mut i = lo.floor();
+                while i < hi {
+                    let overlap = (hi.min(i + 1.0) - lo.max(i)).max(0.0);
+                    self.weights[base + clamp(i) - first] += (overlap / s) as f32;
+                    i += 1.0;
+                }
+                self.first.push(first);
+            } else {
+                let x = map.to_input_px(j as f64);
+                let t = x - x.floor();
+                let (i0, i1) = (clamp(x.floor()), clamp(x.floor() + 1.0));
+                self.weights.resize(base + i1 - i0 + 1, 0.0);
+                self.weights[base] += (1.0 - t) as f32;
+                self.weights[base + i1 - i0] += t as f32;
+                self.first.push(i0);
+            }
+            // Renormalised: a sum of exactly 1 keeps a flat frame flat.
+            let w = &mut self.weights[base..];
+            let total: f32 = w.iter().sum();
+            if total > 0.0 {
+                w.iter_mut().for_each(|v| *v /= total);
+            }
+            self.offset.push(self.weights.len());
+        }
     }
 
     /// The first input pixel of working pixel `j` and its weights (empty past the end).
@@ -101,7 +116,7 @@ impl AxisTaps {
 /// taps of both axes, summing the input rows of each working row in `acc` (at least `in_w`
 /// entries). Rows outside `rows`, and rows the buffers are too short for, are left as they are.
 pub(crate) fn resample_rows(
-    src: &vision_gradient::GreyImage<'_>,
+    src: &GreyImage<'_>,
     dst: &mut [u8],
     cols: &AxisTaps,
     row_taps: &AxisTaps,
@@ -135,9 +150,87 @@ pub(crate) fn resample_rows(
     }
 }
 
+/// Box-average rows `rows = [first, end)` of the working frame from `src` into `dst`
+/// (`working_width` bytes a row, row `r` at `r · working_width`), summing the `f` input rows
+/// of each working row column by column in `sums` (at least `f · working_width` entries;
+/// `u32`), then each run of `f` sums. Rows outside `rows` are left as they are.
+///
+/// Needs `src` at least `f·working_width` wide and `f·end` high, `dst` and `sums` large
+/// enough; the tracker sizes all of them in `LaneTracker::new` and checks the frame's size
+/// before calling. The common factors are compiled for their constant `f` (the sums of a
+/// run then vectorise).
+pub(crate) fn downscale_box(
+    factor: usize,
+    src: &GreyImage<'_>,
+    dst: &mut [u8],
+    working_width: usize,
+    rows: (usize, usize),
+    sums: &mut [u32],
+) {
+    match factor {
+        2 => box_rows::<2>(src, dst, working_width, rows, sums),
+        3 => box_rows::<3>(src, dst, working_width, rows, sums),
+        4 => box_rows::<4>(src, dst, working_width, rows, sums),
+        5 => box_rows::<5>(src, dst, working_width, rows, sums),
+        6 => box_rows::<6>(src, dst, working_width, rows, sums),
+        f => box_rows_any(f, src, dst, working_width, rows, sums),
+    }
+}
+
+/// [`downscale_box`] for a constant factor `F` (the body inlined with `f = F`).
+fn box_rows<const F: usize>(
+    src: &GreyImage<'_>,
+    dst: &mut [u8],
+    working_width: usize,
+    rows: (usize, usize),
+    sums: &mut [u32],
+) {
+    box_rows_any(F, src, dst, working_width, rows, sums);
+}
+
+/// [`downscale_box`] for any factor `f`.
+#[inline(always)]
+fn box_rows_any(
+    f: usize,
+    src: &GreyImage<'_>,
+    dst: &mut [u8],
+    working_width: usize,
+    rows: (usize, usize),
+    sums: &mut [u32],
+) {
+    let area = (f * f) as u32;
+    let sums = &mut sums[..f * working_width];
+    for r in rows.0..rows.1 {
+        sums.fill(0);
+        for j in 0..f {
+            let Some(line) = src.row(f * r + j) else {
+                continue;
+            };
+            for (s, &v) in sums.iter_mut().zip(line) {
+                *s += u32::from(v);
+            }
+        }
+        let Some(out) = dst.get_mut(r * working_width..(r + 1) * working_width) else {
+            return;
+        };
+        for (o, run) in out.iter_mut().zip(sums.chunks_exact(f)) {
+            let sum: u32 = run.iter().sum();
+            // Rounded to the nearest grey level; ≤ 255 as a mean of bytes.
+            *o = ((sum + area / 2) / area).min(255) as u8;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn square(s: f64) -> AxisMap {
+        AxisMap {
+            scale: s,
+            start_px: 0.0,
+        }
+    }
     use vision_gradient::GreyImage;
 
     #[test]
@@ -150,7 +243,7 @@ mod tests {
             (3, 6),
         ] {
             let s = n as f64 / m as f64;
-            let t = AxisTaps::new(n, m, s);
+            let t = AxisTaps::new(n, m, square(s), s);
             for j in 0..m {
                 let (first, w) = t.of(j);
                 let sum: f32 = w.iter().sum();
@@ -166,7 +259,7 @@ mod tests {
         // pixel counted once, neither skipped nor twice).
         let (n, m) = (512usize, 320usize);
         let s = n as f64 / m as f64;
-        let t = AxisTaps::new(n, m, s);
+        let t = AxisTaps::new(n, m, square(s), s);
         let mut per_input = vec![0.0f64; n];
         for j in 0..m {
             let (first, w) = t.of(j);
@@ -187,7 +280,7 @@ mod tests {
         // piecewise-constant pixels: [4.8, 6.4) reads 5.125 for 5.1) and exactly on average.
         for (n, m) in [(512usize, 320usize), (1280, 320), (256, 320), (1920, 320)] {
             let s = n as f64 / m as f64;
-            let t = AxisTaps::new(n, m, s);
+            let t = AxisTaps::new(n, m, square(s), s);
             let tol = if s.fract() == 0.0 || s < 1.0 {
                 1e-3
             } else {
@@ -216,7 +309,10 @@ mod tests {
         let input = vec![137u8; w * h];
         let src = GreyImage::new(&input, w, h, w).expect("image");
         let s = w as f64 / 320.0;
-        let (cols, rows) = (AxisTaps::new(w, 320, s), AxisTaps::new(h, 180, s));
+        let (cols, rows) = (
+            AxisTaps::new(w, 320, square(s), s),
+            AxisTaps::new(h, 180, square(s), s),
+        );
         let mut dst = vec![9u8; 320 * 180];
         let mut acc = vec![0.0f32; w];
         resample_rows(&src, &mut dst, &cols, &rows, (100, 180), &mut acc);
@@ -229,7 +325,10 @@ mod tests {
         let (w, h) = (12usize, 8usize);
         let input: Vec<u8> = (0..w * h).map(|i| ((i * 37) % 256) as u8).collect();
         let src = GreyImage::new(&input, w, h, w).expect("image");
-        let (cols, rows) = (AxisTaps::new(w, 6, 2.0), AxisTaps::new(h, 4, 2.0));
+        let (cols, rows) = (
+            AxisTaps::new(w, 6, square(2.0), 2.0),
+            AxisTaps::new(h, 4, square(2.0), 2.0),
+        );
         let mut dst = vec![0u8; 24];
         let mut acc = vec![0.0f32; w];
         resample_rows(&src, &mut dst, &cols, &rows, (0, 4), &mut acc);
@@ -244,6 +343,58 @@ mod tests {
                     (f64::from(dst[r * 6 + c]) - mean).abs() <= 0.5,
                     "({c}, {r})"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn downscaling_averages_each_block_and_rounds() {
+        // 6×4 input, f = 2: working 3×2; each block's mean rounded to the nearest level.
+        let input: Vec<u8> = vec![
+            0, 1, 10, 10, 255, 255, //
+            1, 1, 10, 11, 255, 254, //
+            7, 7, 0, 0, 100, 0, //
+            7, 8, 0, 1, 0, 0, //
+        ];
+        let src = GreyImage::new(&input, 6, 4, 6).expect("image");
+        let (mut dst, mut acc) = (vec![9u8; 6], vec![0u32; 6]);
+        downscale_box(2, &src, &mut dst, 3, (0, 2), &mut acc);
+        // (0+1+1+1)/4 = 0.75 → 1; 41/4 = 10.25 → 10; 1019/4 = 254.75 → 255;
+        // 29/4 = 7.25 → 7; 1/4 → 0; 100/4 = 25.
+        assert_eq!(dst, vec![1, 10, 255, 7, 0, 25]);
+        // Only the rows asked for are written.
+        let mut dst = vec![9u8; 6];
+        downscale_box(2, &src, &mut dst, 3, (1, 2), &mut acc);
+        assert_eq!(dst, vec![9, 9, 9, 7, 0, 25]);
+    }
+
+    #[test]
+    fn every_factor_gives_each_blocks_rounded_mean() {
+        // The compiled-in factors and the general path against the mean block by block, on a
+        // frame whose sides are not multiples of the factor (the remainder is not read).
+        let (w, h) = (53usize, 37usize);
+        let input: Vec<u8> = (0..w * h)
+            .map(|i| ((i * 7919 + i / w * 31) % 256) as u8)
+            .collect();
+        let src = GreyImage::new(&input, w, h, w).expect("image");
+        for f in 2..=9 {
+            let (ww, wh) = (w / f, h / f);
+            let (mut dst, mut sums) = (vec![0u8; ww * wh], vec![0u32; w]);
+            downscale_box(f, &src, &mut dst, ww, (0, wh), &mut sums);
+            for r in 0..wh {
+                for c in 0..ww {
+                    let mut sum = 0u32;
+                    for j in 0..f {
+                        for i in 0..f {
+                            sum += u32::from(input[(f * r + j) * w + f * c + i]);
+                        }
+                    }
+                    let mean = (f64::from(sum) / (f * f) as f64).round();
+                    assert!(
+                        (f64::from(dst[r * ww + c]) - mean).abs() <= 0.5,
+                        "f = {f} at ({c}, {r})"
+                    );
+                }
             }
         }
     }

@@ -389,6 +389,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 frame: index,
                 t_s: meta.t_s,
                 lanes: &report.lanes,
+                road: report.road,
                 track_us: dt.as_secs_f64() * 1e6,
                 ego_lane: ego,
                 lane_cov_px: (camera.is_some() || mcap_out.is_some()).then(|| {
