@@ -43,6 +43,20 @@ const COLOURS: [Color; 2] = [
         a: 1.0,
     },
 ];
+/// The road region's lines across the image: the road's bottom (where a bonnet or a dashboard
+/// ends it above the frame's last row) yellow, the horizon the lanes show cyan.
+const ROAD_BOTTOM_COLOUR: Color = Color {
+    r: 1.0,
+    g: 1.0,
+    b: 0.0,
+    a: 0.8,
+};
+const HORIZON_COLOUR: Color = Color {
+    r: 0.0,
+    g: 1.0,
+    b: 1.0,
+    a: 0.8,
+};
 const NO_FILL: Color = Color {
     r: 0.0,
     g: 0.0,
@@ -141,6 +155,33 @@ impl LaneMcapSink {
                 fill_color: NO_FILL,
                 thickness: 3.0,
             });
+        }
+        let width = frame.width() as f64;
+        let road = report.road;
+        let lines = [
+            (
+                road.bottom_row_px,
+                ROAD_BOTTOM_COLOUR,
+                road.bottom_row_px < frame.height() as f64,
+            ),
+            (
+                road.horizon_row_px.unwrap_or(0.0),
+                HORIZON_COLOUR,
+                road.horizon_row_px.is_some(),
+            ),
+        ];
+        for (y, colour, shown) in lines {
+            if shown {
+                self.ann.points.push(PointsAnnotation {
+                    timestamp,
+                    kind: LINE_STRIP,
+                    points: vec![Point2 { x: 0.0, y }, Point2 { x: width, y }],
+                    outline_color: colour,
+                    outline_colors: Vec::new(),
+                    fill_color: NO_FILL,
+                    thickness: 1.0,
+                });
+            }
         }
         self.writer
             .write(self.annotations, t_ns, &self.ann)

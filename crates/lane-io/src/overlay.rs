@@ -18,13 +18,21 @@ const COAST_RGB: [u8; 3] = [255, 140, 0];
 const CANDIDATE_RGB: [[u8; 3]; 2] = [[200, 90, 200], [90, 200, 120]];
 /// Rows between two dots of a candidate's curve.
 const CANDIDATE_DOT_ROWS: usize = 3;
+/// The road region (`LaneTracker::road`): the road's bottom when it ends above the frame's
+/// (a bonnet or a dashboard), and the horizon the lanes show; dashed across the frame.
+const ROAD_BOTTOM_RGB: [u8; 3] = [255, 255, 0];
+const HORIZON_RGB: [u8; 3] = [0, 255, 255];
+/// Columns of a dash, and between two.
+const DASH_PX: usize = 6;
 
 /// Draw the tracker's last frame into `rgb` (`width·height·3` bytes, reshaped): the grey frame,
 /// on a frame that ran the joint initialisation its Hough candidates (their least-squares
 /// parabolas, or the lines themselves with `init.candidate_coverage` off; dotted: magenta the
 /// `/` band, green the `\` band; `LaneTracker::init_candidates`),
 /// then each lane's window borders, its points, and its parabola over the ROI rows (left red,
-/// right blue; orange while coasting).
+/// right blue; orange while coasting), and the road region: its bottom dashed yellow where a
+/// bonnet or a dashboard ends it above the frame's last row, the horizon the lanes show dashed
+/// cyan.
 pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8>) {
     let (w, h) = (frame.width(), frame.height());
     rgb.resize(w * h * 3, 0);
@@ -37,6 +45,27 @@ pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8
             rgb[i..i + 3].copy_from_slice(&c);
         }
     };
+    let road = tracker.road();
+    let lines = [
+        (
+            road.bottom_row_px - 1.0,
+            ROAD_BOTTOM_RGB,
+            road.bottom_row_px < h as f64,
+        ),
+        (
+            road.horizon_row_px.unwrap_or(-1.0),
+            HORIZON_RGB,
+            road.horizon_row_px.is_some(),
+        ),
+    ];
+    for (row, colour, shown) in lines {
+        if shown && row.is_finite() {
+            let y = row.round() as i64;
+            for x in (0..w).filter(|x| (x / DASH_PX) % 2 == 0) {
+                put(x as i64, y, colour);
+            }
+        }
+    }
     let (top, bottom) = tracker.roi_rows();
     for c in tracker.init_candidates() {
         let colour = CANDIDATE_RGB[usize::from(c.band == Side::Right)];
@@ -236,5 +265,29 @@ mod tests {
             0
         );
         assert!(count(&rgb, CURVE_RGB[0]) > 0);
+    }
+
+    #[test]
+    fn the_road_bottom_is_drawn_where_a_bonnet_ends_the_road_and_the_horizon_with_both_lanes() {
+        let cfg = TrackerConfig::default_preset().expect("the default preset");
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).expect("a tracker");
+        let mut rgb = Vec::new();
+        let frame = two_marks(320, 240);
+        tracker.track(&frame).expect("a frame");
+        render_overlay(&frame, &tracker, &mut rgb);
+        // The road reaches the bottom: no bottom line; both lanes meet upwards: a horizon.
+        assert_eq!(count(&rgb, ROAD_BOTTOM_RGB), 0);
+        assert!(tracker.road().horizon_row_px.is_some());
+        assert!(count(&rgb, HORIZON_RGB) > 100);
+        // A flat dark bonnet from row 200 down.
+        let mut pixels = frame.data().to_vec();
+        pixels[200 * 320..].fill(30);
+        let bonnet = GreyFrame::from_vec(320, 240, pixels).expect("a whole frame");
+        tracker.reset();
+        tracker.track(&bonnet).expect("a frame");
+        render_overlay(&bonnet, &tracker, &mut rgb);
+        let bottom = tracker.road().bottom_row_px;
+        assert!((190.0..=200.0).contains(&bottom), "bottom {bottom}");
+        assert!(count(&rgb, ROAD_BOTTOM_RGB) > 100);
     }
 }

@@ -134,9 +134,15 @@ impl LaneTracker {
             (roi.1 + 1).min(height),
         );
         let frame = WorkingFrame::new(scale, input_size, (width, height), work_rows, &lanes);
+        let (top, bottom) = frame.view.rows_to_input(roi, input_size.1);
+        let whole_frame = RoadReport {
+            bottom_row_px: input_size.1 as f64,
+            search_rows_px: [top as f64, bottom as f64],
+            horizon_row_px: None,
+        };
         Ok(LaneTracker {
             frame,
-            road: RoadFinder::new(width, height),
+            road: RoadFinder::new(width, height, whole_frame),
             edges,
             init,
             points: PointSelector::new(capacity),
@@ -185,6 +191,12 @@ impl LaneTracker {
         self.frame
             .view
             .rows_to_input(self.setup.roi, self.frame.input_size.1)
+    }
+
+    /// The road region of the last frame ([`TrackReport::road`]; before the first frame, the
+    /// whole frame's rows with the ROI searched and no horizon).
+    pub fn road(&self) -> RoadReport {
+        self.road.last
     }
 
     /// The configuration in use.
@@ -353,10 +365,12 @@ impl LaneTracker {
         let view = self.frame.view;
         let search = view.rows_to_input(self.setup.roi, height);
         let bottom = view.rows_to_input((0, self.setup.height), height).1;
+        let road = RoadReport::of(&lanes, [search.0 as f64, search.1 as f64], bottom as f64);
+        self.road.last = road;
         Ok(TrackReport {
             lanes,
             full_gradient,
-            road: RoadReport::of(&lanes, [search.0 as f64, search.1 as f64], bottom as f64),
+            road,
         })
     }
 

@@ -33,6 +33,7 @@
 
 use vision_gradient::GreyImage;
 
+use super::report::RoadReport;
 use super::setup::Rows;
 
 /// Step between the pixels either side of a pixel that makes it an edge, grey levels.
@@ -58,22 +59,30 @@ pub(super) struct RoadFinder {
     lane_edges: Vec<u32>,
     /// The bottom found on the last frame that looked, working rows of the square view.
     bottom_row: Option<f64>,
+    /// The last frame's region, input pixels.
+    pub(super) last: RoadReport,
+    /// What `last` is before the first frame.
+    initial: RoadReport,
 }
 
 impl RoadFinder {
-    /// A finder for `width × height` working frames.
-    pub(super) fn new(width: usize, height: usize) -> Self {
+    /// A finder for `width × height` working frames, `initial` the region reported before
+    /// the first frame.
+    pub(super) fn new(width: usize, height: usize, initial: RoadReport) -> Self {
         RoadFinder {
             marks: vec![0; width * height],
             cover: vec![0; height],
             lane_edges: vec![0; height],
             bottom_row: None,
+            last: initial,
+            initial,
         }
     }
 
-    /// Forget the bottom carried.
+    /// Forget the bottom carried and the last region.
     pub(super) fn reset(&mut self) {
         self.bottom_row = None;
+        self.last = self.initial;
     }
 
     /// The road's bottom, `[0, h]` working rows of the square view (one past the last row of
@@ -195,9 +204,18 @@ mod tests {
         img
     }
 
+    fn finder() -> RoadFinder {
+        let whole = RoadReport {
+            bottom_row_px: H as f64,
+            search_rows_px: [0.0, H as f64],
+            horizon_row_px: None,
+        };
+        RoadFinder::new(W, H, whole)
+    }
+
     fn find(img: &[u8]) -> Option<f64> {
         let image = GreyImage::new(img, W, H, W).expect("image");
-        RoadFinder::new(W, H).find(&image, (0, H))
+        finder().find(&image, (0, H))
     }
 
     #[test]
@@ -231,7 +249,7 @@ mod tests {
 
     #[test]
     fn a_bottom_seen_again_is_averaged_and_a_new_one_replaces_it() {
-        let mut finder = RoadFinder::new(W, H);
+        let mut finder = finder();
         let mut at = |top| {
             let img = with_bonnet(road(4), top, 0.0);
             let image = GreyImage::new(&img, W, H, W).expect("image");
