@@ -3,7 +3,8 @@
 //! root, the floors of `--check` / `--record` in `fixtures/expectations-lanes-real.json` — and the
 //! classic OpenCV pipeline scored beside the tracker (`bench/opencv_peer.py`, in
 //! `target/opencv-venv`, made from PyPI on first use; `--no-peer` leaves it out). The gate runs
-//! `cargo xtask eval-lanes --check`.
+//! `cargo xtask eval-lanes --check --perturb` (a README command, the `readme` step): the near
+//! band's, the full rule's and the perturbations' floors.
 
 use std::path::Path;
 use std::process::Command;

@@ -169,7 +169,8 @@ const STEPS: &[Step] = &[
     Step {
         // Every command the README shows, as written: the main job, the lane examples, the
         // tracker's default on the real labelled sets against the recorded floors
-        // (`eval-lanes --check`, which was a step of its own), the INS examples.
+        // (`eval-lanes --check --perturb`, which was a step of its own without --perturb: about
+        // 30 s, 18 s of it the perturbations), the INS examples.
         name: "readme",
         run: Run::Xtask(&["readme"]),
     },

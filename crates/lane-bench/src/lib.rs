@@ -10,6 +10,7 @@
 //! - [`protocol`]: the development / hold-out split, the default and the other configurations,
 //!   `summary.json`, `summary.md`, `frames.csv`, the contact sheet, and the floors
 //!   ([`protocol::floors`]);
+//! - [`perturb`]: the frames changed as other cameras would give them (`eval-lanes --perturb`);
 //! - [`import_set`]: the file work of importing a user's labels;
 //! - [`resample`]: the sets at another resolution;
 //! - [`ablation`]: whether each mechanism beyond the paper earns its place (leave-one-set-out);
@@ -23,6 +24,7 @@ pub mod data;
 mod error;
 pub mod import_set;
 pub mod labelled;
+pub mod perturb;
 pub mod protocol;
 pub mod resample;
 

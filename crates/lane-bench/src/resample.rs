@@ -119,7 +119,7 @@ fn resample_set(dir: &Path, out: &Path, factor: u32) -> Result<(), BenchError> {
                     })
                     .unwrap_or_default();
                 lane["points"] = Value::from(
-                    resample_points(&points, k, width as f64, height as f64)
+                    resample_points(&points, [k, k], width as f64, height as f64)
                         .into_iter()
                         .map(|[x, y]| Value::from(vec![x, y]))
                         .collect::<Vec<_>>(),
@@ -145,12 +145,19 @@ fn resample_set(dir: &Path, out: &Path, factor: u32) -> Result<(), BenchError> {
     Ok(())
 }
 
-/// Label points (sorted by row) mapped `v ↦ (v + 0.5)·k − 0.5` and sampled at every integer row
-/// they span (linear between neighbours), the points inside `width × height` kept.
-fn resample_points(points: &[[f64; 2]], k: f64, width: f64, height: f64) -> Vec<[f64; 2]> {
+/// Label points (sorted by row) mapped `x ↦ (x + 0.5)·kx − 0.5`, `y ↦ (y + 0.5)·ky − 0.5` (the
+/// pixel-centre rule of a resize by `[kx, ky]`, `k > 0`) and sampled at every integer row they
+/// span (linear between neighbours), the points inside `width × height` kept. Also the label
+/// mapping of the resized perturbations ([`crate::perturb`]).
+pub(crate) fn resample_points(
+    points: &[[f64; 2]],
+    [kx, ky]: [f64; 2],
+    width: f64,
+    height: f64,
+) -> Vec<[f64; 2]> {
     let mapped: Vec<[f64; 2]> = points
         .iter()
-        .map(|&[x, y]| [(x + 0.5) * k - 0.5, (y + 0.5) * k - 0.5])
+        .map(|&[x, y]| [(x + 0.5) * kx - 0.5, (y + 0.5) * ky - 0.5])
         .collect();
     let mut out = Vec::new();
     for pair in mapped.windows(2) {
@@ -182,13 +189,15 @@ mod tests {
     #[test]
     fn label_points_map_by_pixel_centres_one_per_row() {
         // Two points a row apart at 1x become rows 0.5·2 − 0.5 = 0.5 → 2.5: rows 1 and 2.
-        let p = resample_points(&[[10.0, 0.0], [12.0, 1.0]], 2.0, 640.0, 360.0);
+        let p = resample_points(&[[10.0, 0.0], [12.0, 1.0]], [2.0, 2.0], 640.0, 360.0);
         assert_eq!(p, vec![[20.5 + 2.0 * 0.5, 1.0], [20.5 + 2.0 * 1.5, 2.0]]);
         // Outside the image: dropped (640.3 ≥ 640); a point left of column 0 but inside the
         // image's extent (−0.4 → −0.3) kept.
-        assert!(resample_points(&[[319.9, 0.0], [319.9, 1.0]], 2.0, 640.0, 360.0).is_empty());
+        assert!(
+            resample_points(&[[319.9, 0.0], [319.9, 1.0]], [2.0, 2.0], 640.0, 360.0).is_empty()
+        );
         assert_eq!(
-            resample_points(&[[-0.4, 0.0], [-0.4, 1.0]], 2.0, 640.0, 360.0).len(),
+            resample_points(&[[-0.4, 0.0], [-0.4, 1.0]], [2.0, 2.0], 640.0, 360.0).len(),
             2
         );
     }

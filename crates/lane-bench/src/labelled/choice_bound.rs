@@ -13,14 +13,23 @@
 //! rejection of far lanes on top of a perfect choice). The labels pick, as for the ceiling:
 //! upper bounds of any rule that chooses among these candidates (and of a refinement that only
 //! improves its pick), not results.
+//!
+//! **Row extents** (what the full rule, [`super::full_rule`], scores a lane's reach by): the
+//! output's lanes carry the tracker's own (the rows of the points behind each estimate); a
+//! candidate carries the rows of the search that found it, `[top, bottom − 1]` of the region
+//! searched, in input pixels. A candidate ([`lane_tracker::InitCandidate`]) does not say which
+//! of the joint initialisation's two searches found it — the ROI's rows or, with
+//! `roi.fallback_top_row_fraction`, the taller rows of the second search — so every candidate
+//! gets the taller extent when there is a second search: generous to the ROI's candidates,
+//! which keeps the bound a bound.
 
 use std::path::Path;
 
 use lane_tracker::{Estimator, TrackerConfig};
 
 use super::{
-    EgoPrediction, LabelSet, LabelSide, NEAR_MISS_FRACTION, ScoringRules, run_label_set,
-    scored_points, tusimple_lane_accuracy,
+    EgoPrediction, LabelSet, LabelSide, NEAR_MISS_FRACTION, PredictedLane, ScoringRules,
+    run_label_set, scored_points, tusimple_lane_accuracy,
 };
 use crate::BenchError;
 
@@ -68,8 +77,9 @@ pub fn choice_bound_set(
             out.best_or_none.push([None, None]);
             return Ok(());
         };
-        let (tracker, report) = (t.tracker, &t.report);
-        let output: EgoPrediction = [report.lanes[0].coeffs, report.lanes[1].coeffs];
+        let tracker = t.tracker;
+        let output: EgoPrediction = super::run::ego_of(&t.report);
+        let searched = candidate_rows_px(tracker);
         let (mut best, mut best_or_none) = (output, output);
         for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
             let pts = scored_points(labels, side, y_top);
@@ -77,12 +87,15 @@ pub fn choice_bound_set(
                 continue;
             }
             let accuracy = |c: [f64; 3]| tusimple_lane_accuracy(&pts, c, tus_px, &mut 0.0);
-            let mut top = output[k].map_or(0.0, accuracy);
+            let mut top = output[k].map_or(0.0, |p| accuracy(p.coeffs));
             for c in tracker.init_candidates() {
                 let a = accuracy(c.coeffs);
                 if a > top {
                     top = a;
-                    best[k] = Some(c.coeffs);
+                    best[k] = Some(PredictedLane {
+                        coeffs: c.coeffs,
+                        rows_px: searched,
+                    });
                 }
             }
             best_or_none[k] = best[k].filter(|_| top >= NEAR_MISS_FRACTION);
@@ -93,4 +106,18 @@ pub fn choice_bound_set(
         Ok(())
     })?;
     Ok(out)
+}
+
+/// The row extent given to `tracker`'s candidates (module docs): `[top, bottom − 1]` of the
+/// taller rows of the second search when the configuration has one, else of the ROI, input
+/// pixels.
+fn candidate_rows_px(tracker: &lane_tracker::LaneTracker) -> [f64; 2] {
+    let (roi_top, roi_bottom) = tracker.roi_rows();
+    let f = tracker.working_factor();
+    let working_h = tracker.working_size().1;
+    let top = tracker
+        .config()
+        .fallback_roi_rows(working_h)
+        .map_or(roi_top, |(top, _)| (f * top).min(roi_top));
+    [top as f64, roi_bottom.saturating_sub(1) as f64]
 }

@@ -40,7 +40,9 @@
 //!   label lanes; false detections = unmatched predictions, per label lane.
 //!
 //! Both are pooled over the lanes of a set (and over all sets for the overall figure), so a set
-//! weighs by its number of labelled lanes.
+//! weighs by its number of labelled lanes. These are the **near band**'s rules; the **full
+//! rule** ([`full_rule`]) scores every labelled row with TuSimple's rule and counts a row the
+//! prediction does not reach ([`PredictedLane::rows_px`]) as a wrong point.
 
 use std::path::{Path, PathBuf};
 
@@ -240,9 +242,46 @@ impl Default for ScoringRules {
     }
 }
 
-/// The predicted ego lanes of one frame: `[a1, a2, a3]` of `x = a1·y² + a2·y + a3` per side
-/// (left, right), `None` where nothing is reported.
-pub type EgoPrediction = [Option<[f64; 3]>; 2];
+/// One predicted ego lane: its parabola and the rows it reaches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictedLane {
+    /// `[a1, a2, a3]` of `x = a1·y² + a2·y + a3` (x column, y row, input pixels).
+    pub coeffs: [f64; 3],
+    /// `[top_px, bottom_px]`: the rows the prediction stands on, input pixels, `top ≤ bottom`
+    /// (the tracker's: the row extent of the points behind its estimate,
+    /// [`lane_tracker::LaneReport::rows`]). The near band ignores it; the full rule
+    /// ([`full_rule`]) counts a label row outside it as a wrong point.
+    pub rows_px: [f64; 2],
+}
+
+impl PredictedLane {
+    /// A lane reaching every row: for predictions that report no extent (a peer's file), which
+    /// only the near band scores.
+    pub fn without_extent(coeffs: [f64; 3]) -> Self {
+        PredictedLane {
+            coeffs,
+            rows_px: [f64::NEG_INFINITY, f64::INFINITY],
+        }
+    }
+
+    /// The tracker's lane of one report (`None` where it reports no coefficients), with the row
+    /// extent it reports.
+    pub fn from_report(report: &lane_tracker::LaneReport) -> Option<Self> {
+        report.coeffs.map(|coeffs| PredictedLane {
+            coeffs,
+            rows_px: report.rows,
+        })
+    }
+
+    /// Whether row `row_px` lies within the extent, `tolerance_px` beyond either end allowed.
+    pub fn reaches(&self, row_px: f64, tolerance_px: f64) -> bool {
+        row_px >= self.rows_px[0] - tolerance_px && row_px <= self.rows_px[1] + tolerance_px
+    }
+}
+
+/// The predicted ego lanes of one frame per side (left, right), `None` where nothing is
+/// reported.
+pub type EgoPrediction = [Option<PredictedLane>; 2];
 
 /// Totals of one frame, one set, or all sets (pooled counts; see [`LaneTotals::summary`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -479,7 +518,33 @@ pub fn score_sides(
     prediction: &EgoPrediction,
     rules: &ScoringRules,
 ) -> [LaneTotals; 2] {
-    let side = |side, p| score_side(labels, width, height, side, p, rules);
+    score_sides_from(
+        labels,
+        width,
+        height,
+        prediction,
+        rules,
+        near_top_px(rules, height),
+    )
+}
+
+/// The top row of the near band of a frame `height` rows high: `eval_top_fraction · height`.
+pub fn near_top_px(rules: &ScoringRules, height: usize) -> f64 {
+    rules.eval_top_fraction * height as f64
+}
+
+/// [`score_sides`] with the near band's top row given (`y_top`, px) instead of
+/// [`ScoringRules::eval_top_fraction`]: a perturbed frame ([`crate::perturb`]) is scored on
+/// the rows that were its near band before the perturbation.
+pub fn score_sides_from(
+    labels: &LabelFrame,
+    width: usize,
+    height: usize,
+    prediction: &EgoPrediction,
+    rules: &ScoringRules,
+    y_top: f64,
+) -> [LaneTotals; 2] {
+    let side = |side, p| score_side_from(labels, width, height, side, p, rules, y_top);
     [
         side(LabelSide::Left, prediction[0]),
         side(LabelSide::Right, prediction[1]),
@@ -497,14 +562,27 @@ pub fn score_side(
     width: usize,
     height: usize,
     side: LabelSide,
-    prediction: Option<[f64; 3]>,
+    prediction: Option<PredictedLane>,
     rules: &ScoringRules,
+) -> LaneTotals {
+    let y_top = near_top_px(rules, height);
+    score_side_from(labels, width, height, side, prediction, rules, y_top)
+}
+
+/// [`score_side`] with the near band's top row `y_top` (px) given ([`score_sides_from`]).
+fn score_side_from(
+    labels: &LabelFrame,
+    width: usize,
+    height: usize,
+    side: LabelSide,
+    prediction: Option<PredictedLane>,
+    rules: &ScoringRules,
+    y_top: f64,
 ) -> LaneTotals {
     let mut t = LaneTotals::default();
     if side == LabelSide::Other {
         return t;
     }
-    let y_top = rules.eval_top_fraction * height as f64;
     let tus_px = rules.tusimple_px_at_1280 * width as f64 / 1280.0;
     let aly_px = rules.aly_px_at_640 * width as f64 / 640.0;
     let pts = scored_points(labels, side, y_top);
@@ -522,7 +600,9 @@ pub fn score_side(
         return t;
     }
     t.label_lanes += 1;
-    let Some(c) = prediction else { return t };
+    let Some(PredictedLane { coeffs: c, .. }) = prediction else {
+        return t;
+    };
     let acc = tusimple_lane_accuracy(&pts, c, tus_px, &mut t.abs_err_sum_px);
     t.abs_err_points += pts.len() as u64;
     t.tusimple_acc_sum += acc;
@@ -564,54 +644,6 @@ pub fn score_side(
     t
 }
 
-/// The **ceiling** of the lane model: for each ego label lane of `frame`, the least-squares
-/// parabola `x = a1·y² + a2·y + a3` of its points on the rows `[top, bottom)` (the tracker's
-/// region of interest), reported as that side's prediction (`None` with fewer than 3 such points
-/// or a degenerate fit). Scored by the same rules as the tracker, it says what a perfect tracker
-/// with this model and this ROI would reach: the labels themselves, bent to a parabola and cut
-/// to the rows the tracker looks at.
-pub fn ceiling_prediction(frame: &LabelFrame, rows: (usize, usize)) -> EgoPrediction {
-    let mut out: EgoPrediction = [None, None];
-    for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
-        let Some(lane) = frame.lanes.iter().find(|l| l.side == side) else {
-            continue;
-        };
-        out[k] = fit_parabola_in_rows(&lane.points, rows);
-    }
-    out
-}
-
-/// Least-squares parabola `x(y)` of the points with `top ≤ y < bottom`, centred on their mean
-/// row for conditioning; `None` for fewer than 3 points or a singular system.
-fn fit_parabola_in_rows(points: &[[f64; 2]], (top, bottom): (usize, usize)) -> Option<[f64; 3]> {
-    let inside = || {
-        points
-            .iter()
-            .filter(move |p| p[1] >= top as f64 && p[1] < bottom as f64)
-    };
-    let n = inside().count();
-    if n < 3 {
-        return None;
-    }
-    let yc = inside().map(|p| p[1]).sum::<f64>() / n as f64;
-    let mut a = nalgebra::Matrix3::<f64>::zeros();
-    let mut b = nalgebra::Vector3::<f64>::zeros();
-    for p in inside() {
-        let u = p[1] - yc;
-        let phi = nalgebra::Vector3::new(u * u, u, 1.0);
-        a += phi * phi.transpose();
-        b += phi * p[0];
-    }
-    let c = a.cholesky()?.solve(&b);
-    // x = c0·(y − yc)² + c1·(y − yc) + c2, expanded in y.
-    let coeffs = [
-        c[0],
-        c[1] - 2.0 * c[0] * yc,
-        c[0] * yc * yc - c[1] * yc + c[2],
-    ];
-    coeffs.iter().all(|v| v.is_finite()).then_some(coeffs)
-}
-
 /// Slope `dx/dy` of the least-squares line `x = k·y + b` through the points (0 if degenerate).
 fn fit_slope(pts: &[[f64; 2]]) -> f64 {
     let n = pts.len() as f64;
@@ -627,14 +659,18 @@ fn fit_slope(pts: &[[f64; 2]]) -> f64 {
     if syy > 0.0 { sxy / syy } else { 0.0 }
 }
 
+mod ceiling;
 mod census;
 mod choice_bound;
+pub mod full_rule;
 pub mod import;
 mod run;
 #[cfg(test)]
 mod tests;
 
+pub use ceiling::{ceiling_prediction, whole_label_ceiling};
 pub use census::{LaneCensus, LaneStage, StageCensus, census_lanes};
 pub use choice_bound::{ChoiceBound, choice_bound_set};
-pub(crate) use run::run_label_set;
+pub use full_rule::{FullRates, FullTotals, score_frame_full};
+pub(crate) use run::{FileStills, Stills, ego_of, run_label_set, run_stills};
 pub use run::{SkippedFrame, TrackedSet, track_label_set};

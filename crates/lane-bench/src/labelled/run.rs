@@ -3,6 +3,10 @@
 //! tracker reset at the start of every clip. A frame whose image cannot be read, or has another
 //! size than the set declares, is reported and skipped (a [`SkippedFrame`], scored as a frame
 //! with no prediction), as `nav-app` skips a bad image of a directory.
+//!
+//! The images come from [`Stills`]: the set's files ([`FileStills`]), or frames made in memory
+//! (the perturbed frames of `eval-lanes --perturb`, `crate::protocol::perturbed`), never
+//! written to disk.
 
 use std::path::Path;
 
@@ -10,7 +14,7 @@ use lane_io::frame_loop::{FrameLoop, Step, Tracked};
 use lane_io::{FrameMeta, FrameSource, GreyFrame, LaneIoError};
 use lane_tracker::{Estimator, TrackerConfig};
 
-use super::{EgoPrediction, LabelFrame, LabelSet};
+use super::{EgoPrediction, LabelFrame, LabelSet, PredictedLane};
 use crate::BenchError;
 
 /// A frame of a labelled set that could not be tracked: its image cannot be read or has another
@@ -51,9 +55,7 @@ pub fn track_label_set(
 ) -> Result<TrackedSet, BenchError> {
     let mut predictions = Vec::with_capacity(set.frames.len());
     let skipped = run_label_set(dir, set, cfg, estimator, set.frames.len(), |_, _, t| {
-        predictions.push(t.map_or([None, None], |t| {
-            [t.report.lanes[0].coeffs, t.report.lanes[1].coeffs]
-        }));
+        predictions.push(t.map_or([None, None], |t| ego_of(&t.report)));
         Ok(())
     })?;
     Ok(TrackedSet {
@@ -62,12 +64,72 @@ pub fn track_label_set(
     })
 }
 
+/// The tracker's ego prediction in a report: each side's coefficients with its row extent.
+pub(crate) fn ego_of(report: &lane_tracker::TrackReport) -> EgoPrediction {
+    [
+        PredictedLane::from_report(&report.lanes[0]),
+        PredictedLane::from_report(&report.lanes[1]),
+    ]
+}
+
+/// Where the images of a labelled set's frames come from.
+pub(crate) trait Stills {
+    /// Fill `out` with the image of the frame at `position` in the set (`frame` its labels). An
+    /// error is that frame's: it is reported and skipped.
+    fn fill(
+        &mut self,
+        position: usize,
+        frame: &LabelFrame,
+        out: &mut GreyFrame,
+    ) -> Result<(), LaneIoError>;
+
+    /// The name of a frame in messages (its file).
+    fn name(&self, frame: &LabelFrame) -> String;
+
+    /// What the frames are, for the frame loop's messages.
+    fn describe(&self) -> String;
+}
+
+/// The images of a set's files, `dir` the set's directory.
+pub(crate) struct FileStills<'a>(pub(crate) &'a Path);
+
+impl Stills for FileStills<'_> {
+    fn fill(
+        &mut self,
+        _: usize,
+        frame: &LabelFrame,
+        out: &mut GreyFrame,
+    ) -> Result<(), LaneIoError> {
+        lane_io::sources::decode_image_file(&LabelSet::frame_path(self.0, frame), out)
+    }
+
+    fn name(&self, frame: &LabelFrame) -> String {
+        LabelSet::frame_path(self.0, frame).display().to_string()
+    }
+
+    fn describe(&self) -> String {
+        format!("{} (labelled frames)", self.0.display())
+    }
+}
+
 /// Run a tracker over the frames of a labelled set before position `until`, clip by clip (reset
 /// at the start of every clip), calling `on_frame(position in the set, labels, tracked frame)`
 /// after every frame, in set order, with `None` for a skipped frame; its first error stops the
-/// run and is returned. Returns the skipped frames.
+/// run and is returned. Returns the skipped frames. The images are the files under `dir`.
 pub(crate) fn run_label_set(
     dir: &Path,
+    set: &LabelSet,
+    cfg: &TrackerConfig,
+    estimator: Estimator,
+    until: usize,
+    on_frame: impl FnMut(usize, &LabelFrame, Option<&Tracked<'_>>) -> Result<(), BenchError>,
+) -> Result<Vec<SkippedFrame>, BenchError> {
+    run_stills(&mut FileStills(dir), set, cfg, estimator, until, on_frame)
+}
+
+/// [`run_label_set`] over the images of `stills`.
+pub(crate) fn run_stills(
+    stills: &mut dyn Stills,
     set: &LabelSet,
     cfg: &TrackerConfig,
     estimator: Estimator,
@@ -84,7 +146,7 @@ pub(crate) fn run_label_set(
         lanes.reset();
         let clip = &clip[..clip.len().min(until - position)];
         let mut source = ClipSource {
-            dir,
+            stills: &mut *stills,
             frames: clip,
             first_position: position,
             next: 0,
@@ -111,7 +173,7 @@ pub(crate) fn run_label_set(
 /// The frames of one clip of a labelled set as a frame source; frame indices are positions in
 /// the set.
 struct ClipSource<'a> {
-    dir: &'a Path,
+    stills: &'a mut dyn Stills,
     frames: &'a [LabelFrame],
     first_position: usize,
     next: usize,
@@ -124,13 +186,12 @@ impl FrameSource for ClipSource<'_> {
         let Some(f) = self.frames.get(self.next) else {
             return Ok(None);
         };
-        let index = (self.first_position + self.next) as u64;
+        let position = self.first_position + self.next;
+        let index = position as u64;
         self.next += 1;
-        let path = LabelSet::frame_path(self.dir, f);
-        let name = || path.display().to_string();
-        if let Err(e) = lane_io::sources::decode_image_file(&path, frame) {
+        if let Err(e) = self.stills.fill(position, f, frame) {
             return Err(LaneIoError::BadFrame {
-                name: name(),
+                name: self.stills.name(f),
                 frame: index,
                 source: Box::new(e),
             });
@@ -138,7 +199,7 @@ impl FrameSource for ClipSource<'_> {
         let (w, h) = (frame.width(), frame.height());
         if (w, h) != self.size {
             return Err(LaneIoError::FrameSizeDiffers {
-                name: name(),
+                name: self.stills.name(f),
                 frame: index,
                 got_w: w,
                 got_h: h,
@@ -150,6 +211,6 @@ impl FrameSource for ClipSource<'_> {
     }
 
     fn describe(&self) -> String {
-        format!("{} (labelled frames)", self.dir.display())
+        self.stills.describe()
     }
 }

@@ -28,6 +28,9 @@ fn the_ceiling_of_parabolic_labels_is_exact_and_cut_to_the_rows() {
     let p = ceiling_prediction(&f, (150, 240));
     for (got, want) in p.iter().zip([l, r]) {
         let got = got.unwrap();
+        // Its extent: the rows it was fitted on.
+        assert_eq!(got.rows_px, [150.0, 239.0]);
+        let got = got.coeffs;
         for y in [150.0, 200.0, 239.0] {
             let (g, w) = (para(got)(y), para(want)(y));
             assert!((g - w).abs() < 1e-6, "{y}: {g} vs {w}");
@@ -38,6 +41,19 @@ fn the_ceiling_of_parabolic_labels_is_exact_and_cut_to_the_rows() {
     assert_eq!(t.tusimple_matched, 2);
     // Fewer than three label points inside the rows: nothing to report.
     assert_eq!(ceiling_prediction(&f, (238, 240))[0], None);
+    // The whole label's ceiling: every row of the label, exact too.
+    let whole = whole_label_ceiling(&f);
+    assert_eq!(whole[0].unwrap().rows_px, [100.0, 239.0]);
+    let t = full_rule::score_frame_full(&f, 320, &whole, &ScoringRules::default(), 0.5);
+    assert_eq!((t.label_lanes, t.matched), (2, 2));
+    // Under the full rule the ROI's ceiling misses each label's 50 rows above the ROI (of 140).
+    let t = full_rule::score_frame_full(&f, 320, &p, &ScoringRules::default(), 0.5);
+    assert_eq!((t.matched, t.unreached_points), (0, 100));
+}
+
+/// A predicted lane with no extent (the near band does not read it).
+fn pred(coeffs: [f64; 3]) -> Option<PredictedLane> {
+    Some(PredictedLane::without_extent(coeffs))
 }
 
 fn frame(lanes: Vec<LabelLane>) -> LabelFrame {
@@ -66,7 +82,7 @@ fn exact_predictions_score_full_accuracy_and_match_under_both_rules() {
         line(LabelSide::Right, 0.6, 100.0),
         line(LabelSide::Other, 1.5, 0.0),
     ]);
-    let p = [Some([0.0, -0.5, 200.0]), Some([0.0, 0.6, 100.0])];
+    let p = [pred([0.0, -0.5, 200.0]), pred([0.0, 0.6, 100.0])];
     let t = score_frame(&f, 320, 240, &p, &ScoringRules::default());
     let r = t.summary();
     assert_eq!((t.label_lanes, t.predicted_lanes), (2, 2));
@@ -81,19 +97,19 @@ fn the_tusimple_tolerance_scales_with_width_and_the_slope_of_the_label() {
     // Vertical label: tolerance 5 px at 320 px. A 4.9 px offset passes, 5.1 px fails.
     let f = frame(vec![line(LabelSide::Left, 0.0, 100.0)]);
     let rules = ScoringRules::default();
-    let ok = score_frame(&f, 320, 240, &[Some([0.0, 0.0, 104.9]), None], &rules);
-    let bad = score_frame(&f, 320, 240, &[Some([0.0, 0.0, 105.1]), None], &rules);
+    let ok = score_frame(&f, 320, 240, &[pred([0.0, 0.0, 104.9]), None], &rules);
+    let bad = score_frame(&f, 320, 240, &[pred([0.0, 0.0, 105.1]), None], &rules);
     assert_eq!(ok.tusimple_matched, 1);
     assert_eq!(bad.tusimple_acc_sum, 0.0);
     // A 45° label widens the tolerance to 5·√2 ≈ 7.07 px horizontally.
     let f = frame(vec![line(LabelSide::Left, 1.0, 0.0)]);
-    let ok = score_frame(&f, 320, 240, &[Some([0.0, 1.0, 7.0]), None], &rules);
-    let bad = score_frame(&f, 320, 240, &[Some([0.0, 1.0, 7.2]), None], &rules);
+    let ok = score_frame(&f, 320, 240, &[pred([0.0, 1.0, 7.0]), None], &rules);
+    let bad = score_frame(&f, 320, 240, &[pred([0.0, 1.0, 7.2]), None], &rules);
     assert_eq!(ok.tusimple_matched, 1);
     assert_eq!(bad.tusimple_matched, 0);
     // At 1280 px width the same offset of 7 px on a vertical label is inside 20 px.
     let f = frame(vec![line(LabelSide::Left, 0.0, 100.0)]);
-    let wide = score_frame(&f, 1280, 240, &[Some([0.0, 0.0, 107.0]), None], &rules);
+    let wide = score_frame(&f, 1280, 240, &[pred([0.0, 0.0, 107.0]), None], &rules);
     assert_eq!(wide.tusimple_matched, 1);
 }
 
@@ -105,7 +121,7 @@ fn missing_and_spurious_predictions_are_false_negatives_and_false_positives() {
         &f,
         320,
         240,
-        &[None, Some([0.0, 0.5, 100.0])],
+        &[None, pred([0.0, 0.5, 100.0])],
         &ScoringRules::default(),
     );
     let r = t.summary();
@@ -132,22 +148,22 @@ fn false_positives_are_split_by_what_they_lie_on_and_add_up() {
         [k.unlabelled_side, k.other_marking, k.near, k.far]
     };
     // Exact: none.
-    let exact = score([Some([0.0, -0.5, 200.0]), Some([0.0, 0.6, 100.0])]);
+    let exact = score([pred([0.0, -0.5, 200.0]), pred([0.0, 0.6, 100.0])]);
     assert_eq!(kinds(&exact), [0, 0, 0, 0]);
     // The right prediction on the other marking; the left one on the right label (swapped).
-    let neighbour = score([Some([0.0, 0.6, 100.0]), Some([0.0, 1.5, 0.0])]);
+    let neighbour = score([pred([0.0, 0.6, 100.0]), pred([0.0, 1.5, 0.0])]);
     assert_eq!(kinds(&neighbour), [0, 2, 0, 0]);
     // The left label's line turned about its bottom point by 0.096 px a row: within the
     // tolerance (5 px / cos(atan 0.5) = 5.6 px) on the 15 lowest of the 24 scored points.
     let turned = [0.0, -0.5 - 0.096, 200.0 + 0.096 * 236.0];
-    let near = score([Some(turned), None]);
+    let near = score([pred(turned), None]);
     assert!(
         (near.tusimple_acc_sum - 15.0 / 24.0).abs() < 1e-9,
         "{near:?}"
     );
     assert_eq!(kinds(&near), [0, 0, 1, 0]);
     // On no marking.
-    let far = score([Some([0.0, 0.0, 20.0]), Some([0.0, 0.0, 300.0])]);
+    let far = score([pred([0.0, 0.0, 20.0]), pred([0.0, 0.0, 300.0])]);
     assert_eq!(kinds(&far), [0, 0, 0, 2]);
     // On a side without a label.
     let left_only = frame(vec![line(LabelSide::Left, -0.5, 200.0)]);
@@ -155,7 +171,7 @@ fn false_positives_are_split_by_what_they_lie_on_and_add_up() {
         &left_only,
         320,
         240,
-        &[Some([0.0, -0.5, 200.0]), Some([0.0, 0.6, 100.0])],
+        &[pred([0.0, -0.5, 200.0]), pred([0.0, 0.6, 100.0])],
         &rules,
     );
     assert_eq!(kinds(&unlabelled), [1, 0, 0, 0]);
@@ -183,7 +199,7 @@ fn the_far_field_is_not_scored() {
         &frame(vec![far]),
         320,
         240,
-        &[Some([0.0, 0.0, 0.0]), None],
+        &[pred([0.0, 0.0, 0.0]), None],
         &ScoringRules::default(),
     );
     assert_eq!((t.label_lanes, t.predicted_lanes), (0, 0));
@@ -203,7 +219,7 @@ fn aly_matches_on_the_median_distance_so_a_bent_end_does_not_fail_a_lane() {
         &frame(vec![bent]),
         320,
         240,
-        &[Some([0.0, 0.0, 100.0]), None],
+        &[pred([0.0, 0.0, 100.0]), None],
         &ScoringRules {
             eval_top_fraction: 0.0,
             ..ScoringRules::default()
@@ -294,11 +310,11 @@ fn a_frame_scores_as_the_sum_of_its_two_sides_and_each_side_only_itself() {
     let left_only = frame(vec![line(LabelSide::Left, -0.5, 200.0)]);
     // Exact, on the neighbour's mark, 6 px beside the right label, far, nothing; on frames with
     // both sides or one side labelled.
-    let preds: [Option<[f64; 3]>; 5] = [
-        Some([0.0, -0.5, 200.0]),
-        Some([0.0, 1.5, 0.0]),
-        Some([0.0, 0.6, 106.0]),
-        Some([0.0, 0.0, 20.0]),
+    let preds: [Option<PredictedLane>; 5] = [
+        pred([0.0, -0.5, 200.0]),
+        pred([0.0, 1.5, 0.0]),
+        pred([0.0, 0.6, 106.0]),
+        pred([0.0, 0.0, 20.0]),
         None,
     ];
     for f in [&both, &left_only] {

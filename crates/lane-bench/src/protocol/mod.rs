@@ -12,6 +12,14 @@
 //! default's false positives are also split by what they lie on
 //! ([`crate::labelled::FalsePositives`]).
 //!
+//! Beside the near band, every configuration that reports row extents (the default, the
+//! configurations beside it, the bounds of its choice, the ceilings; not a peer's file, which
+//! has none) is scored under TuSimple's **full rule** ([`crate::labelled::full_rule`]: every
+//! labelled row, a row the prediction does not reach a wrong point), with its own ceiling,
+//! [`FULL_CEILING_NAME`]: the parabola of each whole label lane, the model's own bound. With
+//! [`Options::perturb`], the default also runs on the frames changed as other cameras would
+//! give them ([`perturbed`], [`crate::perturb`]).
+//!
 //! [`Evaluation::write`] writes `summary.md`, `summary.json`, `worst_frames.png` (the worst
 //! frames of the default run: labels green, the tracker red, the peer blue) and `frames.csv`
 //! (the default run's outcome per scored ego side of every frame,
@@ -27,19 +35,24 @@ use lane_tracker::{Estimator, LaneTracker, TrackerConfig};
 use serde::{Deserialize, Serialize};
 
 use crate::BenchError;
+use crate::labelled::full_rule::REACH_WORKING_PX;
 use crate::labelled::{
-    EgoPrediction, LabelSet, LaneRates, LaneTotals, ScoringRules, SkippedFrame, StageCensus,
-    ceiling_prediction, census_lanes, choice_bound_set, score_sides, track_label_set,
+    EgoPrediction, FullRates, FullTotals, LabelSet, LaneRates, LaneTotals, PredictedLane,
+    ScoringRules, SkippedFrame, StageCensus, ceiling_prediction, census_lanes, choice_bound_set,
+    score_frame_full, score_sides, track_label_set, whole_label_ceiling,
 };
 
 pub mod floors;
+pub mod perturbed;
 mod report;
 mod sheet;
 
+pub use perturbed::PerturbedSummary;
 pub use report::FRAMES_CSV_HEADER;
 
-/// Format version of `summary.json`.
-pub const SUMMARY_SCHEMA: u32 = 2;
+/// Format version of `summary.json` (3: the full rule, `full_rule` and `overall_full_rule`, and
+/// the perturbation table, `perturbations`, were added; the near band's fields are as in 2).
+pub const SUMMARY_SCHEMA: u32 = 3;
 /// Fraction of every set's frames (the first ones, in set order) in the development part.
 pub const DEV_FRACTION: f64 = 0.7;
 /// Name of the default configuration in the reports.
@@ -54,6 +67,21 @@ pub const CHOICE_BOUND_NAME: &str = "best-of-candidates";
 pub const CHOICE_BOUND_OR_NONE_NAME: &str = "best-of-candidates-or-none";
 /// Name of the peer (the OpenCV pipeline of `cargo xtask eval-lanes`) in the reports.
 pub const PEER_NAME: &str = "opencv-peer";
+/// Name of the full rule's ceiling: per ego label lane, the parabola of all its points
+/// ([`crate::labelled::whole_label_ceiling`]). Under the full rule, [`CEILING_NAME`] is the
+/// near band's ceiling (fitted on the ROI rows, reaching those rows only).
+pub const FULL_CEILING_NAME: &str = "ceiling-whole-label";
+
+/// One configuration's figures under the full rule on one set (or overall).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FullSplitRates {
+    /// Every frame.
+    pub all: FullRates,
+    /// The development part.
+    pub dev: FullRates,
+    /// The held-out part.
+    pub holdout: FullRates,
+}
 
 /// One configuration's figures on one set (or overall).
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -85,6 +113,10 @@ pub struct SetSummary {
     pub longest_clip: usize,
     /// Per configuration (`default`, presets, `opencv-peer`).
     pub results: BTreeMap<String, SplitRates>,
+    /// Per configuration under the full rule (every one with row extents, and
+    /// [`FULL_CEILING_NAME`]).
+    #[serde(default)]
+    pub full_rule: BTreeMap<String, FullSplitRates>,
 }
 
 /// `summary.json`.
@@ -102,6 +134,17 @@ pub struct Summary {
     pub sets: Vec<SetSummary>,
     /// Pooled over every set, per configuration.
     pub overall: BTreeMap<String, SplitRates>,
+    /// The full rule's tolerance on a prediction's row extent, px of the tracker's working
+    /// frame ([`crate::labelled::full_rule`]).
+    #[serde(default)]
+    pub full_rule_reach_working_px: f64,
+    /// Pooled over every set under the full rule, per configuration.
+    #[serde(default)]
+    pub overall_full_rule: BTreeMap<String, FullSplitRates>,
+    /// The default under each perturbation ([`Options::perturb`]), in [`crate::perturb::TABLE`]'s
+    /// order; empty (and absent from the file) without it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub perturbations: Vec<PerturbedSummary>,
 }
 
 #[derive(Default, Clone, Copy)]
@@ -134,6 +177,37 @@ impl SplitTotals {
     }
 }
 
+/// [`SplitTotals`] under the full rule.
+#[derive(Default, Clone, Copy)]
+struct FullSplitTotals {
+    all: FullTotals,
+    dev: FullTotals,
+    holdout: FullTotals,
+}
+
+impl FullSplitTotals {
+    fn add(&mut self, t: &FullTotals, dev: bool) {
+        self.all.add(t);
+        if dev {
+            self.dev.add(t);
+        } else {
+            self.holdout.add(t);
+        }
+    }
+    fn merge(&mut self, o: &FullSplitTotals) {
+        self.all.add(&o.all);
+        self.dev.add(&o.dev);
+        self.holdout.add(&o.holdout);
+    }
+    fn rates(&self) -> FullSplitRates {
+        FullSplitRates {
+            all: self.all.summary(),
+            dev: self.dev.summary(),
+            holdout: self.holdout.summary(),
+        }
+    }
+}
+
 /// Frames `0..dev_count(n)` of a set of `n` are the development part.
 pub fn dev_count(n: usize) -> usize {
     (DEV_FRACTION * n as f64).ceil() as usize
@@ -153,8 +227,10 @@ pub struct Options {
     pub one_sequence: bool,
     /// A directory with a peer's predictions, `peer-<set>.json` per set (`{"frames": [{"index":
     /// i, "lanes": [left, right]}]}`, each lane `[a1, a2, a3]` or `null`), scored as
-    /// [`PEER_NAME`].
+    /// [`PEER_NAME`] (near band only: the file gives no row extents).
     pub peer: Option<PathBuf>,
+    /// Also run the default on every perturbation of [`crate::perturb::TABLE`] ([`perturbed`]).
+    pub perturb: bool,
 }
 
 /// A scored frame of the default run, for the contact sheet.
@@ -175,6 +251,9 @@ pub struct Evaluation {
     pub frames_csv: String,
     /// The frames skipped (set name, frame), each listed once.
     pub skipped: Vec<(String, SkippedFrame)>,
+    /// Wall time of each perturbation of the table, over every set (with
+    /// [`Options::perturb`]).
+    pub perturb_times: Vec<perturbed::PerturbTime>,
     dev_only: bool,
     sets: Vec<(PathBuf, LabelSet)>,
     ranks: Vec<FrameRank>,
@@ -236,7 +315,11 @@ fn read_peer(dir: &Path, set: &LabelSet) -> Result<Vec<EgoPrediction>, BenchErro
             set.set
         )));
     }
-    Ok(file.frames.into_iter().map(|f| f.lanes).collect())
+    Ok(file
+        .frames
+        .into_iter()
+        .map(|f| f.lanes.map(|lane| lane.map(PredictedLane::without_extent)))
+        .collect())
 }
 
 /// Score the default configuration and `options`' on every set of `sets` (module docs).
@@ -257,6 +340,7 @@ pub fn evaluate(
     let mut summaries = Vec::new();
     let mut censuses: Vec<(String, StageCensus)> = Vec::new();
     let mut overall: BTreeMap<String, SplitTotals> = BTreeMap::new();
+    let mut overall_full: BTreeMap<String, FullSplitTotals> = BTreeMap::new();
     let mut ranks = Vec::new();
     let mut drawn = Vec::new();
     let mut skipped = Vec::new();
@@ -296,14 +380,16 @@ pub fn evaluate(
         // The ceiling: a parabola fitted to the labels themselves over the default's ROI rows
         // (the tracker's, in this set's pixels: a wide frame's working rows mapped back),
         // scored by the same rules (what the lane model can reach on this set).
-        let roi = LaneTracker::new(&default, Estimator::Kif, set.width, set.height)
-            .map_err(|e| {
+        let probe =
+            LaneTracker::new(&default, Estimator::Kif, set.width, set.height).map_err(|e| {
                 BenchError::from(e).during(format!(
                     "{}: no tracker for {}×{}",
                     set.set, set.width, set.height
                 ))
-            })?
-            .roi_rows();
+            })?;
+        let roi = probe.roi_rows();
+        // The full rule's reach: half a working pixel, in this set's pixels.
+        let reach_px = REACH_WORKING_PX * probe.working_factor() as f64;
         runs.push((CHOICE_BOUND_NAME.to_owned(), bound.best));
         runs.push((CHOICE_BOUND_OR_NONE_NAME.to_owned(), bound.best_or_none));
         runs.push((
@@ -338,6 +424,28 @@ pub fn evaluate(
             overall.entry(name.clone()).or_default().merge(&totals);
             results.insert(name.clone(), totals.rates());
         }
+        // The full rule: every run with row extents (not the peer's), and its own ceiling.
+        let whole_label: Vec<EgoPrediction> = set.frames.iter().map(whole_label_ceiling).collect();
+        let mut full_rule = BTreeMap::new();
+        let with_extents = runs
+            .iter()
+            .filter(|(name, _)| name != PEER_NAME)
+            .map(|(name, preds)| (name.as_str(), preds))
+            .chain([(FULL_CEILING_NAME, &whole_label)]);
+        for (name, preds) in with_extents {
+            let mut totals = FullSplitTotals::default();
+            for (i, (f, p)) in set.frames.iter().zip(preds).enumerate() {
+                totals.add(
+                    &score_frame_full(f, set.width, p, &rules, reach_px),
+                    i < n_dev,
+                );
+            }
+            overall_full
+                .entry(name.to_owned())
+                .or_default()
+                .merge(&totals);
+            full_rule.insert(name.to_owned(), totals.rates());
+        }
         drawn.push((runs.swap_remove(0).1, peer));
         summaries.push(SetSummary {
             set: set.set.clone(),
@@ -348,8 +456,14 @@ pub fn evaluate(
             frames: set.frames.len(),
             longest_clip: set.longest_clip(),
             results,
+            full_rule,
         });
     }
+    let (perturbations, perturb_times) = if options.perturb {
+        perturbed::perturbation_table(&sets, &default, &rules)?
+    } else {
+        (Vec::new(), Vec::new())
+    };
     let summary = Summary {
         schema: SUMMARY_SCHEMA,
         rules,
@@ -360,12 +474,19 @@ pub fn evaluate(
             .iter()
             .map(|(k, v)| (k.clone(), v.rates()))
             .collect(),
+        full_rule_reach_working_px: REACH_WORKING_PX,
+        overall_full_rule: overall_full
+            .iter()
+            .map(|(k, v)| (k.clone(), v.rates()))
+            .collect(),
+        perturbations,
     };
     Ok(Evaluation {
         summary,
         censuses,
         frames_csv,
         skipped,
+        perturb_times,
         dev_only: options.dev_only,
         sets,
         ranks,
@@ -383,6 +504,10 @@ impl Evaluation {
         let mut md = report::render_markdown(&self.summary, self.dev_only, command);
         if !self.censuses.is_empty() {
             md += &report::render_census(&self.censuses);
+        }
+        md += &report::render_full_rule(&self.summary, self.dev_only);
+        if !self.summary.perturbations.is_empty() {
+            md += &perturbed::render(&self.summary, self.dev_only);
         }
         md
     }

@@ -5,7 +5,8 @@ use crate::labelled::{
     StageCensus,
 };
 
-use super::{DEFAULT_NAME, SplitRates, Summary};
+use super::{DEFAULT_NAME, FULL_CEILING_NAME, FullSplitRates, SplitRates, Summary};
+use crate::labelled::FullRates;
 
 /// The census table (`--census`): per set and overall, development part, default configuration.
 pub(super) fn render_census(censuses: &[(String, StageCensus)]) -> String {
@@ -198,6 +199,62 @@ pub(super) fn render_markdown(s: &Summary, dev_only: bool, command: &str) -> Str
     md
 }
 
+/// The full rule's table ([`crate::labelled::full_rule`]): per set and overall, every
+/// configuration it scores, hold-out and development parts (the development part alone with
+/// `dev_only`), with the near band's accuracy of the same predictions beside it.
+pub(super) fn render_full_rule(s: &Summary, dev_only: bool) -> String {
+    type FullPick = fn(&FullSplitRates) -> &FullRates;
+    let splits: &[(&str, FullPick, Pick)] = if dev_only {
+        &[("dev", |r| &r.dev, |r| &r.dev)]
+    } else {
+        &[
+            ("hold-out", |r| &r.holdout, |r| &r.holdout),
+            ("dev", |r| &r.dev, |r| &r.dev),
+        ]
+    };
+    let mut md = format!(
+        "\n## The full rule (TuSimple's own: every labelled row)\n\n\
+         Every labelled row of each ego lane is scored (not only the near band's); the point \
+         tolerance is slope-corrected from the line fitted to the whole label; a labelled row \
+         outside the prediction's row extent (± {} px of the working frame) is a wrong point; a \
+         lane is matched at ≥ {:.0} % correct points. `near acc`: the near band's TuSimple \
+         accuracy of the same predictions (above). `unreached`: of the label points of predicted \
+         lanes, those on rows the prediction does not reach. Extents: the tracker's, the rows of \
+         the points behind each estimate; a candidate's, the rows searched; the ceiling's, the \
+         rows it was fitted on. `{FULL_CEILING_NAME}`: a parabola over each whole label lane \
+         (the model's own bound); `ceiling`: the near band's, fitted on the ROI rows. The peer's \
+         predictions carry no extent and are not scored here. In %.\n\n\
+         | set | config | split | lanes | near acc | full acc | FP | FN | unreached |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+        s.full_rule_reach_working_px,
+        100.0 * s.rules.tusimple_match_fraction,
+    );
+    let named = s
+        .sets
+        .iter()
+        .map(|set| (set.set.as_str(), &set.full_rule, &set.results))
+        .chain([("**overall**", &s.overall_full_rule, &s.overall)]);
+    for (name, full, near) in named {
+        for (cfg, rates) in full {
+            for (split, pick_full, pick_near) in splits {
+                let r = pick_full(rates);
+                let near_acc = near
+                    .get(cfg)
+                    .map_or_else(|| "—".to_owned(), |n| pct(pick_near(n).tusimple_accuracy));
+                md += &format!(
+                    "| {name} | {cfg} | {split} | {} | {near_acc} | {} | {} | {} | {} |\n",
+                    r.label_lanes,
+                    pct(r.tusimple_accuracy),
+                    pct(r.tusimple_fp),
+                    pct(r.tusimple_fn),
+                    pct(r.unreached_fraction)
+                );
+            }
+        }
+    }
+    md
+}
+
 /// The default's unmatched predictions by kind ([`crate::labelled::FalsePositives`]), per set
 /// and overall, for each of `splits`.
 fn render_false_positives(s: &Summary, splits: &[(&str, Pick)]) -> String {
@@ -239,7 +296,7 @@ mod tests {
         LabelFrame, LabelLane, LabelSet, LabelSide, LaneCensus, LaneStage, SceneKind, ScoringRules,
     };
 
-    use crate::labelled::{EgoPrediction, score_sides};
+    use crate::labelled::{EgoPrediction, PredictedLane, score_sides};
 
     use super::{FRAMES_CSV_HEADER, side_rows};
 
@@ -294,7 +351,10 @@ mod tests {
             &f,
             3,
             true,
-            &[Some([0.0, 0.0, 101.0]), Some([0.0, 0.0, 0.0])],
+            &[
+                Some(PredictedLane::without_extent([0.0, 0.0, 101.0])),
+                Some(PredictedLane::without_extent([0.0, 0.0, 0.0])),
+            ],
             &[],
         );
         assert_eq!(
@@ -312,12 +372,24 @@ mod tests {
             census(3, LabelSide::Right, LaneStage::NoCandidate),
             census(3, LabelSide::Left, LaneStage::FoundByRefinement),
         ];
-        let got = rows(&f, 3, true, &[Some([0.0, 0.0, 101.0]), None], &stages);
+        let got = rows(
+            &f,
+            3,
+            true,
+            &[Some(PredictedLane::without_extent([0.0, 0.0, 101.0])), None],
+            &stages,
+        );
         assert!(got.ends_with(",1.00,found_by_refinement\n"), "{got}");
         let got = rows(&f, 2, true, &[None, None], &stages);
         assert!(got.ends_with(",,not_chosen\n"), "{got}");
         // 40 px off: a far false positive; no prediction: a missed label with no error.
-        let got = rows(&f, 3, false, &[Some([0.0, 0.0, 140.0]), None], &[]);
+        let got = rows(
+            &f,
+            3,
+            false,
+            &[Some(PredictedLane::without_extent([0.0, 0.0, 140.0])), None],
+            &[],
+        );
         assert_eq!(
             got,
             "\"my,set\",\"frames/a\"\"b.png\",hold-out,left,1,1,0.0000,0,0,far,40.00,\n"
@@ -327,7 +399,13 @@ mod tests {
         // Only the left label: a right prediction is scored on its own row, unlabelled.
         let mut left_only = f.clone();
         left_only.lanes.truncate(1);
-        let got = rows(&left_only, 3, true, &[None, Some([0.0, 0.0, 250.0])], &[]);
+        let got = rows(
+            &left_only,
+            3,
+            true,
+            &[None, Some(PredictedLane::without_extent([0.0, 0.0, 250.0]))],
+            &[],
+        );
         let lines: Vec<&str> = got.lines().collect();
         assert_eq!(lines.len(), 2);
         assert!(

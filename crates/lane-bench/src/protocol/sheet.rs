@@ -57,12 +57,12 @@ pub(super) fn contact_sheet(
         }
         let (ours, peer) = &drawn[r.set];
         let mut curves: Vec<([f64; 3], [u8; 3])> = Vec::new();
-        for c in ours[r.frame].iter().flatten() {
-            curves.push((*c, [255, 40, 40]));
+        for lane in ours[r.frame].iter().flatten() {
+            curves.push((lane.coeffs, [255, 40, 40]));
         }
         if let Some(p) = peer {
-            for c in p[r.frame].iter().flatten() {
-                curves.push((*c, [60, 120, 255]));
+            for lane in p[r.frame].iter().flatten() {
+                curves.push((lane.coeffs, [60, 120, 255]));
             }
         }
         for ([a1, a2, a3], col) in curves {
