@@ -113,11 +113,8 @@ pub fn choice_bound_set(
 /// pixels.
 fn candidate_rows_px(tracker: &lane_tracker::LaneTracker) -> [f64; 2] {
     let (roi_top, roi_bottom) = tracker.roi_rows();
-    let f = tracker.working_factor();
-    let working_h = tracker.working_size().1;
     let top = tracker
-        .config()
-        .fallback_roi_rows(working_h)
-        .map_or(roi_top, |(top, _)| (f * top).min(roi_top));
+        .second_search_rows()
+        .map_or(roi_top, |(top, _)| top.min(roi_top));
     [top as f64, roi_bottom.saturating_sub(1) as f64]
 }

@@ -389,7 +389,7 @@ pub fn evaluate(
             })?;
         let roi = probe.roi_rows();
         // The full rule's reach: half a working pixel, in this set's pixels.
-        let reach_px = REACH_WORKING_PX * probe.working_factor() as f64;
+        let reach_px = REACH_WORKING_PX * probe.working_scale();
         runs.push((CHOICE_BOUND_NAME.to_owned(), bound.best));
         runs.push((CHOICE_BOUND_OR_NONE_NAME.to_owned(), bound.best_or_none));
         runs.push((

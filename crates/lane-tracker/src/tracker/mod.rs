@@ -193,6 +193,14 @@ impl LaneTracker {
             .rows_to_input(self.setup.roi, self.frame.input_size.1)
     }
 
+    /// Rows of the second search (`roi.fallback_top_row_fraction`), `[top, bottom)`, px of the
+    /// input as [`LaneTracker::roi_rows`]; `None` without a second search.
+    pub fn second_search_rows(&self) -> Option<(usize, usize)> {
+        self.setup
+            .fallback_roi
+            .map(|rows| self.frame.view.rows_to_input(rows, self.frame.input_size.1))
+    }
+
     /// The road region of the last frame ([`TrackReport::road`]; before the first frame, the
     /// whole frame's rows with the ROI searched and no horizon).
     pub fn road(&self) -> RoadReport {
