@@ -697,3 +697,41 @@ fn a_bonnet_in_view_ends_the_road_and_the_lanes_are_found_above_it() {
         mean[1]
     );
 }
+
+#[test]
+fn a_lanes_rows_reach_up_as_far_as_its_mark_is_seen() {
+    // The rendered straight scene: its marks run from the bottom towards the horizon, so each
+    // lane's rows reach well above the ROI's top (module `lane_tracker::tracker::reach`). With
+    // the marks painted out above a row, the rows stop there (within the walk's gap).
+    let spec = scene("straight_solid");
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let (w, h) = (320usize, 240usize);
+    let mut renderer = SceneRenderer::new(spec, w, h);
+    let mut frame = GreyFrame::default();
+    renderer.render(0, &mut frame);
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+    let report = tracker.track(&frame).unwrap();
+    let roi_top = tracker.roi_rows().0 as f64;
+    let tops = report.lanes.map(|l| l.rows[0]);
+    for top in tops {
+        assert!(top < roi_top - 20.0, "rows from {top}, ROI from {roi_top}");
+    }
+    // Painted out above row 130 (the floor's grey taken from the row's first column).
+    let cut = 130usize;
+    let mut pixels = frame.data().to_vec();
+    for y in 0..cut {
+        let floor = pixels[y * w];
+        pixels[y * w..(y + 1) * w].fill(floor);
+    }
+    let cut_frame = GreyFrame::from_vec(w, h, pixels).unwrap();
+    tracker.reset();
+    let report = tracker.track(&cut_frame).unwrap();
+    for lane in report.lanes {
+        assert!(lane.coeffs.is_some());
+        let top = lane.rows[0];
+        assert!(
+            top >= cut as f64 && top <= roi_top,
+            "rows from {top}, marks from {cut}"
+        );
+    }
+}

@@ -32,6 +32,7 @@ mod init;
 mod kerb;
 mod lane;
 mod points;
+mod reach;
 mod report;
 mod resample;
 mod road;
@@ -127,12 +128,8 @@ impl LaneTracker {
             cfg.track.max_points_per_lane.max(capacity.min(1 << 16)),
             height,
         );
-        let work_rows = (
-            fallback_roi
-                .map_or(roi.0, |r| r.0.min(roi.0))
-                .saturating_sub(1),
-            (roi.1 + 1).min(height),
-        );
+        // From the top: the reach (module `reach`) follows the lanes up to the horizon.
+        let work_rows = (0, (roi.1 + 1).min(height));
         let frame = WorkingFrame::new(scale, input_size, (width, height), work_rows, &lanes);
         let (top, bottom) = frame.view.rows_to_input(roi, input_size.1);
         let whole_frame = RoadReport {
@@ -471,6 +468,15 @@ impl LaneTracker {
                     .recheck_kerb_foot(lane, side, &image, rows, &self.setup.cfg);
             }
         }
+        // Each lane followed upwards as far as its mark is seen (module `reach`), no higher
+        // than where the two lanes meet.
+        let valid_rows = if self.frame.resamples() {
+            self.frame.resampled_rows()
+        } else {
+            (0, image.height())
+        };
+        let horizon = report::horizon_row_px(&self.lanes.reports());
+        reach::reach_up(&mut self.lanes, &image, valid_rows, horizon, &self.setup);
         Ok(need_init || revalidate)
     }
 

@@ -93,7 +93,9 @@ pub struct LaneReport {
     /// `[a1, a2, a3]` of `x = a1·y² + a2·y + a3` (x column, y row, pixels of the input image);
     /// `None` when the lane is [`LaneState::Initialising`] or [`LaneState::Lost`].
     pub coeffs: Option<[f64; 3]>,
-    /// `[y_min, y_max]`, rows (px) of the points behind the estimate (last update or initialisation).
+    /// `[y_min, y_max]`, rows (px) over which the lane is seen: the points behind the estimate
+    /// (last update or initialisation), and above them the marks found along the lane on a frame
+    /// it was updated on (module `tracker::reach`).
     pub rows: [f64; 2],
     /// Points used this frame (filter update, or LS fit of an initialisation; after an
     /// initialisation's refinement with `init.stripe_trace`, its points and the traced stripe's
@@ -159,7 +161,7 @@ impl RoadReport {
 /// Where the tangents of both lanes at the lower of their top rows meet, px: `y_t − g/(m_r −
 /// m_l)` with `g = x_r(y_t) − x_l(y_t) > 0` the gap and `m = dx/dy = 2·a1·y_t + a2` the slopes,
 /// the gap closing upwards (`m_r > m_l`); `None` otherwise.
-fn horizon_row_px(lanes: &[LaneReport; 2]) -> Option<f64> {
+pub(super) fn horizon_row_px(lanes: &[LaneReport; 2]) -> Option<f64> {
     let (Some(l), Some(r)) = (lanes[0].coeffs, lanes[1].coeffs) else {
         return None;
     };
