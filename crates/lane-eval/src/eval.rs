@@ -359,6 +359,7 @@ mod tests {
                 bottom_row_px: 240.0,
                 search_rows_px: [148.0, 240.0],
                 horizon_row_px: None,
+                refused: None,
             },
         }
     }
@@ -443,6 +444,7 @@ mod tests {
                 bottom_row_px: 240.0,
                 search_rows_px: [148.0, 240.0],
                 horizon_row_px: None,
+                refused: None,
             },
         };
         let s = score_against_instance_label(&r, &label, 300, 10);

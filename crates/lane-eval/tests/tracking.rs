@@ -735,3 +735,39 @@ fn a_lanes_rows_reach_up_as_far_as_its_mark_is_seen() {
         );
     }
 }
+
+#[test]
+fn a_frame_with_no_road_reports_no_lane_and_no_horizon() {
+    // Black, a white sky, a brick wall (mortar lines across and upright), at the working
+    // width, a fractional scale and a whole one: no lane, no horizon, the road's bottom within
+    // the frame, and no error.
+    let cfg = TrackerConfig::default_preset().unwrap();
+    for (w, h) in [(320usize, 240usize), (512, 288), (1280, 720)] {
+        let brick = |x: usize, y: usize| {
+            let course = y / (h / 12).max(1);
+            let x = x + course % 2 * (w / 16);
+            let mortar = y % (h / 12).max(1) < 2 || x % (w / 8).max(1) < 2;
+            if mortar {
+                200
+            } else {
+                90 + ((x * 31 + y * 17) % 7) as u8
+            }
+        };
+        let frames: [(&str, Vec<u8>); 3] = [
+            ("black", vec![0; w * h]),
+            ("sky", vec![235; w * h]),
+            ("wall", (0..w * h).map(|i| brick(i % w, i / w)).collect()),
+        ];
+        for (name, pixels) in frames {
+            let frame = GreyFrame::from_vec(w, h, pixels).unwrap();
+            let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+            for _ in 0..3 {
+                let r = tracker.track(&frame).unwrap();
+                assert!(r.lanes.iter().all(|l| l.coeffs.is_none()), "{name} {w}×{h}");
+                assert_eq!(r.road.horizon_row_px, None, "{name} {w}×{h}");
+                let b = r.road.bottom_row_px;
+                assert!(b > 0.0 && b <= h as f64, "{name} {w}×{h}: bottom {b}");
+            }
+        }
+    }
+}

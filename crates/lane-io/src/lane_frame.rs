@@ -89,6 +89,7 @@ mod tests {
                 bottom_row_px: 240.0,
                 search_rows_px: [148.0, 240.0],
                 horizon_row_px: Some(96.5),
+                refused: None,
             },
             track_us: 31.0,
             ego_lane: Some(None),

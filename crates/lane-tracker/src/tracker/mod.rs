@@ -48,8 +48,8 @@ mod working;
 
 pub(crate) use report::MAX_CANDIDATE_LINES;
 pub use report::{
-    Estimator, InitCandidate, LaneReport, LaneState, LaneView, RoadReport, Side, TrackReport,
-    TrackerCounters,
+    Estimator, InitCandidate, LaneReport, LaneState, LaneView, RoadRefusal, RoadReport, Side,
+    TrackReport, TrackerCounters,
 };
 
 use edges::EdgeStage;
@@ -136,6 +136,7 @@ impl LaneTracker {
             bottom_row_px: input_size.1 as f64,
             search_rows_px: [top as f64, bottom as f64],
             horizon_row_px: None,
+            refused: None,
         };
         Ok(LaneTracker {
             frame,
@@ -345,15 +346,33 @@ impl LaneTracker {
             });
         }
         let input = GreyImage::new(data, width, height, stride_px)?;
-        if self.setup.cfg.roi.road_bottom == RoadBottom::Found
-            && !self.lanes.iter().any(|l| l.has_estimate())
-        {
+        let placing = self.setup.cfg.roi.road_bottom == RoadBottom::Found
+            && !self.lanes.iter().any(|l| l.has_estimate());
+        if placing {
             self.place_road(&input);
         }
-        let (lanes, full_gradient) = if self.frame.resamples() {
+        let (lanes, full_gradient) = self.track_view(&input)?;
+        let view = self.frame.view;
+        let search = view.rows_to_input(self.setup.roi, height);
+        let bottom = view.rows_to_input((0, self.setup.height), height).1;
+        let road = RoadReport::of(&lanes, [search.0 as f64, search.1 as f64], bottom as f64);
+        self.road.last = road;
+        Ok(TrackReport {
+            lanes,
+            full_gradient,
+            road,
+        })
+    }
+
+    /// The tracked frame in the view in force: `(lanes, full_gradient)` in input pixels.
+    fn track_view(
+        &mut self,
+        input: &GreyImage<'_>,
+    ) -> Result<([LaneReport; 2], bool), TrackerError> {
+        Ok(if self.frame.resamples() {
             // The working frame (module `working`), in a buffer lent out of the stage for the
             // frame and put back whatever happens.
-            let pixels = self.frame.resample(&input);
+            let pixels = self.frame.resample(input);
             let (w, h) = (self.setup.width, self.setup.height);
             let tracked = GreyImage::new(&pixels, w, h, w)
                 .map_err(TrackerError::from)
@@ -364,18 +383,8 @@ impl LaneTracker {
             self.frame.publish(&self.lanes, &self.init.found);
             (self.frame.lanes(), tracked?)
         } else {
-            let full_gradient = self.track_working(input)?;
+            let full_gradient = self.track_working(*input)?;
             (self.lanes.reports(), full_gradient)
-        };
-        let view = self.frame.view;
-        let search = view.rows_to_input(self.setup.roi, height);
-        let bottom = view.rows_to_input((0, self.setup.height), height).1;
-        let road = RoadReport::of(&lanes, [search.0 as f64, search.1 as f64], bottom as f64);
-        self.road.last = road;
-        Ok(TrackReport {
-            lanes,
-            full_gradient,
-            road,
         })
     }
 
@@ -475,7 +484,7 @@ impl LaneTracker {
         } else {
             (0, image.height())
         };
-        let horizon = report::horizon_row_px(&self.lanes.reports());
+        let horizon = report::horizon_row_px(&self.lanes.reports(), self.setup.roi.0 as f64);
         reach::reach_up(&mut self.lanes, &image, valid_rows, horizon, &self.setup);
         Ok(need_init || revalidate)
     }

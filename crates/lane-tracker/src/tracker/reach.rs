@@ -19,8 +19,10 @@
 //! ```
 //!
 //! the mark's width shrinking linearly towards the horizon row `y_h` (where the two lanes meet,
-//! else the frame's top). The brightest such column moves `d` halfway to it. The walk stops at
-//! `y_h`, at the top of the rows the working frame holds, or after [`MAX_GAP_FRACTION`] of the
+//! else the frame's top). The brightest such column moves `d` halfway to it (`|d| ≤ 2k`). The
+//! walk stops at `y_h` (without one — the lanes do not close in upwards — at the top of the
+//! second search's rows, `roi.fallback_top_row_fraction`), at the top of the rows the working
+//! frame holds, or after [`MAX_GAP_FRACTION`] of the
 //! height without a mark (a dash's gap is shorter); the lane's rows then start at the highest
 //! row where a mark was seen, if at least [`MIN_MARK_ROWS`] were.
 //!
@@ -51,7 +53,10 @@ pub(super) fn reach_up(
     setup: &Setup,
 ) {
     let (w, h) = (image.width(), image.height());
-    let y_h = horizon_row.unwrap_or(0.0).max(0.0);
+    // Without a horizon (the lanes do not close in upwards) no higher than the second search's
+    // rows, or the ROI's.
+    let unknown = setup.fallback_roi.unwrap_or(setup.roi).0 as f64;
+    let y_h = horizon_row.unwrap_or(unknown).max(0.0);
     let limit = (y_h.ceil() as usize).max(rows.0).max(1);
     let k = setup.cfg.track.window_half_width_px as i64;
     let max_width = f64::from(setup.cfg.gradient.stripe_max_width_px).max(4.0);
@@ -91,7 +96,8 @@ pub(super) fn reach_up(
             }
             match best {
                 Some((_, c)) => {
-                    drift += 0.5 * (c - centre) as f64;
+                    drift =
+                        (drift + 0.5 * (c - centre) as f64).clamp(-2.0 * k as f64, 2.0 * k as f64);
                     marks += 1;
                     gap = 0;
                     top = Some(y as f64);

@@ -137,9 +137,24 @@ pub struct RoadReport {
     /// The rows searched for lanes, `[top, bottom)`, px (the ROI, placed in the road's rows).
     pub search_rows_px: [f64; 2],
     /// The horizon as the ego lanes show it: the row where the two reported lanes' tangents at
-    /// the top of their rows meet, px; `None` unless both lanes are reported and close in
-    /// upwards, or where that row would lie below the road's bottom (refused: not a road).
+    /// the top of the search band meet, px; `None` unless both lanes are reported and close in
+    /// upwards ([`Self::refused`] says why not, when the pair cannot be a road's).
     pub horizon_row_px: Option<f64>,
+    /// Why the road the two reported lanes show was refused, when it was: on a flat road seen
+    /// by a camera looking ahead the ego lanes close in upwards, so a pair that moves apart
+    /// upwards, or whose left lane lies right of its right one, shows no road; `None` otherwise
+    /// (also with fewer than two lanes). The lanes are reported as tracked; the horizon is not.
+    pub refused: Option<RoadRefusal>,
+}
+
+/// Why a frame's road region was refused ([`RoadReport::refused`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RoadRefusal {
+    /// The two lanes move apart upwards at the top of the search band.
+    LanesDivergeUpwards,
+    /// The left lane lies right of the right one at the top of the search band.
+    LanesCrossed,
 }
 
 impl RoadReport {
@@ -150,28 +165,46 @@ impl RoadReport {
         search_rows_px: [f64; 2],
         bottom_row_px: f64,
     ) -> Self {
+        let (horizon_row_px, refused) = match horizon_of(lanes, search_rows_px[0]) {
+            Ok(horizon) => (horizon, None),
+            Err(why) => (None, Some(why)),
+        };
         RoadReport {
             bottom_row_px,
             search_rows_px,
-            horizon_row_px: horizon_row_px(lanes).filter(|&y| y < bottom_row_px),
+            horizon_row_px,
+            refused,
         }
     }
 }
 
-/// Where the tangents of both lanes at the lower of their top rows meet, px: `y_t − g/(m_r −
-/// m_l)` with `g = x_r(y_t) − x_l(y_t) > 0` the gap and `m = dx/dy = 2·a1·y_t + a2` the slopes,
-/// the gap closing upwards (`m_r > m_l`); `None` otherwise.
-pub(super) fn horizon_row_px(lanes: &[LaneReport; 2]) -> Option<f64> {
+/// [`horizon_of`]'s horizon, `None` also where the pair is refused.
+pub(super) fn horizon_row_px(lanes: &[LaneReport; 2], y_t: f64) -> Option<f64> {
+    horizon_of(lanes, y_t).ok().flatten()
+}
+
+/// Where the tangents of both lanes at row `y_t` (the top of the search band: the parabolas
+/// are fitted to the band's points) meet, px: `y_t − g/(m_r − m_l)` with `g = x_r(y_t) −
+/// x_l(y_t) > 0` the gap and `m = dx/dy = 2·a1·y_t + a2` the slopes, the gap closing upwards
+/// (`m_r > m_l`); `Ok(None)` with fewer than two lanes or tangents parallel within 10⁻⁶ px/row;
+/// the refusal for a gap that is not positive or opens upwards.
+fn horizon_of(lanes: &[LaneReport; 2], y_t: f64) -> Result<Option<f64>, RoadRefusal> {
+    const PARALLEL: f64 = 1e-6;
     let (Some(l), Some(r)) = (lanes[0].coeffs, lanes[1].coeffs) else {
-        return None;
+        return Ok(None);
     };
-    let y_t = lanes[0].rows[0].max(lanes[1].rows[0]);
     let x = |c: [f64; 3]| c[0] * y_t * y_t + c[1] * y_t + c[2];
     let m = |c: [f64; 3]| 2.0 * c[0] * y_t + c[1];
     let (gap, closing) = (x(r) - x(l), m(r) - m(l));
-    (gap > 0.0 && closing > 1e-6)
+    if gap <= 0.0 {
+        return Err(RoadRefusal::LanesCrossed);
+    }
+    if closing < -PARALLEL {
+        return Err(RoadRefusal::LanesDivergeUpwards);
+    }
+    Ok((closing > PARALLEL)
         .then(|| y_t - gap / closing)
-        .filter(|y| y.is_finite())
+        .filter(|y| y.is_finite()))
 }
 
 /// Counters over the tracker's life.
@@ -252,4 +285,54 @@ pub struct LaneView<'a> {
     pub spans: &'a [ColSpan],
     /// The points fed to the filter or the LS fit on the last frame, `(col_px, row_px)`.
     pub points: &'a [(f32, f32)],
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lane(side: Side, coeffs: Option<[f64; 3]>) -> LaneReport {
+        LaneReport {
+            side,
+            state: if coeffs.is_some() {
+                LaneState::Tracking
+            } else {
+                LaneState::Lost
+            },
+            coeffs,
+            rows: [150.0, 239.0],
+            points: 40,
+            initialised: false,
+        }
+    }
+
+    fn road(left: Option<[f64; 3]>, right: Option<[f64; 3]>) -> RoadReport {
+        let lanes = [lane(Side::Left, left), lane(Side::Right, right)];
+        RoadReport::of(&lanes, [150.0, 240.0], 240.0)
+    }
+
+    #[test]
+    fn lanes_closing_in_upwards_meet_at_the_horizon() {
+        // x_l = 100 − 0.5·(y − 150), x_r = 220 + 0.5·(y − 150): gap 120 at row 150, closing
+        // by 1 px a row upwards: they meet at row 30.
+        let r = road(Some([0.0, -0.5, 175.0]), Some([0.0, 0.5, 145.0]));
+        let y = r.horizon_row_px.expect("a horizon");
+        assert!((y - 30.0).abs() < 1e-9, "{y}");
+        assert_eq!(r.refused, None);
+    }
+
+    #[test]
+    fn a_pair_no_road_shows_is_refused_with_its_reason_and_no_horizon() {
+        let diverging = road(Some([0.0, 0.5, 25.0]), Some([0.0, -0.5, 295.0]));
+        assert_eq!(diverging.refused, Some(RoadRefusal::LanesDivergeUpwards));
+        assert_eq!(diverging.horizon_row_px, None);
+        let crossed = road(Some([0.0, -0.5, 375.0]), Some([0.0, 0.5, 45.0]));
+        assert_eq!(crossed.refused, Some(RoadRefusal::LanesCrossed));
+        assert_eq!(crossed.horizon_row_px, None);
+        // One lane, or parallel lanes: no horizon and nothing refused.
+        let one = road(Some([0.0, -0.5, 175.0]), None);
+        assert_eq!((one.horizon_row_px, one.refused), (None, None));
+        let parallel = road(Some([0.0, 0.2, 50.0]), Some([0.0, 0.2, 170.0]));
+        assert_eq!((parallel.horizon_row_px, parallel.refused), (None, None));
+    }
 }

@@ -209,6 +209,7 @@ mod tests {
             bottom_row_px: H as f64,
             search_rows_px: [0.0, H as f64],
             horizon_row_px: None,
+            refused: None,
         };
         RoadFinder::new(W, H, whole)
     }
