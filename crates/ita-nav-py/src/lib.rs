@@ -158,6 +158,13 @@ fn lane_dict<'py>(py: Python<'py>, l: &LaneReport) -> PyResult<Bound<'py, PyDict
     d.set_item("rows", (l.rows[0], l.rows[1]))?;
     d.set_item("points", l.points)?;
     d.set_item("initialised", l.initialised)?;
+    d.set_item(
+        "far",
+        l.far.map(|f| {
+            let [a, b, c] = f.coeffs;
+            ((a, b, c), (f.rows[0], f.rows[1]))
+        }),
+    )?;
     Ok(d)
 }
 

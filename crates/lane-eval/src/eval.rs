@@ -351,6 +351,7 @@ mod tests {
             rows: [150.0, 239.0],
             points: 100,
             initialised: false,
+            far: None,
         };
         TrackReport {
             lanes: [lane(Side::Left, 100.0), lane(Side::Right, 250.0)],
@@ -435,6 +436,7 @@ mod tests {
             rows: [300.0, 719.0],
             points: 100,
             initialised: true,
+            far: None,
         };
         // Left lane 10 px off (correct at 20 px tolerance), right lane 30 px off (wrong).
         let r = TrackReport {

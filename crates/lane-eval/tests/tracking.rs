@@ -712,9 +712,11 @@ fn a_lanes_rows_reach_up_as_far_as_its_mark_is_seen() {
     let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
     let report = tracker.track(&frame).unwrap();
     let roi_top = tracker.roi_rows().0 as f64;
-    let tops = report.lanes.map(|l| l.rows[0]);
-    for top in tops {
+    for lane in report.lanes {
+        let top = lane.rows[0];
         assert!(top < roi_top - 20.0, "rows from {top}, ROI from {roi_top}");
+        // Straight marks: the near parabola holds up there, no far segment.
+        assert_eq!(lane.far, None);
     }
     // Painted out above row 130 (the floor's grey taken from the row's first column).
     let cut = 130usize;
@@ -734,6 +736,51 @@ fn a_lanes_rows_reach_up_as_far_as_its_mark_is_seen() {
             "rows from {top}, marks from {cut}"
         );
     }
+}
+
+#[test]
+fn a_curving_lane_gets_a_far_segment_that_follows_it_better_than_the_near_parabola() {
+    // The rendered curves: where a lane reports a far segment, it lies closer to the truth on
+    // its rows than the near parabola extrapolated there (mean over the scene's first frames),
+    // and it joins the near parabola at its lower row.
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let (w, h) = (320usize, 240usize);
+    let (mut far_err, mut near_err, mut n) = (0.0, 0.0, 0usize);
+    for name in ["curve_left_dashed", "curve_right_dashed"] {
+        let spec = scene(name);
+        let mut renderer = SceneRenderer::new(spec, w, h);
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+        let mut frame = GreyFrame::default();
+        for i in 0..spec.frames.min(40) {
+            renderer.render(i, &mut frame);
+            let report = tracker.track(&frame).unwrap();
+            let truth = renderer.truth(i);
+            for (lane, t) in report.lanes.iter().zip(truth.lanes) {
+                let (Some(far), true) = (lane.far, t.visible) else {
+                    continue;
+                };
+                let join = far.rows[1];
+                let near_at_join = lane.col_at_row(join).unwrap();
+                assert!(
+                    (far.col_at_row(join) - near_at_join).abs() < 1e-6,
+                    "{name} {i}"
+                );
+                let mut y = far.rows[0];
+                while y < join {
+                    far_err += (far.col_at_row(y) - t.col_at_row(y)).abs();
+                    near_err += (lane.col_at_row(y).unwrap() - t.col_at_row(y)).abs();
+                    n += 1;
+                    y += 1.0;
+                }
+            }
+        }
+    }
+    assert!(n > 50, "far rows scored: {n}");
+    let (far_err, near_err) = (far_err / n as f64, near_err / n as f64);
+    assert!(
+        far_err < near_err,
+        "far {far_err:.2} px, near {near_err:.2} px"
+    );
 }
 
 #[test]

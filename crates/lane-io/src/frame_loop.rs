@@ -42,6 +42,9 @@ pub struct Tracked<'a> {
 }
 
 /// What one [`FrameLoop::step`] did.
+// The tracked frame's report (both lanes with their far segments, the road) is most of a step;
+// a step is returned once per frame and read at once, and boxing it would allocate per frame.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 pub enum Step<'a> {
     /// A frame was tracked.

@@ -55,6 +55,7 @@ mod tests {
             rows: [150.0, 239.0],
             points: 42,
             initialised: false,
+            far: None,
         }
     }
 

@@ -27,7 +27,7 @@ pub const LANES_TOPIC: &str = "/lanes";
 pub const LANES_SCHEMA_NAME: &str = "ita_nav.LaneFrame";
 
 /// JSON schema of the `/lanes` messages (`nav-app --json`'s per-frame object, schema 1).
-pub const LANES_SCHEMA: &str = r#"{"title":"ita_nav.LaneFrame","description":"One frame of nav-app's lane tracker (lane_io::lane_frame::LaneFrame, the --json object, schema 1)","type":"object","properties":{"schema":{"type":"integer","const":1},"frame":{"type":"integer","minimum":0},"t_s":{"type":"number"},"lanes":{"type":"array","minItems":2,"maxItems":2,"items":{"type":"object","properties":{"side":{"enum":["left","right"]},"state":{"enum":["initialising","tracking","coasting","lost"]},"coeffs":{"type":["array","null"],"items":{"type":"number"},"minItems":3,"maxItems":3,"description":"[a1, a2, a3] of x = a1 y^2 + a2 y + a3, pixels of the input image"},"rows":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2},"points":{"type":"integer","minimum":0},"initialised":{"type":"boolean"}},"required":["side","state","coeffs","rows","points","initialised"]}},"road":{"type":"object","properties":{"bottom_row_px":{"type":"number","description":"one past the lowest row of road, pixels of the input image"},"search_rows_px":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2,"description":"[top, bottom) rows searched for lanes"},"horizon_row_px":{"type":["number","null"],"description":"row where the two ego lanes' tangents meet"},"refused":{"enum":["lanes_diverge_upwards","lanes_crossed",null],"description":"why the region the lanes show was refused"}},"required":["bottom_row_px","search_rows_px","horizon_row_px","refused"]},"track_us":{"type":"number"},"ego_lane":{"type":["object","null"]},"lane_cov_px":{"type":["array","null"]}},"required":["schema","frame","t_s","lanes","road","track_us"]}"#;
+pub const LANES_SCHEMA: &str = r#"{"title":"ita_nav.LaneFrame","description":"One frame of nav-app's lane tracker (lane_io::lane_frame::LaneFrame, the --json object, schema 1)","type":"object","properties":{"schema":{"type":"integer","const":1},"frame":{"type":"integer","minimum":0},"t_s":{"type":"number"},"lanes":{"type":"array","minItems":2,"maxItems":2,"items":{"type":"object","properties":{"side":{"enum":["left","right"]},"state":{"enum":["initialising","tracking","coasting","lost"]},"coeffs":{"type":["array","null"],"items":{"type":"number"},"minItems":3,"maxItems":3,"description":"[a1, a2, a3] of x = a1 y^2 + a2 y + a3, pixels of the input image"},"rows":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2},"points":{"type":"integer","minimum":0},"initialised":{"type":"boolean"},"far":{"type":["object","null"],"properties":{"coeffs":{"type":"array","items":{"type":"number"},"minItems":3,"maxItems":3},"rows":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2}},"description":"the far segment above the near parabola's rows: [a1, a2, a3] on rows [y_min, y_join]"}},"required":["side","state","coeffs","rows","points","initialised","far"]}},"road":{"type":"object","properties":{"bottom_row_px":{"type":"number","description":"one past the lowest row of road, pixels of the input image"},"search_rows_px":{"type":"array","items":{"type":"number"},"minItems":2,"maxItems":2,"description":"[top, bottom) rows searched for lanes"},"horizon_row_px":{"type":["number","null"],"description":"row where the two ego lanes' tangents meet"},"refused":{"enum":["lanes_diverge_upwards","lanes_crossed",null],"description":"why the region the lanes show was refused"}},"required":["bottom_row_px","search_rows_px","horizon_row_px","refused"]},"track_us":{"type":"number"},"ego_lane":{"type":["object","null"]},"lane_cov_px":{"type":["array","null"]}},"required":["schema","frame","t_s","lanes","road","track_us"]}"#;
 
 const COLOURS: [Color; 2] = [
     Color {
@@ -140,10 +140,15 @@ impl LaneMcapSink {
         for (lane, colour) in report.lanes.iter().zip(COLOURS) {
             let Some(_) = lane.coeffs else { continue };
             let [top, bottom] = lane.rows;
+            // Above the far segment's join, its column (`LaneReport::far`).
+            let col = |y: f64| match lane.far {
+                Some(far) if y < far.rows[1] => Some(far.col_at_row(y)),
+                _ => lane.col_at_row(y),
+            };
             let points = (0..POLYLINE_POINTS)
                 .filter_map(|k| {
                     let y = top + (bottom - top) * k as f64 / (POLYLINE_POINTS - 1) as f64;
-                    lane.col_at_row(y).map(|x| Point2 { x, y })
+                    col(y).map(|x| Point2 { x, y })
                 })
                 .collect();
             self.ann.points.push(PointsAnnotation {

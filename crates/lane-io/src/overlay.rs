@@ -114,6 +114,16 @@ pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8
                 }
                 prev = Some(x);
             }
+            // The far segment above the near rows (`LaneReport::far`), dotted in the same colour.
+            if let Some(far) = view.report.far {
+                let (from, to) = (far.rows[0].max(0.0) as usize, far.rows[1].max(0.0) as usize);
+                for row in (from..to.min(h)).step_by(2) {
+                    let x = far.col_at_row(row as f64);
+                    if x.is_finite() {
+                        put(x.round() as i64, row as i64, colour);
+                    }
+                }
+            }
         }
     }
 }

@@ -364,6 +364,6 @@ pub use error::{FilterFailure, TrackerError};
 /// The workspace's one grey frame (crate `grey-frame`).
 pub use grey_frame::{FrameError, GreyFrame};
 pub use tracker::{
-    Estimator, InitCandidate, LaneReport, LaneState, LaneTracker, LaneView, RoadRefusal,
-    RoadReport, Side, TrackReport, TrackerCounters,
+    Estimator, FarSegment, InitCandidate, LaneReport, LaneState, LaneTracker, LaneView,
+    RoadRefusal, RoadReport, Side, TrackReport, TrackerCounters,
 };

@@ -76,5 +76,9 @@ fn fit_parabola(points: &[[f64; 2]], keep: impl Fn(&[f64; 2]) -> bool) -> Option
     coeffs
         .iter()
         .all(|v| v.is_finite())
-        .then_some(PredictedLane { coeffs, rows_px })
+        .then_some(PredictedLane {
+            coeffs,
+            rows_px,
+            far: None,
+        })
 }

@@ -95,6 +95,7 @@ pub fn choice_bound_set(
                     best[k] = Some(PredictedLane {
                         coeffs: c.coeffs,
                         rows_px: searched,
+                        far: None,
                     });
                 }
             }

@@ -30,9 +30,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{
-    EgoPrediction, LabelFrame, LabelSide, PredictedLane, ScoringRules, eval_parabola, fit_slope,
-};
+use super::{EgoPrediction, LabelFrame, LabelSide, PredictedLane, ScoringRules, fit_slope};
 
 /// The full rule's reach tolerance, in pixels of the tracker's working frame (module docs).
 pub const REACH_WORKING_PX: f64 = 0.5;
@@ -162,7 +160,7 @@ fn score_side_full(
     for &[x, y] in &pts {
         if !p.reaches(y, reach_px) {
             t.unreached_points += 1;
-        } else if (eval_parabola(p.coeffs, y) - x).abs() <= tol_px {
+        } else if (p.col_at_row(y) - x).abs() <= tol_px {
             correct += 1;
         }
     }
@@ -195,6 +193,7 @@ mod tests {
         Some(PredictedLane {
             coeffs: [0.0, 0.0, 100.0],
             rows_px,
+            far: None,
         })
     }
 
@@ -227,6 +226,27 @@ mod tests {
     }
 
     #[test]
+    fn the_far_segment_is_read_above_the_row_it_joins_at() {
+        // The label is x = 100 on rows 20..239. A near parabola on it and a far segment 30 px
+        // off above row 130: the far rows are wrong; the same far segment on the label: right.
+        let rules = ScoringRules::default();
+        let f = frame();
+        let with_far = |far_a3: f64| PredictedLane {
+            coeffs: [0.0, 0.0, 100.0],
+            rows_px: [20.0, 239.0],
+            far: Some(([0.0, 0.0, far_a3], 130.0)),
+        };
+        let off = score_frame_full(&f, 320, &[Some(with_far(130.0)), None], &rules, 0.5);
+        assert!((off.acc_sum - 0.5).abs() < 1e-12, "{off:?}");
+        let on = score_frame_full(&f, 320, &[Some(with_far(100.0)), None], &rules, 0.5);
+        assert_eq!(on.acc_sum, 1.0);
+        // The near band never reads it.
+        let near =
+            crate::labelled::score_frame(&f, 320, 240, &[Some(with_far(130.0)), None], &rules);
+        assert_eq!(near.tusimple_matched, 1);
+    }
+
+    #[test]
     fn the_tolerance_is_slope_corrected_from_the_whole_label() {
         // A 45° label x = y: 5 px at 320 px, / cos 45° = 7.07 px.
         let mut f = frame();
@@ -236,6 +256,7 @@ mod tests {
             let p = PredictedLane {
                 coeffs: [0.0, 1.0, offset],
                 rows_px: [0.0, 239.0],
+                far: None,
             };
             score_frame_full(&f, 320, &[Some(p), None], &rules, 0.5).matched
         };

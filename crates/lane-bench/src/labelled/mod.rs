@@ -252,6 +252,10 @@ pub struct PredictedLane {
     /// [`lane_tracker::LaneReport::rows`]). The near band ignores it; the full rule
     /// ([`full_rule`]) counts a label row outside it as a wrong point.
     pub rows_px: [f64; 2],
+    /// The far segment above the near parabola's rows ([`lane_tracker::FarSegment`]:
+    /// `[a1, a2, a3]` and the row it joins at), which the full rule reads above that row; the
+    /// near band never does (its rows are the near parabola's).
+    pub far: Option<([f64; 3], f64)>,
 }
 
 impl PredictedLane {
@@ -261,6 +265,7 @@ impl PredictedLane {
         PredictedLane {
             coeffs,
             rows_px: [f64::NEG_INFINITY, f64::INFINITY],
+            far: None,
         }
     }
 
@@ -270,7 +275,17 @@ impl PredictedLane {
         report.coeffs.map(|coeffs| PredictedLane {
             coeffs,
             rows_px: report.rows,
+            far: report.far.map(|f| (f.coeffs, f.rows[1])),
         })
+    }
+
+    /// Its column at `row_px`: the far segment's above the row it joins at, the near
+    /// parabola's elsewhere.
+    pub fn col_at_row(&self, row_px: f64) -> f64 {
+        match self.far {
+            Some((far, join_px)) if row_px < join_px => eval_parabola(far, row_px),
+            _ => eval_parabola(self.coeffs, row_px),
+        }
     }
 
     /// Whether row `row_px` lies within the extent, `tolerance_px` beyond either end allowed.

@@ -11,7 +11,7 @@ use lane_geometry::FitRows;
 use nalgebra::Vector3;
 use vision_gradient::ColSpan;
 
-use super::report::{LaneReport, LaneState, Side, TrackerCounters};
+use super::report::{FarSegment, LaneReport, LaneState, Side, TrackerCounters};
 use super::setup::Setup;
 use crate::error::FilterFailure;
 use crate::wrls_lane::WrlsLane;
@@ -63,6 +63,8 @@ pub(super) struct Lane {
     pub(super) weights: Vec<f64>,
     pub(super) spans: Vec<ColSpan>,
     pub(super) rows: [f64; 2],
+    /// The far segment followed up on this frame (module `reach`), working pixels.
+    pub(super) far: Option<FarSegment>,
     /// Rows and weights of the points behind the last update or initialisation.
     pub(super) fit: FitRows,
     pub(super) points_now: usize,
@@ -134,6 +136,7 @@ impl Lane {
             weights: Vec::with_capacity(point_capacity),
             spans: vec![ColSpan::EMPTY; height_px],
             rows: [0.0, 0.0],
+            far: None,
             fit: FitRows::uniform(0.0, 0.0),
             points_now: 0,
             points_before: 0,
@@ -163,6 +166,7 @@ impl Lane {
         self.spans.fill(ColSpan::EMPTY);
         self.points_now = 0;
         self.tracked_tall = false;
+        self.far = None;
     }
 
     /// The start of a frame: nothing initialised, updated, replaced or set aside on it yet;
@@ -174,6 +178,7 @@ impl Lane {
         self.points_now = 0;
         self.replaced = None;
         self.set_aside = None;
+        self.far = None;
     }
 
     /// A frame without an update: coasting on the prediction, lost after
@@ -293,6 +298,7 @@ impl Lane {
             rows: self.rows,
             points: self.points_now,
             initialised: self.initialised_now,
+            far: self.far.filter(|_| coeffs.is_some()),
         }
     }
 

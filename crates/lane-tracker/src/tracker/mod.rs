@@ -48,8 +48,8 @@ mod working;
 
 pub(crate) use report::MAX_CANDIDATE_LINES;
 pub use report::{
-    Estimator, InitCandidate, LaneReport, LaneState, LaneView, RoadRefusal, RoadReport, Side,
-    TrackReport, TrackerCounters,
+    Estimator, FarSegment, InitCandidate, LaneReport, LaneState, LaneView, RoadRefusal, RoadReport,
+    Side, TrackReport, TrackerCounters,
 };
 
 use edges::EdgeStage;

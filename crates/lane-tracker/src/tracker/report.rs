@@ -105,6 +105,28 @@ pub struct LaneReport {
     pub points: usize,
     /// `true` if the lane was (re-)initialised by Hough + LS on this frame.
     pub initialised: bool,
+    /// Above `coeffs`' rows, where its marks bend away from the near field's parabola: the far
+    /// segment that follows them (module `tracker::reach`); `None` when no marks were followed
+    /// up past the near field on this frame.
+    pub far: Option<FarSegment>,
+}
+
+/// The far part of a lane (module `tracker::reach`): `x = a1·y² + a2·y + a3` on its rows, joined
+/// to the near field's parabola at its lower row with the same column and slope.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FarSegment {
+    /// `[a1, a2, a3]`, pixels of the input image.
+    pub coeffs: [f64; 3],
+    /// `[y_min, y_join]`, rows (px): from the highest mark followed to the row it joins the
+    /// near field's parabola at.
+    pub rows: [f64; 2],
+}
+
+impl FarSegment {
+    /// Column at `row_px`.
+    pub fn col_at_row(&self, row_px: f64) -> f64 {
+        Parabola::from_coeffs(self.coeffs).col_at_row(row_px)
+    }
 }
 
 impl LaneReport {
@@ -303,6 +325,7 @@ mod tests {
             rows: [150.0, 239.0],
             points: 40,
             initialised: false,
+            far: None,
         }
     }
 

@@ -38,7 +38,7 @@
 use nalgebra::{Matrix3, Vector3};
 use vision_gradient::ColSpan;
 
-use super::report::LaneReport;
+use super::report::{FarSegment, LaneReport};
 use super::setup::Rows;
 
 /// One axis of the view: working pixel `j` stands for input `[start + s·j, start + s·(j + 1))`.
@@ -132,6 +132,10 @@ impl WorkingView {
     pub(crate) fn report_to_input(self, mut report: LaneReport) -> LaneReport {
         report.coeffs = report.coeffs.map(|b| self.coeffs_to_input(b));
         report.rows = report.rows.map(|r| self.rows.to_input_px(r));
+        report.far = report.far.map(|far| FarSegment {
+            coeffs: self.coeffs_to_input(far.coeffs),
+            rows: far.rows.map(|r| self.rows.to_input_px(r)),
+        });
         report
     }
 
