@@ -52,8 +52,9 @@ const BOUNDARY_HALF_ROWS: usize = 4;
 /// The road's bottom row finder: per-row counts over the lower half of a working frame.
 #[derive(Debug)]
 pub(super) struct RoadFinder {
-    /// Per pixel of the rows looked at: bit 0 horizontal edge, bit 1 lane-like edge.
-    marks: Vec<u8>,
+    /// Per row looked at, a bit per column: a horizontal edge there (`words` words a row).
+    horizontal: Vec<u64>,
+    words: usize,
     /// Per row: columns with a horizontal edge within ±2 rows; lane-like edges.
     cover: Vec<u32>,
     lane_edges: Vec<u32>,
@@ -69,8 +70,10 @@ impl RoadFinder {
     /// A finder for `width × height` working frames, `initial` the region reported before
     /// the first frame.
     pub(super) fn new(width: usize, height: usize, initial: RoadReport) -> Self {
+        let words = width.div_ceil(64);
         RoadFinder {
-            marks: vec![0; width * height],
+            horizontal: vec![0; words * height],
+            words,
             cover: vec![0; height],
             lane_edges: vec![0; height],
             bottom_row: None,
@@ -105,7 +108,8 @@ impl RoadFinder {
         let (w, h) = (image.width(), image.height());
         let first = (h / 2).max(rows.0 + 1);
         let last = h.min(rows.1).saturating_sub(1);
-        if w < 3 || first + 4 > last || self.marks.len() < w * h {
+        let words = self.words;
+        if w < 3 || first + 4 > last || self.horizontal.len() < words * h {
             return None;
         }
         // Marks, then per-row counts.
@@ -115,26 +119,27 @@ impl RoadFinder {
             else {
                 return None;
             };
-            let marks = &mut self.marks[y * w..(y + 1) * w];
-            marks[0] = 0;
-            marks[w - 1] = 0;
+            let bits = &mut self.horizontal[y * words..(y + 1) * words];
+            bits.fill(0);
             let mut lane_edges = 0;
             for x in 1..w - 1 {
                 let gv = (i16::from(down[x]) - i16::from(up[x])).abs();
                 let gh = (i16::from(mid[x + 1]) - i16::from(mid[x - 1])).abs();
                 let horizontal = gv >= EDGE_STEP && gv >= 2 * gh;
-                let lane_like = gh >= EDGE_STEP && gh > gv;
-                marks[x] = u8::from(horizontal) | (u8::from(lane_like) << 1);
-                lane_edges += u32::from(lane_like);
+                bits[x / 64] |= u64::from(horizontal) << (x % 64);
+                lane_edges += u32::from(gh >= EDGE_STEP && gh > gv);
             }
             self.lane_edges[y] = lane_edges;
         }
+        // A column covers row y when one of rows y ± BOUNDARY_HALF_ROWS has a horizontal edge
+        // there: the OR of those rows' bits, counted.
         for y in first..last {
             let lo = y.saturating_sub(BOUNDARY_HALF_ROWS).max(first);
             let hi = (y + BOUNDARY_HALF_ROWS + 1).min(last);
             let mut cover = 0;
-            for x in 0..w {
-                cover += u32::from((lo..hi).any(|r| self.marks[r * w + x] & 1 != 0));
+            for word in 0..words {
+                let any = (lo..hi).fold(0u64, |acc, r| acc | self.horizontal[r * words + word]);
+                cover += any.count_ones();
             }
             self.cover[y] = cover;
         }
