@@ -61,7 +61,7 @@ pub fn render_overlay(frame: &GreyFrame, tracker: &LaneTracker, rgb: &mut Vec<u8
     for (row, colour, shown) in lines {
         if shown && row.is_finite() {
             let y = row.round() as i64;
-            for x in (0..w).filter(|x| (x / DASH_PX) % 2 == 0) {
+            for x in (0..w).filter(|x| (x / DASH_PX).is_multiple_of(2)) {
                 put(x as i64, y, colour);
             }
         }
