@@ -12,9 +12,11 @@
 //! largest per-frame time of those 5 × 221 frames (the mean over the median is what issue 53
 //! item 6 bounds), and how many frames re-validated.
 //!
-//! Cases: `default` (the default configuration), `revalidation_off` (the same with
-//! `track.revalidate_every_frames = 0` and `track.revalidate_below_points = 0`: what the tracked
-//! frames alone cost).
+//! Cases: `default` (the default configuration: the period's re-validation spread over its
+//! frames, `track.revalidate_spread`), `whole_revalidation` (the same with
+//! `track.revalidate_spread = false`: the whole re-validation on every 10th frame, the default
+//! before issue 53 item 6), `revalidation_off` (`track.revalidate_every_frames = 0` and
+//! `track.revalidate_below_points = 0`: what the tracked frames alone cost).
 //!
 //! `cargo bench -p lane-eval --bench clip -- --warm-up-time 2 --measurement-time 10`
 //!
@@ -89,6 +91,8 @@ fn clip(c: &mut Criterion) {
         return;
     };
     let default = TrackerConfig::default_preset().unwrap();
+    let mut whole = default;
+    whole.track.revalidate_spread = false;
     let mut off = default;
     off.track.revalidate_every_frames = 0;
     off.track.revalidate_below_points = 0;
@@ -96,7 +100,11 @@ fn clip(c: &mut Criterion) {
     let n = u32::try_from(frames.len()).unwrap();
     let mut group = c.benchmark_group("clip");
     group.sample_size(20);
-    for (case, cfg) in [("default", default), ("revalidation_off", off)] {
+    for (case, cfg) in [
+        ("default", default),
+        ("whole_revalidation", whole),
+        ("revalidation_off", off),
+    ] {
         print_per_frame(case, &cfg, &frames);
         group.bench_function(BenchmarkId::new(case, "udacity_320x240_per_frame"), |b| {
             b.iter_custom(|iters| {
