@@ -9,7 +9,10 @@
 //! half blanked: the second search runs for the right side), `both` (the whole ROI blanked: both
 //! sides searched for over the taller rows), `track` (a tracked frame; re-validation off),
 //! `revalidate` (a re-validation frame: both lanes tracked, the joint initialisation run over
-//! the ROI on every frame).
+//! the ROI on every frame), `clip` (the whole clip, 221 frames, with a fresh tracker, `N` times:
+//! the difference over `N · 221` is the mean per frame over the clip, re-validations and the
+//! first frame's initialisation included), `clip_whole` (the same with
+//! `track.revalidate_spread = false`: the whole re-validation on every 10th frame).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 use lane_io::FrameSource;
 use lane_io::y4m::Y4mSource;
@@ -27,6 +30,29 @@ fn main() {
     let mut src = Y4mSource::new(std::io::BufReader::new(file), path.display().to_string())
         .expect("a y4m stream");
     let mut frame = GreyFrame::default();
+    if kind.starts_with("clip") {
+        let mut cfg = TrackerConfig::default_preset().unwrap();
+        cfg.track.revalidate_spread = kind != "clip_whole";
+        let mut clip = Vec::new();
+        while src.next_frame(&mut frame).unwrap().is_some() {
+            clip.push(frame.clone());
+        }
+        let (w, h) = (clip[0].width(), clip[0].height());
+        let start = std::time::Instant::now();
+        for _ in 0..n {
+            let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+            for f in &clip {
+                std::hint::black_box(tracker.track(std::hint::black_box(f)).unwrap());
+            }
+        }
+        let frames = (n * clip.len()).max(1);
+        let per_frame_us = start.elapsed().as_secs_f64() * 1e6 / frames as f64;
+        println!(
+            "{kind}: {n} × {} frames, {per_frame_us:.1} µs a frame (wall, trackers' construction included)",
+            clip.len()
+        );
+        return;
+    }
     for _ in 0..10 {
         src.next_frame(&mut frame).unwrap().expect("10 frames");
     }
@@ -50,7 +76,9 @@ fn main() {
         "init" | "track" | "revalidate" => None,
         "right" => Some(w / 2),
         "both" => Some(0),
-        other => panic!("unknown kind {other}: init, right, both, track or revalidate"),
+        other => {
+            panic!("unknown kind {other}: init, right, both, track, revalidate, clip or clip_whole")
+        }
     };
     let mut input = frame.clone();
     if let Some(from_col) = blank_from {

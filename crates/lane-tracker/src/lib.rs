@@ -133,7 +133,11 @@
 //!    side, and put back if it finds nothing —, where the tracked lanes compete with the
 //!    candidates, each weighed by its own row coverage ×
 //!    `track.revalidate_keep_factor`, and a lane is replaced only by a candidate off its mark,
-//!    [`TrackerCounters::revalidations`]; with re-validation on, a lane tracked from earlier
+//!    [`TrackerCounters::revalidations`]; with `track.revalidate_spread` (the default) the
+//!    period's re-validation is spread over the period's frames, a tenth of its work a frame on
+//!    the edges of the period's first frame, and runs whole on the period's last frame only
+//!    when its choice there would change a lane (module `tracker::revalidation`); with
+//!    re-validation on, a lane tracked from earlier
 //!    frames competes so too when the other side is initialised again, instead of being locked
 //!    into the pair; a tracked lane the joint choice puts on the other side
 //!    of the pair — the camera crossed it, a lane change — is handed over to that side with its

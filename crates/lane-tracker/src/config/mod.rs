@@ -382,6 +382,18 @@ pub struct TrackConfig {
     /// when absent): the period only.
     #[serde(default)]
     pub revalidate_below_points: usize,
+    /// The period's re-validation spread over the period's frames (an addition beyond the
+    /// paper; with `revalidate_every_frames` ≥ 2): its work — the ROI's gradient, each band's
+    /// pixels, vote and candidates' fits — cut into ten steps done on the frames of the period,
+    /// on the edges of its first frame, and the choice on its last frame, the frame the whole
+    /// re-validation would run on; if that choice would change a lane (its evidence a period
+    /// old), the whole re-validation runs at once on that frame and changes it or not. A frame
+    /// then costs a tenth of a re-validation more instead of every tenth frame costing a whole
+    /// one (module `tracker::revalidation`). The weak-evidence trigger
+    /// (`revalidate_below_points`) stays whole and immediate. `false` (default when absent):
+    /// the whole re-validation on the period's frame.
+    #[serde(default)]
+    pub revalidate_spread: bool,
 }
 
 fn default_revalidate_keep_factor() -> f64 {

@@ -12,18 +12,18 @@
 //! `vertical-marks.md`, `revalidation-period.md`, `revalidation-weak-evidence.md`; whether each
 //! earns its place: `docs/results/ablation.md`.
 
-use hough_init::{
-    Chord, HoughLine, HoughWorkspace, LaneInit, Parabola, choose_ego_pair, init_lane,
-};
+use hough_init::{HoughLine, HoughWorkspace, LaneInit, Parabola, init_lane};
 use nalgebra::Vector3;
-use vision_gradient::{EdgeClass, GreyImage};
+use vision_gradient::GreyImage;
 
 use super::candidates::CandidateIndex;
 use super::edges::EdgeStage;
+use super::joint::{self, Gathered, JointChoice};
 use super::lane::{HandOver, Health, Lane, Lanes};
 use super::points::fit_profile;
 use super::report::{InitCandidate, LaneState, MAX_CANDIDATE_LINES, Side};
-use super::setup::{Pass, Rows, Setup};
+use super::revalidation::SpreadRevalidation;
+use super::setup::{Rows, Setup};
 use crate::TrackerError;
 
 pub(super) use super::candidates::LEAN_SCALE;
@@ -46,6 +46,9 @@ pub(super) struct Initialiser {
     /// The candidates of the last frame's joint initialisation, then those of its second search
     /// (capacity `4 · MAX_CANDIDATE_LINES`, never exceeded); empty on a frame without one.
     pub(super) found: Vec<InitCandidate>,
+    /// The period's re-validation spread over its frames (`track.revalidate_spread`, module
+    /// `revalidation`); `None` when it is off or cannot be spread.
+    spread: Option<SpreadRevalidation>,
 }
 
 impl Initialiser {
@@ -59,11 +62,49 @@ impl Initialiser {
             // The oriented vote's points: one class of the tallest region's pixels at most.
             hough.reserve_oriented_points(capacity);
         }
+        let t = &setup.cfg.track;
+        let spreads = t.revalidate_spread
+            && t.revalidate_every_frames >= 2
+            && setup.cfg.init.candidate_lines > 0
+            && setup.cfg.init.candidate_coverage;
         Ok(Initialiser {
             hough,
             index: CandidateIndex::new(setup, capacity),
             found: Vec::with_capacity(4 * MAX_CANDIDATE_LINES),
+            spread: spreads
+                .then(|| SpreadRevalidation::new(setup))
+                .transpose()?,
         })
+    }
+
+    /// Whether the period's re-validation is spread over its frames (module `revalidation`).
+    pub(super) fn spreads(&self) -> bool {
+        self.spread.is_some()
+    }
+
+    /// The spread re-validation's steps on the period's frame `since` of `every` (module
+    /// `revalidation`, `SpreadRevalidation::step`): `true` when the tracked pair is to be
+    /// re-validated whole on this frame; `false` without a spread re-validation.
+    #[allow(clippy::too_many_arguments)] // the stages it reads and writes, each named
+    pub(super) fn spread_step(
+        &mut self,
+        since: u64,
+        every: u64,
+        image: &GreyImage<'_>,
+        lanes: &Lanes,
+        setup: &Setup,
+        health: &mut Health,
+    ) -> Result<bool, TrackerError> {
+        let Initialiser {
+            hough,
+            index,
+            spread,
+            ..
+        } = self;
+        match spread {
+            Some(spread) => spread.step(since, every, image, lanes, hough, index, setup, health),
+            None => Ok(false),
+        }
     }
 
     /// Initialise the sides without an estimate in the ROI (or, both tracked, re-validate
@@ -197,192 +238,47 @@ impl Initialiser {
         vote: [bool; 2],
         weak: WeakLanes,
     ) {
-        const MAX_LINES: usize = MAX_CANDIDATE_LINES;
-        let none = HoughLine {
+        // The steps of module `joint`, all on this frame.
+        let pair = joint::weighed(lanes, setup);
+        let competes = joint::competes(&pair);
+        let mut gathered = Gathered::default();
+        let mut lines = [HoughLine {
             rho_px: 0.0,
             theta_rad: 0.0,
             votes: 0,
-        };
-        let n = setup.cfg.init.candidate_lines.min(MAX_LINES);
-        let (top, bottom) = rows;
-        let (yt, yb) = (top as f64, (bottom - 1) as f64);
-        let mut lines = [none; 2 * MAX_LINES];
-        let mut classes = [EdgeClass::LeftLane; 2 * MAX_LINES];
-        let mut chords = [Chord::default(); 2 * MAX_LINES + 2];
-        let mut found = [none; MAX_LINES];
-        let mut m = 0;
-        // This search's candidates follow those of an earlier search on the same frame.
-        let first = self.found.len();
-        // With re-validation on (`TrackConfig::revalidates`), a lane tracked from
-        // earlier frames competes with the candidates, weighed by its own row coverage: in a
-        // re-validation (both tracked) and when the other side is (re-)initialised. A lane
-        // initialised on this frame (the first search's, during the second search) is locked
-        // into the pair instead, as every tracked lane is with re-validation off.
-        // A lane tracked over the taller rows (`Lane::tracked_tall`) competes too, weighed on the
-        // ROI's rows, where its mark may not be: a candidate of the ROI for its side replaces
-        // it. (Locked instead, lanes of an earlier scene were kept: the stress test fell.)
-        let competes: [bool; 2] = Side::BOTH.map(|side| {
-            let lane = &lanes[side];
-            setup.cfg.track.revalidates()
-                && setup.cfg.init.candidate_coverage
-                && lane.has_estimate()
-                && !lane.initialised_now
-        });
-        let mut tracked_support = [0.0f64; 2];
+        }; MAX_CANDIDATE_LINES];
         for (band_side, _) in Side::BOTH.into_iter().zip(vote).filter(|&(_, votes)| votes) {
-            let (class, band) = (band_side.edge_class(), setup.band(band_side));
-            if !self
-                .index
-                .has(edges, class, setup.init_params.min_points, setup)
-            {
+            if !joint::prepare_band(
+                &mut self.index,
+                edges,
+                band_side,
+                &pair,
+                &mut gathered,
+                setup,
+                rows,
+            ) {
                 continue;
             }
-            if setup.cfg.init.candidate_coverage || setup.cfg.init.orientation_tolerance_deg > 0.0 {
-                self.index.sort_by_row(edges, class, setup);
-            }
-            if competes.contains(&true) {
-                // Each competing lane's coverage by this band's pixels; the better band counts
-                // (on a bend a boundary leans into the other band).
-                for ((support, lane), competing) in
-                    tracked_support.iter_mut().zip(lanes.iter()).zip(competes)
-                {
-                    if let (true, Some(f)) = (competing, lane.filter.as_ref()) {
-                        let p = Parabola::from_coeffs(f.coeffs());
-                        *support = support.max(self.index.row_coverage(&p, rows, setup));
-                    }
-                }
-            }
-            if setup.cfg.init.orientation_tolerance_deg <= 0.0 {
-                self.index.fill(edges, class, setup); // the plain vote's input
-            }
-            let (sep_deg, sep_px) = (
-                setup.cfg.init.candidate_separation_deg,
-                setup.cfg.init.candidate_separation_px,
+            let count =
+                joint::vote_band(&mut self.hough, &self.index, band_side, setup, &mut lines);
+            joint::fit_lines(
+                &self.index,
+                band_side,
+                &lines[..count],
+                &mut gathered,
+                setup,
+                rows,
             );
-            let tolerance_deg = setup.cfg.init.orientation_tolerance_deg;
-            let lines_found = if tolerance_deg > 0.0 {
-                self.hough.find_lines_oriented(
-                    &self.index.oriented,
-                    &band,
-                    tolerance_deg,
-                    sep_deg,
-                    sep_px,
-                    &mut found[..n],
-                )
-            } else {
-                self.hough.find_lines(
-                    &self.index.candidates,
-                    &band,
-                    sep_deg,
-                    sep_px,
-                    &mut found[..n],
-                )
-            };
-            let Ok(count) = lines_found else {
-                continue;
-            };
-            for line in &found[..count] {
-                // The candidate as a curve x(y): its LS parabola, or the Hough line itself.
-                let (p, support) = if setup.cfg.init.candidate_coverage {
-                    let Some(p) = self.index.row_fit(line, rows, setup) else {
-                        continue;
-                    };
-                    (p, self.index.row_coverage(&p, rows, setup))
-                } else {
-                    let (Some(x0), Some(x1)) = (line.col_at_row(0.0), line.col_at_row(1.0)) else {
-                        continue;
-                    };
-                    let p = Parabola {
-                        a1: 0.0,
-                        a2: x1 - x0,
-                        a3: x0,
-                    };
-                    (p, f64::from(line.votes))
-                };
-                let chord = Chord {
-                    col_top_px: p.col_at_row(yt),
-                    col_bottom_px: p.col_at_row(yb),
-                    support,
-                };
-                // Within capacity: at most MAX_LINES per band, two searches a frame.
-                self.found.push(InitCandidate {
-                    band: band_side,
-                    coeffs: [p.a1, p.a2, p.a3],
-                    support,
-                    chosen: None,
-                });
-                lines[m] = *line;
-                classes[m] = class;
-                chords[m] = chord;
-                m += 1;
-            }
         }
-        let s_max = chords[..m].iter().map(|c| c.support).fold(0.0, f64::max);
-        // Lanes with an estimate as chords after the candidates: a competing one with its row
-        // coverage counted `track.revalidate_keep_factor` times, unlocked; otherwise the first
-        // one, locked into the pair with the strongest support.
-        let mut locked = None;
-        let mut tracked_at = [None; 2];
-        for (i, lane) in lanes.iter().enumerate() {
-            let (true, Some(f)) = (lane.has_estimate(), lane.filter.as_ref()) else {
-                continue;
-            };
-            if !competes[i] && locked.is_some() {
-                continue;
-            }
-            let support = if competes[i] {
-                tracked_support[i] * setup.cfg.track.revalidate_keep_factor
-            } else {
-                s_max
-            };
-            chords[m] = f.chord(yt, yb, support);
-            tracked_at[i] = Some(m);
-            if !competes[i] {
-                locked = Some((m, i));
-            }
-            m += 1;
+        let choice = gathered.choose(&pair, setup, rows);
+        // This search's candidates follow those of an earlier search on the same frame
+        // (within capacity: at most `MAX_CANDIDATE_LINES` per band, two searches a frame).
+        let first = self.found.len();
+        self.found.extend_from_slice(gathered.candidates());
+        if choice.locked_moved {
+            return; // a locked lane the choice put on the other side: both left as they are
         }
-        // With tracked lanes competing, the pair gate's rules: the choice's 0.9 margin would
-        // refuse the tracked pair of a camera looking down and pair one of its lanes with
-        // clutter instead.
-        let ego_pair = if competes.contains(&true) {
-            setup.tracked_pair_rules()
-        } else {
-            setup.cfg.init.ego_pair
-        };
-        let choice = choose_ego_pair(
-            &chords[..m],
-            setup.width as f64,
-            yb - yt,
-            &ego_pair,
-            locked.map(|(j, _)| j),
-        );
-        // A locked lane the choice put on the other side: leave both as they are.
-        if let Some((j, i)) = locked
-            && [choice.left, choice.right][i] != Some(j)
-        {
-            return;
-        }
-        let picks = [choice.left, choice.right];
-        // The lane each pick lies on, if any: its own chord, or (a competing lane) a candidate
-        // within the tracking window of it at every ROI row — its own mark.
-        let owner = |j: usize| -> Option<usize> {
-            if let Some(k) = tracked_at.iter().position(|&t| t == Some(j)) {
-                return Some(k);
-            }
-            let c = self.found.get(first + j)?;
-            let p = Parabola::from_coeffs(c.coeffs);
-            (0..2).filter(|&k| competes[k]).find(|&k| {
-                // The lane's tracking window (wider on a double line: both its lines).
-                let lane = &lanes[Side::BOTH[k]];
-                let w = setup.window_half_width(lane, Pass::Tracking) as f64;
-                lane.filter.as_ref().is_some_and(|f| {
-                    (top..bottom)
-                        .all(|y| (p.col_at_row(y as f64) - f.col_at_row(y as f64)).abs() <= w)
-                })
-            })
-        };
-        let owners = picks.map(|p| p.and_then(owner));
+        let JointChoice { picks, owners, .. } = choice;
         // A competing lane the choice put on the other side: the camera crossed it (a lane
         // change), and it is that side's boundary now. It moves over with its filter; the lane
         // it replaces there is dropped unless the choice gives that side a candidate below.
@@ -399,8 +295,8 @@ impl Initialiser {
         for (side, pick) in Side::BOTH.into_iter().zip(picks) {
             let i = side.index();
             let Some(j) = pick else { continue };
-            // `init_candidates[first..]` holds the first candidates' chords in order.
-            if let Some(c) = self.found.get_mut(first + j) {
+            // `found[first..]` holds the candidates in the order of the chords.
+            if let Some(c) = self.found.get_mut(first + j).filter(|_| j < gathered.len) {
                 c.chosen = Some(side);
             }
             // A lane kept on its side (or just handed over to it), or a locked one.
@@ -408,10 +304,13 @@ impl Initialiser {
             if owners[i].is_some() || (replaced && !competes[i]) {
                 continue;
             }
-            if let Ok(init) = self
-                .index
-                .fit_chosen_line(edges, classes[j], lines[j], rows, setup)
-            {
+            if let Ok(init) = self.index.fit_chosen_line(
+                edges,
+                gathered.classes[j],
+                gathered.lines[j],
+                rows,
+                setup,
+            ) {
                 // The estimate a switch replaces is kept for the crossing gate, which restores
                 // it if it undoes the switch.
                 let lane = &lanes[side];

@@ -29,12 +29,14 @@ mod double_line;
 mod edges;
 mod gates;
 mod init;
+mod joint;
 mod kerb;
 mod lane;
 mod points;
 mod reach;
 mod report;
 mod resample;
+mod revalidation;
 mod road;
 mod setup;
 mod stripe_trace;
@@ -292,7 +294,8 @@ impl LaneTracker {
     /// angle bands (at most `init.candidate_lines` each), with their support and the side the
     /// choice gave them ([`InitCandidate`]). Empty when the last frame ran neither (both lanes
     /// tracked between re-validations, or `init.candidate_lines = 0`, the paper's one line per
-    /// band).
+    /// band), and on the frames of a re-validation spread over its period
+    /// (`track.revalidate_spread`: its candidates are of the period's first frame).
     pub fn init_candidates(&self) -> &[InitCandidate] {
         if self.frame.resamples() {
             self.frame.candidates()
@@ -437,9 +440,10 @@ impl LaneTracker {
             &self.setup,
             &mut self.health,
         );
-        // II. (Re-)initialisation, or a re-validation of the tracked pair.
+        // II. (Re-)initialisation, or a re-validation of the tracked pair (whole, or a step of
+        // one spread over the period's frames: module `revalidation`).
         let need_init = self.lanes.iter().any(|l| !l.has_estimate());
-        let revalidate = !need_init && self.revalidation_due();
+        let revalidate = !need_init && self.revalidation_due(&image)?;
         self.health.counters.revalidations += u64::from(revalidate);
         self.health.frames_since_full_gradient = if need_init || revalidate {
             0
@@ -489,21 +493,36 @@ impl LaneTracker {
         Ok(need_init || revalidate)
     }
 
-    /// Whether the tracked pair is re-validated on this frame (`track.revalidate_every_frames`,
+    /// Whether the tracked pair is re-validated whole on this frame (`track.revalidate_every_frames`,
     /// `track.revalidate_below_points`; joint initialisation weighing its candidates by row
     /// coverage only): the joint initialisation runs over the ROI and the tracked lanes compete
     /// with its candidates — every `revalidate_every_frames` frames, and at once on a frame a
-    /// lane's window gave fewer than `revalidate_below_points` points.
-    fn revalidation_due(&self) -> bool {
+    /// lane's window gave fewer than `revalidate_below_points` points. With the period's
+    /// re-validation spread over its frames (`track.revalidate_spread`), this frame's steps of
+    /// it, and `true` only on the period's last frame when its choice would change a lane
+    /// (module `revalidation`).
+    fn revalidation_due(&mut self, image: &GreyImage<'_>) -> Result<bool, TrackerError> {
         let cfg = &self.setup.cfg;
         let every = u64::from(cfg.track.revalidate_every_frames);
         let weak = self
             .lanes
             .iter()
             .any(|l| l.points_now < cfg.track.revalidate_below_points);
-        cfg.init.candidate_lines > 0
-            && cfg.init.candidate_coverage
-            && ((every > 0 && self.health.frames_since_full_gradient + 1 >= every) || weak)
+        if !(cfg.init.candidate_lines > 0 && cfg.init.candidate_coverage) {
+            return Ok(false);
+        }
+        let since = self.health.frames_since_full_gradient;
+        if weak || every == 0 || !self.init.spreads() {
+            return Ok(weak || (every > 0 && since + 1 >= every));
+        }
+        self.init.spread_step(
+            since,
+            every,
+            image,
+            &self.lanes,
+            &self.setup,
+            &mut self.health,
+        )
     }
 
     /// III. One frame of the lane on `side` in its windows (over its rows, `Setup::rows_of`):

@@ -142,8 +142,10 @@ impl LaneReport {
 pub struct TrackReport {
     /// Left then right.
     pub lanes: [LaneReport; 2],
-    /// `true` if the full region of interest went through the gradient (an initialisation was
-    /// attempted); `false` on a pure tracking frame (gradient inside the windows only).
+    /// `true` if the full region of interest went through the gradient for an initialisation or
+    /// a whole re-validation on this frame's edges; `false` on a tracking frame (gradient inside
+    /// the windows), also on the frames of a re-validation spread over its period
+    /// (`track.revalidate_spread`), the first of which puts the ROI through the gradient for it.
     pub full_gradient: bool,
     /// The road region the frame was searched in.
     pub road: RoadReport,
@@ -245,7 +247,8 @@ pub struct TrackerCounters {
     pub gated_pairs: u64,
     /// Re-validations (`track.revalidate_every_frames`, `track.revalidate_below_points`):
     /// frames on which the tracked pair was weighed against a fresh initialisation's
-    /// candidates.
+    /// candidates; a re-validation spread over its period (`track.revalidate_spread`) counts
+    /// once, on the period's last frame (also when it re-validates whole there).
     pub revalidations: u64,
     /// Tracked lanes the joint choice replaced by a candidate off their mark (with
     /// re-validation on: in a re-validation, or when the other side was initialised again),

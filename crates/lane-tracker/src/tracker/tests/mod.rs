@@ -20,6 +20,7 @@ mod failures;
 mod gates;
 mod init;
 mod readings;
+mod revalidation;
 mod scenes;
 mod second_search;
 mod stripe_trace;
