@@ -70,12 +70,15 @@ impl AxisTaps {
                     map.start_px + s * j as f64,
                     map.start_px + s * (j + 1) as f64,
                 );
-                let (first, end) = (clamp(lo.floor()), clamp((hi - 1e-9).ceil() - 1.0) + 1);
+                // Every `i` of the loop has `⌊lo⌋ ≤ i < hi`, so `clamp(i)` lies in `[first, end)`.
+                let (first, end) = (clamp(lo.floor()), clamp(hi.ceil() - 1.0) + 1);
                 self.weights.resize(base + end.max(first + 1) - first, 0.0);
                 let mut i = lo.floor();
                 while i < hi {
                     let overlap = (hi.min(i + 1.0) - lo.max(i)).max(0.0);
-                    self.weights[base + clamp(i) - first] += (overlap / s) as f32;
+                    if let Some(w) = self.weights.get_mut(base + clamp(i).saturating_sub(first)) {
+                        *w += (overlap / s) as f32;
+                    }
                     i += 1.0;
                 }
                 self.first.push(first);
@@ -249,6 +252,37 @@ mod tests {
                 let sum: f32 = w.iter().sum();
                 assert!((sum - 1.0).abs() < 1e-5, "{n}→{m}, pixel {j}: {sum}");
                 assert!(first + w.len() <= n, "{n}→{m}, pixel {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn taps_for_any_scale_and_start_stay_inside_and_sum_to_one() {
+        // A lattice of scales and starts, the rows' views of a found road's bottom among them
+        // (a scale of 1.0000000001 once put a tap one past its run).
+        let (n, m) = (180usize, 172usize);
+        let mut scales: Vec<f64> = (0..120).map(|k| 0.5 + 0.037 * k as f64).collect();
+        scales.extend([1.0 + 1e-10, 1.0 - 1e-10, 180.0 / 172.0, 4.0 / 3.0]);
+        for &s in &scales {
+            for start in [0.0, -3.25, 7.5, 1e-9] {
+                let t = AxisTaps::new(
+                    n,
+                    m,
+                    AxisMap {
+                        scale: s,
+                        start_px: start,
+                    },
+                    s,
+                );
+                for j in 0..m {
+                    let (first, w) = t.of(j);
+                    let sum: f32 = w.iter().sum();
+                    assert!(
+                        (sum - 1.0).abs() < 1e-4,
+                        "s {s}, start {start}, pixel {j}: {sum}"
+                    );
+                    assert!(first + w.len() <= n, "s {s}, start {start}, pixel {j}");
+                }
             }
         }
     }
