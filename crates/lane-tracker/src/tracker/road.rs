@@ -25,7 +25,10 @@
 //! [`MIN_BONNET_ROWS`] of the height) hold at most [`MAX_LANE_EDGES_BELOW`] lane-like edges per
 //! pixel — a road's marks alone give about 1 % (four edges a row over 320 columns), its texture
 //! more. The road's bottom is the boundary row with the widest cover (the highest among equals),
-//! two rows above it; the frame's last row when no row qualifies.
+//! [`BOUNDARY_HALF_ROWS`] rows above it. Without such a boundary, a run of at least
+//! [`MIN_FLAT_ROWS`] of the height at the bottom whose rows hold no edge of either kind (at most
+//! [`MAX_FLAT_EDGES`] per column: a flat fill, a black band, a smooth bonnet whose edge is faint)
+//! is no road either, and the road ends at its top; else the road reaches the frame's last row.
 //!
 //! Carried over a sequence: found again only on frames where neither lane has an estimate (a
 //! view that changed under a tracked lane would move it), averaged with the last when the two
@@ -46,6 +49,10 @@ pub(crate) const MIN_BONNET_ROWS: f64 = 0.04;
 pub(crate) const MAX_LANE_EDGES_BELOW: f64 = 0.0015;
 /// Two bottoms within this fraction of the height are the same one seen again.
 pub(crate) const SAME_BOTTOM_FRACTION: f64 = 0.05;
+/// Fewest rows of a flat run at the bottom with no boundary above it, as a fraction of the height.
+pub(crate) const MIN_FLAT_ROWS: f64 = 0.06;
+/// Most edges of either kind per column in a row of a flat run.
+pub(crate) const MAX_FLAT_EDGES: f64 = 0.003;
 /// Rows either side of a row whose horizontal edges count for it.
 const BOUNDARY_HALF_ROWS: usize = 4;
 
@@ -159,7 +166,24 @@ impl RoadFinder {
                 best = Some((self.cover[y], y));
             }
         }
-        best.map(|(_, y)| y.saturating_sub(BOUNDARY_HALF_ROWS))
+        if let Some((_, y)) = best {
+            return Some(y.saturating_sub(BOUNDARY_HALF_ROWS));
+        }
+        // No boundary: a run of rows at the bottom with no edge of either kind (a flat fill,
+        // a black band, a smooth bonnet whose edge is faint) is no road either.
+        let flat_rows = ((MIN_FLAT_ROWS * h as f64).ceil() as usize).max(3);
+        let mut top = last;
+        for y in (first..last).rev() {
+            let horizontal: u32 = self.horizontal[y * words..(y + 1) * words]
+                .iter()
+                .map(|b| b.count_ones())
+                .sum();
+            if f64::from(horizontal + self.lane_edges[y]) > MAX_FLAT_EDGES * w as f64 {
+                break;
+            }
+            top = y;
+        }
+        (last - top >= flat_rows).then_some(top)
     }
 }
 
@@ -240,6 +264,17 @@ mod tests {
     fn a_road_down_to_the_last_row_has_no_bottom() {
         assert_eq!(find(&road(0)), None);
         assert_eq!(find(&road(30)), None);
+    }
+
+    #[test]
+    fn a_flat_band_at_the_bottom_ends_the_road_without_a_boundary() {
+        // The bottom 20 rows one flat grey the road's own (no edge at the seam), and a road
+        // whose marks reach the last row: only the first has a bottom.
+        let mut img = road(0);
+        img[160 * W..].fill(110);
+        let b = find(&img).expect("a flat band found");
+        assert!((155.0..=161.0).contains(&b), "bottom {b}");
+        assert_eq!(find(&road(0)), None);
     }
 
     #[test]
