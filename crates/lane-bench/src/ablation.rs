@@ -72,6 +72,13 @@ pub fn mechanisms() -> Vec<Mechanism> {
             others: &[],
         },
         Mechanism {
+            name: "the road's bottom found",
+            keys: "roi.road_bottom",
+            off: value!("frame", |c| c.roi.road_bottom =
+                lane_tracker::RoadBottom::Frame),
+            others: &[],
+        },
+        Mechanism {
             name: "bright-stripe pairing",
             keys: "gradient.stripe_max_width_px, stripe_paired_votes",
             // (The kerb's foot and the stripe trace read up to the stripe width: off with it.)
@@ -225,6 +232,12 @@ pub fn mechanisms() -> Vec<Mechanism> {
                 value!("every 5", |c| c.track.revalidate_every_frames = 5),
                 value!("keep factor 2", |c| c.track.revalidate_keep_factor = 2.0),
             ],
+        },
+        Mechanism {
+            name: "re-validation spread over its period",
+            keys: "track.revalidate_spread",
+            off: value!("whole", |c| c.track.revalidate_spread = false),
+            others: &[],
         },
     ]
 }
