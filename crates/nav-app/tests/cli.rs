@@ -99,7 +99,29 @@ fn json_is_one_object_per_frame_with_the_documented_schema() {
         // The documented fields, no more (docs/json.md, lane_io::lane_frame::LaneFrame), schema 1.
         let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
         keys.sort_unstable();
-        assert_eq!(keys, ["frame", "lanes", "schema", "t_s", "track_us"]);
+        assert_eq!(
+            keys,
+            ["frame", "lanes", "road", "schema", "t_s", "track_us"]
+        );
+        let mut road: Vec<&str> = v["road"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(String::as_str)
+            .collect();
+        road.sort_unstable();
+        assert_eq!(
+            road,
+            [
+                "bottom_row_px",
+                "horizon_row_px",
+                "refused",
+                "search_rows_px"
+            ]
+        );
+        // A rendered road down to the last row, both lanes closing in upwards.
+        assert_eq!(v["road"]["bottom_row_px"], 240.0);
+        assert!(v["road"]["horizon_row_px"].as_f64().unwrap() < 240.0);
         assert_eq!(v["schema"], 1);
         assert!(v["track_us"].as_f64().unwrap() > 0.0);
         assert_eq!(v["frame"].as_u64(), Some(i as u64));
@@ -116,7 +138,15 @@ fn json_is_one_object_per_frame_with_the_documented_schema() {
             keys.sort_unstable();
             assert_eq!(
                 keys,
-                ["coeffs", "initialised", "points", "rows", "side", "state"]
+                [
+                    "coeffs",
+                    "far",
+                    "initialised",
+                    "points",
+                    "rows",
+                    "side",
+                    "state"
+                ]
             );
         }
         assert_eq!(lanes[0]["side"], "left");
