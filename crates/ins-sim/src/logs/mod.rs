@@ -100,6 +100,7 @@ mod reference;
 mod replay;
 mod request;
 mod sightings;
+mod spans;
 mod write;
 
 pub use align::*;
@@ -111,4 +112,5 @@ pub use reference::*;
 pub use replay::*;
 pub use request::*;
 pub use sightings::*;
+pub use spans::*;
 pub use write::*;
