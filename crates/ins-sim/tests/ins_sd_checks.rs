@@ -215,11 +215,14 @@ fn an_imu_log_that_starts_long_after_the_start_is_refused_with_the_spans() {
     let dir = temp_dir("imu-late");
     write_imu(&dir.join("imu.csv"), 100.0, 10.0, at_rest);
     write_reference(&dir.join("truth.csv"), 0.0, 20.0, 0.0);
+    let sightings = write_sightings(&dir, &dir.join("truth.csv"), 0.0);
     let text = expect_spans(
-        run(&dir, &request(&dir, None)),
+        run(&dir, &request(&dir, Some(sightings))),
         "the first IMU sample after the start of the replay (t = 0.000 s) comes 100.010 s later",
     );
     assert!(text.contains("t = 100.010–110.000 s (1000 rows)"), "{text}");
+    // The sightings' whole span, though the replay stopped before the first.
+    assert!(text.contains("t = 1.000–20.000 s (80 rows)"), "{text}");
 }
 
 /// The second trap: sightings on another clock made `--filter kf` an unaided run

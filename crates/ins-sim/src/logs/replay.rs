@@ -450,6 +450,9 @@ pub fn replay(
                 imu_rows += 1;
                 imu_last_s = r.t_s;
             }
+            if let Some(s) = run.sightings.as_mut() {
+                run.summary.unused.sightings_after_end = s.drain()?;
+            }
             let problem = format!(
                 "the inputs do not overlap in time: the first IMU sample after the start of the replay (t = {:.3} s) comes {dt:.3} s later, more than the {max_gap_s} s bridged (max_gap_s)",
                 init.t_s
