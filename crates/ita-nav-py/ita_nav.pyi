@@ -183,9 +183,12 @@ def replay(
     max_gap_s: float = 5.0,
     rate_hz: Optional[float] = None,
     imu_topic: Optional[str] = None,
+    allow_unaided: bool = False,
 ) -> dict:
     """Replay an IMU log as `nav-app ins` does; returns imu_samples, epochs, sightings_used,
-    sightings_rejected, gaps, longest_gap_s, end_t_s and, with truth, metrics (as --metrics-json)."""
+    sightings_rejected, gaps, longest_gap_s, end_t_s and, with truth, metrics (as --metrics-json).
+    Inputs that do not overlap in time, a filter that used no sighting (unless allow_unaided) and
+    an alignment (align_s) away from rest raise NavError naming the files and their spans."""
 
 def write_sightings(
     reference: str,

@@ -151,6 +151,39 @@ pub enum SimError {
         /// What was needed.
         what: &'static str,
     },
+    /// A static alignment (`--align-s`) over a window where the vehicle is not at rest
+    /// ([`crate::logs::align_at_rest`]): the measured quantity and the filter file's limit.
+    #[error(
+        "{}: the vehicle is not at rest over the alignment window t = {t0_s:.3}–{t1_s:.3} s: {quantity} {measured:.4} {unit}, above the filter file's align.{field} = {limit} {unit}; align on a period at rest, or start moving without --align-s (the initial attitude from the reference)",
+        path.display()
+    )]
+    NotAtRest {
+        /// The IMU log.
+        path: PathBuf,
+        /// Start of the window, s.
+        t0_s: f64,
+        /// End of the window, s.
+        t1_s: f64,
+        /// What was measured (`the gyro's spread … is`).
+        quantity: &'static str,
+        /// Its value, in `unit`.
+        measured: f64,
+        /// The limit, in `unit`.
+        limit: f64,
+        /// The filter file's key in `[align]`.
+        field: &'static str,
+        /// The unit of `measured` and `limit`.
+        unit: &'static str,
+    },
+    /// The inputs of a replay do not overlap in time, or a filter applied no sighting: what is
+    /// wrong, and each input file with its time span ([`crate::logs::replay`]).
+    #[error("{problem}; {}", crate::logs::InputSpan::list(spans))]
+    InputSpans {
+        /// What is wrong.
+        problem: String,
+        /// The inputs: the IMU log, the reference, the sightings.
+        spans: Vec<crate::logs::InputSpan>,
+    },
     /// The settings of a filter file make a filter configuration the filter refuses
     /// ([`crate::filter_file::FilterFile::filter_config`]).
     #[error("filter file")]

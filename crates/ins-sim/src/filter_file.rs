@@ -24,7 +24,39 @@
 //! phi_subintervals = 2
 //! feedback_from_s = 0.0      # open loop for this long after the start, then feedback
 //! akf_window = 10            # Mohamed–Schwarz window N (updates)
+//! [align]                    # the rest check of --align-s (defaults shown; no preset sets them)
+//! max_accel_spread_mps2 = 0.05     # accelerometer: largest per-axis std of its 1-s means, m/s²
+//! max_gyro_spread_deg_per_s = 0.25 # gyro: the same, °/s
+//! max_speed_mps = 0.3              # the reference's largest speed over the window, m/s
 //! ```
+//!
+//! ## The rest check of a static alignment (`[align]`)
+//!
+//! `--align-s S` takes the gyro bias (and without a reference attitude, roll and pitch) from the
+//! first S seconds, which is right only if the vehicle is at rest then
+//! ([`crate::logs::align_at_rest`]). The window is cut into 1-s blocks and the standard
+//! deviation of the block means is taken per axis: a 1-s mean averages out the sensor's white
+//! noise and the engine's or rotors' vibration (tens of hertz and up), which leave the mean
+//! bias unchanged, and keeps what a moving vehicle does over seconds — turns, accelerating,
+//! braking — which would be taken as bias and tilt. The defaults:
+//!
+//! - `max_accel_spread_mps2 = 0.05`: three times the σ of a 1-s mean of white noise at the `mems`
+//!   preset's (ten-fold inflated) 1 m/s/√h, 1/60 m/s² = 0.017 m/s². Measured on the shared real
+//!   logs: 0.007 m/s² (EuRoC MH_01 at rest, rotors stirring at the end) and 0.019 m/s² (a car at
+//!   rest, engine running) over their alignment windows; 0.11–1.6 m/s² over any 10–30 s window
+//!   of the car driving or the MAV flying.
+//! - `max_gyro_spread_deg_per_s = 0.25`: 1.5 σ of a 1-s mean at the `mems` preset's
+//!   10 °/√h (0.17 °/s), half the preset's turn-on bias σ (0.5 °/s): motion that moves the 1-s
+//!   means by more than this would bias the estimate by as much as the filter's prior allows.
+//!   Measured: 0.035 and 0.052 °/s at rest, 0.37–18 °/s driving or flying.
+//! - `max_speed_mps = 0.3` (with a reference): three times a standard GNSS receiver's velocity
+//!   noise (about 0.1 m/s 1σ); a fifth of walking pace. Measured at rest: 0.03 m/s (EuRoC's
+//!   laser tracker), 0.055 m/s (RTK); the issue's moving car: 8–11 m/s.
+//!
+//! A vehicle that turns at a constant rate at constant speed passes the spread checks (its
+//! 1-s means do not vary): without a reference nothing in the IMU alone tells that from a bias.
+//! A vehicle that is moving at the start is not aligned: leave out `--align-s` and take the
+//! initial attitude from the reference (its quaternion, or its course and grade).
 //!
 //! ## From datasheet figures to the filter's densities
 //!
@@ -111,6 +143,14 @@ struct FilterSection {
     akf_window: Option<usize>,
 }
 
+#[derive(Clone, Copy, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AlignSection {
+    max_accel_spread_mps2: Option<f64>,
+    max_gyro_spread_deg_per_s: Option<f64>,
+    max_speed_mps: Option<f64>,
+}
+
 #[derive(Clone, Debug, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawFile {
@@ -123,6 +163,8 @@ struct RawFile {
     sighting: SightingSection,
     #[serde(default)]
     filter: FilterSection,
+    #[serde(default)]
+    align: AlignSection,
 }
 
 macro_rules! overlay {
@@ -160,6 +202,13 @@ impl RawFile {
             phi_subintervals,
             feedback_from_s,
             akf_window
+        );
+        overlay!(
+            self.align,
+            o.align,
+            max_accel_spread_mps2,
+            max_gyro_spread_deg_per_s,
+            max_speed_mps
         );
     }
 }
@@ -201,6 +250,13 @@ pub struct FilterFile {
     pub feedback_from_s: f64,
     /// Mohamed–Schwarz window, updates.
     pub akf_window: usize,
+    /// Rest check of `--align-s`: largest per-axis standard deviation of the accelerometer's
+    /// 1-s means, m/s² (module documentation).
+    pub align_max_accel_spread_mps2: f64,
+    /// Likewise for the gyro, °/s.
+    pub align_max_gyro_spread_deg_per_s: f64,
+    /// The reference's largest speed over the window, m/s.
+    pub align_max_speed_mps: f64,
 }
 
 fn toml_err(path: &str, error: toml_config::TomlError) -> SimError {
@@ -255,7 +311,8 @@ impl FilterFile {
             )
         };
         let get = |v: Option<f64>, key: &'static str| v.ok_or_else(|| missing(key));
-        let (i, n, s, f) = (raw.imu, raw.initial, raw.sighting, raw.filter);
+        let (i, n, s, f, a) = (raw.imu, raw.initial, raw.sighting, raw.filter, raw.align);
+        let defaults = crate::logs::AlignLimits::default();
         let out = FilterFile {
             gyro_arw_deg_per_rt_h: get(i.gyro_arw_deg_per_rt_h, "imu.gyro_arw_deg_per_rt_h")?,
             accel_vrw_mps_per_rt_h: get(i.accel_vrw_mps_per_rt_h, "imu.accel_vrw_mps_per_rt_h")?,
@@ -289,6 +346,13 @@ impl FilterFile {
                 .ok_or_else(|| missing("filter.phi_subintervals"))?,
             feedback_from_s: get(f.feedback_from_s, "filter.feedback_from_s")?,
             akf_window: f.akf_window.ok_or_else(|| missing("filter.akf_window"))?,
+            align_max_accel_spread_mps2: a
+                .max_accel_spread_mps2
+                .unwrap_or(defaults.max_accel_spread_mps2),
+            align_max_gyro_spread_deg_per_s: a
+                .max_gyro_spread_deg_per_s
+                .unwrap_or(defaults.max_gyro_spread_deg_per_s),
+            align_max_speed_mps: a.max_speed_mps.unwrap_or(defaults.max_speed_mps),
         };
         let bad = |key: &str, requirement: &str, value: String| {
             toml_err(
@@ -339,6 +403,17 @@ impl FilterFile {
             ("sighting.sigma_m", out.sighting_sigma_m, true),
             ("filter.update_period_s", out.update_period_s, true),
             ("filter.feedback_from_s", out.feedback_from_s, false),
+            (
+                "align.max_accel_spread_mps2",
+                out.align_max_accel_spread_mps2,
+                true,
+            ),
+            (
+                "align.max_gyro_spread_deg_per_s",
+                out.align_max_gyro_spread_deg_per_s,
+                true,
+            ),
+            ("align.max_speed_mps", out.align_max_speed_mps, true),
         ] {
             let ok = v.is_finite() && if strictly { v > 0.0 } else { v >= 0.0 };
             if !ok {
@@ -370,6 +445,15 @@ impl FilterFile {
             ));
         }
         Ok(out)
+    }
+
+    /// The rest check of `--align-s` (section `[align]`).
+    pub fn align_limits(&self) -> crate::logs::AlignLimits {
+        crate::logs::AlignLimits {
+            max_accel_spread_mps2: self.align_max_accel_spread_mps2,
+            max_gyro_spread_deg_per_s: self.align_max_gyro_spread_deg_per_s,
+            max_speed_mps: self.align_max_speed_mps,
+        }
     }
 
     /// The continuous densities (module documentation).

@@ -55,10 +55,8 @@ fn replay(
     let initial = logs::initial_from_reference(&reference, start, 1.0).unwrap();
     let mut imu = logs::ImuLog::new(d.join("imu.csv"), None);
     let step = imu.nominal_step_s().unwrap();
-    let config = FilterFile::preset(preset)
-        .unwrap()
-        .filter_config(mode, step, initial.t_s)
-        .unwrap();
+    let file = FilterFile::preset(preset).unwrap();
+    let config = file.filter_config(mode, step, initial.t_s).unwrap();
     let level = reference.iter().any(|r| r.att_b_to_n.is_none());
     let inputs = ReplayInputs {
         imu,
@@ -68,8 +66,10 @@ fn replay(
         config,
         max_gap_s: 5.0,
         rate: SolutionRate::Hz(1.0),
-        reference: Some(reference),
+        reference: Some((d.join("truth.csv"), reference)),
         align_s: set.align_s,
+        align_limits: file.align_limits(),
+        allow_unaided: false,
         level,
         mcap_out: None,
     };

@@ -30,6 +30,8 @@ fn inputs(dir: &Path, mode: Mode) -> ReplayInputs {
         rate: SolutionRate::Epochs,
         reference: None,
         align_s: 0.0,
+        align_limits: logs::AlignLimits::default(),
+        allow_unaided: false,
         level: false,
         mcap_out: None,
     }
@@ -405,17 +407,24 @@ fn a_replay_reads_its_imu_log_once() {
     let sc = Scenario::paper_default().truncated(20.0).unwrap();
     let dir = temp_dir("once");
     logs::export_run(&sc, Mode::Kf, 4, &dir).unwrap();
-    let request = |dir: &Path, imu: PathBuf| logs::ReplayRequest {
+    // The simulated aircraft flies: the rest check is opened wide, for the read-ahead to be
+    // exercised (the check itself: tests/ins_sd_checks.rs).
+    let mut flying = FilterFile::preset("paper").unwrap();
+    flying.align_max_speed_mps = 1e3;
+    flying.align_max_gyro_spread_deg_per_s = 1e3;
+    flying.align_max_accel_spread_mps2 = 1e3;
+    let request = move |dir: &Path, imu: PathBuf| logs::ReplayRequest {
         imu,
         imu_topic: None,
         sightings: Some((dir.join(names::SIGHTINGS), dir.join(names::LANDMARKS))),
         initial: Some(dir.join(names::INITIAL)),
         reference: Some(dir.join(names::TRUTH)),
         start_s: None,
-        settings: logs::FilterSettings::File(FilterFile::preset("paper").unwrap()),
+        settings: logs::FilterSettings::File(flying),
         mode: Mode::Kf,
         gate: None,
-        align_s: 1.0,
+        align_s: 2.0,
+        allow_unaided: false,
         max_gap_s: 1.0,
         rate: SolutionRate::EveryImu,
         mcap_out: None,

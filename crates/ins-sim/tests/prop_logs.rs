@@ -210,6 +210,8 @@ fn replay_with(which: &str, bytes: &[u8], case_dir: &Path) -> (Vec<PathBuf>, Res
         rate: SolutionRate::Epochs,
         reference: None,
         align_s: 0.0,
+        align_limits: logs::AlignLimits::default(),
+        allow_unaided: false,
         level: false,
         mcap_out: None,
     };

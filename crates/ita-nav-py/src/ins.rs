@@ -448,10 +448,11 @@ pub fn monte_carlo<'py>(
 /// (with `landmarks`) or unaided (`filter="none"`), the initial state from `initial` or from the
 /// reference `truth` at `start_s`, the filter settings from `filter_file` or `preset` (default
 /// mems), an optional static alignment `align_s`, solution rows into `out` at `rate_hz` (None:
-/// every sample). Returns the summary, and with `truth` the metrics (`position_m`,
+/// every sample); a filter that used no sighting is refused unless `allow_unaided`. Returns the
+/// summary, and with `truth` the metrics (`position_m`,
 /// `velocity_mps`, `attitude_rad`, `nees_per_dof`, `nis_per_dof`, … as in `--metrics-json`).
 #[pyfunction]
-#[pyo3(signature = (imu, out, sightings=None, landmarks=None, initial=None, truth=None, start_s=None, filter="kf", filter_file=None, preset=None, gate=None, align_s=0.0, max_gap_s=5.0, rate_hz=None, imu_topic=None))]
+#[pyo3(signature = (imu, out, sightings=None, landmarks=None, initial=None, truth=None, start_s=None, filter="kf", filter_file=None, preset=None, gate=None, align_s=0.0, max_gap_s=5.0, rate_hz=None, imu_topic=None, allow_unaided=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn replay<'py>(
     py: Python<'py>,
@@ -470,6 +471,7 @@ pub fn replay<'py>(
     max_gap_s: f64,
     rate_hz: Option<f64>,
     imu_topic: Option<&str>,
+    allow_unaided: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = logs::ReplayRequest {
         imu: imu.into(),
@@ -482,6 +484,7 @@ pub fn replay<'py>(
         mode: mode_of(filter)?,
         gate: gate.map(|p| (p != 0.0).then_some(p)),
         align_s,
+        allow_unaided,
         max_gap_s,
         rate: rate_hz.map_or(logs::SolutionRate::EveryImu, logs::SolutionRate::Hz),
         mcap_out: None,

@@ -125,6 +125,11 @@ impl MetricsAcc {
         }
     }
 
+    /// The reference rows.
+    pub(super) fn reference(&self) -> &[ReferenceRow] {
+        &self.reference
+    }
+
     /// Compares the filter at its time with the reference, once per reference row passed.
     pub(super) fn observe(&mut self, filter: &InsSdFilter) {
         let t = filter.time_s();

@@ -32,7 +32,9 @@
 //! spans it is cut there), gaps are bridged ([`GAP_FACTOR`]), the solution is written at the
 //! requested rate and compared with a reference on the way ([`ReplayMetrics`]); an optional
 //! static alignment ([`align_at_rest`]) takes the gyro bias (and without a reference attitude,
-//! roll and pitch) from a rest period. [`ReplayRequest`] turns what a user gives (`nav-app ins`,
+//! roll and pitch) from a rest period, after checking the rest ([`AlignLimits`]). Inputs that do
+//! not overlap in time, and a filter that used no sighting unless allowed, are refused naming
+//! each file's span ([`InputSpan`]); the rows not used are counted ([`UnusedRows`]). [`ReplayRequest`] turns what a user gives (`nav-app ins`,
 //! the Python package) into [`ReplayInputs`]. Every malformed field, short line or filter
 //! rejection is an error naming the file, the line (1-based) and the column (1-based start of
 //! the field).
@@ -100,6 +102,7 @@ mod reference;
 mod replay;
 mod request;
 mod sightings;
+mod spans;
 mod write;
 
 pub use align::*;
@@ -111,4 +114,5 @@ pub use reference::*;
 pub use replay::*;
 pub use request::*;
 pub use sightings::*;
+pub use spans::*;
 pub use write::*;

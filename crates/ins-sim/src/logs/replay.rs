@@ -10,6 +10,15 @@
 //! previous one is a **gap**: it is bridged by propagating its mean rates in nominal steps (the
 //! covariance grows with the model's Q over the gap), counted and reported, and refused only
 //! when longer than `max_gap_s`.
+//!
+//! ## Inputs that cannot be right
+//!
+//! The IMU log, the reference and the sightings must overlap in time: a replay is refused
+//! ([`SimError::InputSpans`], naming each file with its first and last stamp) when no IMU
+//! sample follows the start, when the first one after the start comes later than `max_gap_s`,
+//! when no reference row falls inside the replay (after the start, up to the IMU's last
+//! sample), and when a filter with sightings used none of them, unless
+//! [`ReplayInputs::allow_unaided`]. Every input row not used is counted ([`UnusedRows`]).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -18,12 +27,13 @@ use ins_errors::strapdown::NavState;
 use ins_sd_filter::{InsSdFilter, InsSdFilterConfig, PointedSighting, Sighting};
 use nalgebra::Vector3;
 
-use super::align::{Alignment, align_at_rest};
+use super::align::{AlignLimits, Alignment, align_at_rest};
 use super::csv::{CsvReader, Record, io_err};
 use super::imu::ImuLog;
 use super::metrics::{MetricsAcc, ReplayMetrics};
 use super::read::{InitialState, read_landmarks};
 use super::reference::ReferenceRow;
+use super::spans::{InputSpan, UnusedRows};
 use super::write::write_solution;
 use super::{POINTED_SIGHTINGS_HEADER, SIGHTINGS_HEADER, SOLUTION_HEADER};
 use crate::SimError;
@@ -60,12 +70,16 @@ pub struct ReplayInputs {
     pub max_gap_s: f64,
     /// When solution rows are written.
     pub rate: SolutionRate,
-    /// Reference trajectory for [`ReplayMetrics`].
-    pub reference: Option<Vec<ReferenceRow>>,
+    /// Reference trajectory (the file, named in errors, and its rows) for [`ReplayMetrics`].
+    pub reference: Option<(PathBuf, Vec<ReferenceRow>)>,
     /// Static alignment: the vehicle is at rest for this long after the initial time, s (0:
-    /// none). The mean angular rate over it, less the Earth rate, is the initial gyro bias
-    /// ([`align_at_rest`]).
+    /// none). The rest is checked against `align_limits`; the mean angular rate over it, less
+    /// the Earth rate, is the initial gyro bias ([`align_at_rest`]).
     pub align_s: f64,
+    /// The rest check of the static alignment.
+    pub align_limits: AlignLimits,
+    /// A filter with sightings that used none of them is an error unless this is set.
+    pub allow_unaided: bool,
     /// With `align_s`: also take roll and pitch from the mean specific force (keeping the
     /// initial heading): for an initial attitude that did not come from a reference attitude.
     pub level: bool,
@@ -79,16 +93,18 @@ pub struct ReplayInputs {
 pub struct ReplaySummary {
     /// IMU samples propagated.
     pub imu_samples: u64,
-    /// IMU samples at or before the initial time, skipped.
-    pub imu_skipped: u64,
+    /// Start of the replay (the initial state's time), s.
+    pub start_t_s: f64,
+    /// The input files and their time spans (IMU log, reference, sightings).
+    pub spans: Vec<InputSpan>,
+    /// Input rows not used, by reason.
+    pub unused: UnusedRows,
     /// Sighting epochs applied.
     pub epochs: u64,
     /// Sightings used.
     pub sightings_used: u64,
     /// Sightings rejected by the gate.
     pub sightings_rejected: u64,
-    /// Sightings at or before the initial time, skipped.
-    pub sightings_skipped: u64,
     /// True when the sightings were offsets (format 1): meaningful only to the filter that
     /// pointed the device.
     pub offset_sightings: bool,
@@ -117,6 +133,8 @@ struct SightingStream {
     offsets: Vec<Sighting>,
     directions: Vec<PointedSighting>,
     last_epoch_s: f64,
+    first_t_s: Option<f64>,
+    rows: u64,
 }
 
 impl SightingStream {
@@ -124,7 +142,7 @@ impl SightingStream {
         let (mut reader, which) =
             CsvReader::open_any(path, &[SIGHTINGS_HEADER, POINTED_SIGHTINGS_HEADER])?;
         let pending = reader.next()?;
-        Ok(Self {
+        let mut stream = Self {
             path: path.to_path_buf(),
             reader,
             pointed: which == 1,
@@ -132,7 +150,29 @@ impl SightingStream {
             offsets: Vec::new(),
             directions: Vec::new(),
             last_epoch_s: f64::NEG_INFINITY,
-        })
+            first_t_s: None,
+            rows: 0,
+        };
+        stream.first_t_s = stream.next_time()?;
+        Ok(stream)
+    }
+
+    /// Reads the epochs left (checked as any), returns their rows.
+    fn drain(&mut self) -> Result<u64, SimError> {
+        let mut rows = 0;
+        while self.take_epoch()?.is_some() {
+            rows += (self.offsets.len() + self.directions.len()) as u64;
+        }
+        Ok(rows)
+    }
+
+    fn span(&self) -> InputSpan {
+        InputSpan {
+            role: "sightings",
+            path: self.path.clone(),
+            span_s: self.first_t_s.map(|a| [a, self.last_epoch_s]),
+            rows: self.rows,
+        }
     }
 
     fn next_time(&self) -> Result<Option<f64>, SimError> {
@@ -202,6 +242,7 @@ impl SightingStream {
                     h_m: r.f64(rec, 3, "h_m")?,
                 });
             }
+            self.rows += 1;
             self.pending = self.reader.next()?;
         }
         Ok(Some((t, first_line)))
@@ -236,7 +277,8 @@ impl<W: Write> Run<'_, W> {
                     break;
                 };
                 if t <= self.t0_s {
-                    self.summary.sightings_skipped += (s.offsets.len() + s.directions.len()) as u64;
+                    self.summary.unused.sightings_before_start +=
+                        (s.offsets.len() + s.directions.len()) as u64;
                     continue;
                 }
                 let r = if s.pointed {
@@ -321,9 +363,12 @@ pub fn replay(
         rate,
         reference,
         align_s,
+        align_limits,
+        allow_unaided,
         level,
         mcap_out,
     } = inputs;
+    let (reference_path, reference) = reference.unzip();
     let (table, sightings) = match &sightings {
         Some((log, landmarks)) => (read_landmarks(landmarks)?, Some(SightingStream::open(log)?)),
         None => (
@@ -337,7 +382,14 @@ pub fn replay(
     };
     let mut initial = initial;
     let alignment = if align_s > 0.0 {
-        Some(align_at_rest(&mut imu, &mut initial, align_s, level)?)
+        Some(align_at_rest(
+            &mut imu,
+            &mut initial,
+            align_s,
+            level,
+            &align_limits,
+            reference.as_deref(),
+        )?)
     } else {
         None
     };
@@ -358,11 +410,14 @@ pub fn replay(
     writeln!(out, "{SOLUTION_HEADER}").map_err(io_err(out_path))?;
     let rates = imu.rates()?;
     let step = config.imu_step_s;
+    let imu_first_s = imu.peek(0)?.map(|r| r.t_s);
+    let (mut imu_last_s, mut imu_rows) = (f64::NAN, 0u64);
     let mut run = Run {
         rate,
         out,
         out_path,
         summary: ReplaySummary {
+            start_t_s: init.t_s,
             offset_sightings: sightings.as_ref().is_some_and(|s| !s.pointed),
             ..Default::default()
         },
@@ -379,14 +434,38 @@ pub fn replay(
     run.after(&mut filter)?;
     while let Some(rec) = imu.next()? {
         let t = rec.t_s;
+        imu_rows += 1;
+        imu_last_s = t;
         if t <= init.t_s {
-            run.summary.imu_skipped += 1;
+            run.summary.unused.imu_before_start += 1;
             continue;
         }
         // (specific force or Δv, angular rate or Δθ)
         let (a, b) = (rec.a, rec.b);
         let now = filter.time_s();
         let dt = t - now;
+        if dt > max_gap_s && run.summary.imu_samples == 0 {
+            // The IMU starts (or resumes) long after the start: the logs are on other clocks.
+            while let Some(r) = imu.next()? {
+                imu_rows += 1;
+                imu_last_s = r.t_s;
+            }
+            if let Some(s) = run.sightings.as_mut() {
+                run.summary.unused.sightings_after_end = s.drain()?;
+            }
+            let problem = format!(
+                "the inputs do not overlap in time: the first IMU sample after the start of the replay (t = {:.3} s) comes {dt:.3} s later, more than the {max_gap_s} s bridged (max_gap_s)",
+                init.t_s
+            );
+            let spans = input_spans(
+                (&imu_path, imu_first_s, imu_last_s, imu_rows),
+                reference_path
+                    .as_deref()
+                    .zip(run.metrics.as_ref().map(MetricsAcc::reference)),
+                run.sightings.as_ref(),
+            );
+            return Err(SimError::InputSpans { problem, spans });
+        }
         if dt > max_gap_s {
             return Err(imu.parse_err(
                 rec.line,
@@ -450,6 +529,12 @@ pub fn replay(
     }
     run.summary.end_t_s = filter.time_s();
     run.out.flush().map_err(io_err(out_path))?;
+    check_overlap(
+        &mut run,
+        (&imu_path, imu_first_s, imu_last_s, imu_rows),
+        reference_path.as_deref(),
+        allow_unaided,
+    )?;
     if let Some(sink) = run.mcap.take() {
         sink.finish()?;
     }
@@ -458,4 +543,83 @@ pub fn replay(
     summary.alignment = alignment;
     summary.initial = Some(initial);
     Ok(summary)
+}
+
+/// The spans of the inputs: the IMU log (path, first and last stamp, rows), the reference
+/// (path and rows) and the sightings read so far.
+fn input_spans(
+    (imu_path, first_s, last_s, rows): (&Path, Option<f64>, f64, u64),
+    reference: Option<(&Path, &[ReferenceRow])>,
+    sightings: Option<&SightingStream>,
+) -> Vec<InputSpan> {
+    let mut spans = vec![InputSpan {
+        role: "IMU log",
+        path: imu_path.to_path_buf(),
+        span_s: first_s.map(|a| [a, last_s]),
+        rows,
+    }];
+    if let Some((path, r)) = reference {
+        spans.push(InputSpan {
+            role: "reference",
+            path: path.to_path_buf(),
+            span_s: r.first().zip(r.last()).map(|(a, b)| [a.t_s, b.t_s]),
+            rows: r.len() as u64,
+        });
+    }
+    if let Some(s) = sightings {
+        spans.push(s.span());
+    }
+    spans
+}
+
+/// After the IMU's last sample: counts the sightings and reference rows not used, records the
+/// spans, and refuses inputs that do not overlap (module documentation).
+fn check_overlap<W: Write>(
+    run: &mut Run<'_, W>,
+    imu: (&Path, Option<f64>, f64, u64),
+    reference_path: Option<&Path>,
+    allow_unaided: bool,
+) -> Result<(), SimError> {
+    let (t0, end) = (run.t0_s, run.summary.end_t_s);
+    if let Some(s) = run.sightings.as_mut() {
+        run.summary.unused.sightings_after_end = s.drain()?;
+    }
+    let mut reference_inside = 0;
+    if let Some(m) = run.metrics.as_ref() {
+        for r in m.reference() {
+            if r.t_s < t0 {
+                run.summary.unused.reference_before_start += 1;
+            } else if r.t_s > end {
+                run.summary.unused.reference_after_end += 1;
+            } else if r.t_s > t0 {
+                reference_inside += 1;
+            }
+        }
+    }
+    let reference = reference_path.zip(run.metrics.as_ref().map(MetricsAcc::reference));
+    run.summary.spans = input_spans(imu, reference, run.sightings.as_ref());
+    let s = &run.summary;
+    let problem = if s.imu_samples == 0 {
+        format!(
+            "the inputs do not overlap in time: no IMU sample after the start of the replay at t = {t0:.3} s"
+        )
+    } else if reference.is_some() && reference_inside == 0 {
+        format!(
+            "the inputs do not overlap in time: no reference row inside the replay, t = {t0:.3}–{end:.3} s"
+        )
+    } else if run.sightings.is_some() && s.sightings_used == 0 && !allow_unaided {
+        format!(
+            "the filter used no sighting ({} epochs applied, {} sightings rejected by the gate; {} sightings at or before the start at t = {t0:.3} s, {} after the IMU's last sample at t = {end:.3} s): an unaided run is refused unless allowed (allow_unaided; nav-app ins --allow-unaided)",
+            s.epochs,
+            s.sightings_rejected,
+            s.unused.sightings_before_start,
+            s.unused.sightings_after_end
+        )
+    } else {
+        return Ok(());
+    };
+    Err(SimError::InputSpans {
+        problem,
+        spans: s.spans.clone(),
+    })
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use toml_config::TomlDoc;
 
+use super::align::AlignLimits;
 use super::imu::ImuLog;
 use super::read::read_initial;
 use super::reference::{initial_from_reference, read_reference};
@@ -67,8 +68,11 @@ pub struct ReplayRequest {
     pub mode: Mode,
     /// Overrides the gate probability (`Some(None)`: no gate).
     pub gate: Option<Option<f64>>,
-    /// Static alignment at rest after the start, s (0: none).
+    /// Static alignment at rest after the start, s (0: none); its rest check takes its limits
+    /// from the filter file (the defaults with a scenario).
     pub align_s: f64,
+    /// A filter run that used no sighting is refused unless this is set.
+    pub allow_unaided: bool,
     /// Longest IMU gap bridged, s.
     pub max_gap_s: f64,
     /// When solution rows are written.
@@ -106,13 +110,13 @@ impl ReplayRequest {
             return Err(SimError::invalid("rate", "must be a rate > 0 Hz", hz));
         }
         let reference = match &self.reference {
-            Some(path) => Some(read_reference(path)?),
+            Some(path) => Some((path.clone(), read_reference(path)?)),
             None => None,
         };
         let mut level = false;
         let initial = match (&self.initial, &reference) {
             (Some(path), _) => read_initial(path)?,
-            (None, Some(rows)) => {
+            (None, Some((_, rows))) => {
                 let start = self
                     .start_s
                     .unwrap_or_else(|| rows.first().map_or(0.0, |r| r.t_s));
@@ -134,6 +138,10 @@ impl ReplayRequest {
                 f.filter_config(self.mode, imu.nominal_step_s()?, initial.t_s)?
             }
             FilterSettings::Scenario(s) => s.online_filter_config(self.mode),
+        };
+        let align_limits = match &self.settings {
+            FilterSettings::File(f) => f.align_limits(),
+            FilterSettings::Scenario(_) => AlignLimits::default(),
         };
         if let Some(gate) = self.gate {
             config.gate_probability = gate;
@@ -158,6 +166,8 @@ impl ReplayRequest {
             rate: self.rate,
             reference,
             align_s: self.align_s,
+            align_limits,
+            allow_unaided: self.allow_unaided,
             level,
             mcap_out: self.mcap_out.clone(),
         })

@@ -24,7 +24,9 @@ use ins_sim::logs::{
     after_help = "The filter settings come from --config (a filter file in datasheet units, \
                   ins_sim::filter_file) or --preset (compiled in: mems, the default, or paper). \
                   The initial state comes from --init, or from the reference (--truth) at \
-                  --start-s (default: its first row).\n\n\
+                  --start-s (default: its first row). The IMU log, the reference and the \
+                  sightings must overlap in time (an error names each file's first and last \
+                  stamp); input rows not used are counted in the summary.\n\n\
                   Exit codes: 0 success; 1 error (a malformed log names its file, line and \
                   column); 2 bad command line."
 )]
@@ -51,9 +53,12 @@ struct InsArgs {
     /// Start time of the replay when the initial state comes from --truth, s.
     #[arg(long, value_name = "S")]
     start_s: Option<f64>,
-    /// Static alignment: the vehicle is at rest for this long after the start, s. The mean
-    /// rate over it (less the Earth rate) is the initial gyro bias; when the attitude did not
-    /// come from a reference attitude, roll and pitch are levelled from the accelerometers.
+    /// Static alignment: the vehicle is at rest for this long after the start, s (at least 2).
+    /// The rest is checked (the spread of the accelerometer's and gyro's 1-s means, and with
+    /// --truth its speed, against the filter file's [align] limits) and the alignment refused
+    /// otherwise. The mean rate over it (less the Earth rate) is the initial gyro bias; when
+    /// the attitude did not come from a reference attitude, roll and pitch are levelled from
+    /// the accelerometers. Moving at the start: leave it out (attitude from the reference).
     #[arg(long, value_name = "S", default_value_t = 0.0)]
     align_s: f64,
     /// Filter file (TOML, datasheet units; `preset = "mems"|"paper"` plus overrides). An older
@@ -66,6 +71,10 @@ struct InsArgs {
     /// none (unaided INS), kf, akf (Mohamed–Schwarz), akf_sage_husa, akf_structured.
     #[arg(long, value_name = "NAME", default_value = "kf")]
     filter: String,
+    /// With a filter (kf, akf…): accept a run that used no sighting (none in the replay's time
+    /// span, or all rejected by the gate); without it such a run is an error.
+    #[arg(long)]
+    allow_unaided: bool,
     /// χ² gate probability per sighting (overrides the filter file's; 0 = no gate).
     #[arg(long, value_name = "P")]
     gate: Option<f64>,
@@ -166,6 +175,12 @@ fn run_ins(args: &InsArgs) -> Result<()> {
                 args.filter
             )
         })?;
+    if mode == Mode::Standalone && args.sightings.is_some() {
+        eprintln!(
+            "nav-app ins: warning: --filter none runs the INS unaided: the sightings ({}) are ignored",
+            args.sightings.as_deref().unwrap_or(Path::new("")).display()
+        );
+    }
     if mode != Mode::Standalone && args.sightings.is_none() {
         bail!(
             "--filter {}: give --sightings and --landmarks, or --filter none",
@@ -183,6 +198,7 @@ fn run_ins(args: &InsArgs) -> Result<()> {
         mode,
         gate: args.gate.map(|p| (p != 0.0).then_some(p)),
         align_s: args.align_s,
+        allow_unaided: args.allow_unaided,
         max_gap_s: args.max_gap_s,
         rate: args.rate.map_or(SolutionRate::EveryImu, SolutionRate::Hz),
         mcap_out: args.mcap_out.clone(),
@@ -198,24 +214,51 @@ fn run_ins(args: &InsArgs) -> Result<()> {
     report(args, &summary)
 }
 
+/// The input rows not used, as one clause of the summary line.
+fn unused_text(args: &InsArgs, s: &ReplaySummary) -> String {
+    let u = &s.unused;
+    let mut text = format!(
+        "rows not used: IMU {} at or before the start",
+        u.imu_before_start
+    );
+    if s.spans.iter().any(|p| p.role == "sightings") {
+        text += &format!(
+            ", sightings {} at or before the start and {} after the IMU's end",
+            u.sightings_before_start, u.sightings_after_end
+        );
+    }
+    if args.truth.is_some() {
+        text += &format!(
+            ", reference {} before the start and {} after the IMU's end",
+            u.reference_before_start, u.reference_after_end
+        );
+    }
+    text
+}
+
 fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
     eprintln!(
-        "nav-app ins: {} IMU samples to t = {:.3} s ({} before the start skipped), {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; wrote {}",
+        "nav-app ins: {} IMU samples to t = {:.3} s from the start at t = {:.3} s, {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; {}; wrote {}",
         s.imu_samples,
         s.end_t_s,
-        s.imu_skipped,
+        s.start_t_s,
         s.gaps,
         s.longest_gap_s,
         s.epochs,
         s.sightings_used,
         s.sightings_rejected,
+        unused_text(args, s),
         args.out.display()
     );
     if let Some(a) = &s.alignment {
         let [x, y, z] = a.gyro_bias_body_radps;
         eprintln!(
-            "nav-app ins: aligned on {} samples at rest: gyro bias ({:.4}, {:.4}, {:.4}) °/s{}",
+            "nav-app ins: aligned on {} samples at rest (spread of the 1-s means: accelerometer {:.4} m/s², gyro {:.4} °/s{}): gyro bias ({:.4}, {:.4}, {:.4}) °/s{}",
             a.samples,
+            a.accel_spread_mps2,
+            a.gyro_spread_radps.to_degrees(),
+            a.reference_max_speed_mps
+                .map_or(String::new(), |v| format!("; reference speed ≤ {v:.3} m/s")),
             x.to_degrees(),
             y.to_degrees(),
             z.to_degrees(),
@@ -248,6 +291,11 @@ fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
             "sightings_rejected": s.sightings_rejected,
             "gaps": s.gaps,
             "longest_gap_s": s.longest_gap_s,
+            "start_t_s": s.start_t_s,
+            "end_t_s": s.end_t_s,
+            "unused": s.unused,
+            "inputs": s.spans,
+            "alignment": s.alignment,
             "metrics": m,
         });
         std::fs::write(path, serde_json::to_string_pretty(&json)? + "\n")
