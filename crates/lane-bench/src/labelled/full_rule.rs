@@ -18,8 +18,8 @@
 //!   predictions / predictions (a prediction on a side without a label lane is one), FN =
 //!   unmatched label lanes / label lanes: as the near band counts them.
 //!
-//! `reach_px` is half a pixel of the tracker's working frame, `0.5·f` input pixels (`f` the
-//! working factor, [`lane_tracker::LaneTracker::working_factor`]; 0.5 px at 320 px): the
+//! `reach_px` is half a pixel of the tracker's working frame, `0.5·s` input pixels (`s` the
+//! working scale, [`lane_tracker::LaneTracker::working_scale`]; 0.5 px at 320 px): the
 //! reported extent is the rows of the points behind the estimate, pixel centres, so a label
 //! row within half a working pixel of the extreme rows lies on a row the tracker read.
 //! [`REACH_WORKING_PX`] holds it.
