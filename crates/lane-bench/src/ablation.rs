@@ -79,6 +79,15 @@ pub fn mechanisms() -> Vec<Mechanism> {
             others: &[],
         },
         Mechanism {
+            name: "noisy frames smoothed",
+            keys: "denoise.above_noise_grey",
+            off: value!("0 (never)", |c| c.denoise.above_noise_grey = 0.0),
+            others: &[
+                value!("3 grey levels", |c| c.denoise.above_noise_grey = 3.0),
+                value!("6 grey levels", |c| c.denoise.above_noise_grey = 6.0),
+            ],
+        },
+        Mechanism {
             name: "bright-stripe pairing",
             keys: "gradient.stripe_max_width_px, stripe_paired_votes",
             // (The kerb's foot and the stripe trace read up to the stripe width: off with it.)

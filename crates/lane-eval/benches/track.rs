@@ -38,6 +38,24 @@ fn synthetic_frame(w: usize, h: usize) -> GreyFrame {
     frame
 }
 
+/// `frame` with seeded Gaussian noise of σ = 8 grey levels (xorshift64* and Box–Muller).
+fn noisy(frame: &GreyFrame) -> GreyFrame {
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut uniform = || {
+        state ^= state >> 12;
+        state ^= state << 25;
+        state ^= state >> 27;
+        ((state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    let mut out = frame.clone();
+    for v in out.data_mut() {
+        let (u, w) = (uniform(), uniform());
+        let n = (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * w).cos();
+        *v = (f64::from(*v) + 8.0 * n).round().clamp(0.0, 255.0) as u8;
+    }
+    out
+}
+
 /// A tracker for `frame`'s size that has tracked it five times (its lanes settled on it).
 fn warmed_up(cfg: &TrackerConfig, estimator: Estimator, frame: &GreyFrame) -> LaneTracker {
     let mut tracker = LaneTracker::new(cfg, estimator, frame.width(), frame.height()).unwrap();
@@ -103,6 +121,18 @@ fn tracking_frame(c: &mut Criterion) {
             group.bench_function(BenchmarkId::new("kif_default", name), |b| {
                 b.iter(|| black_box(tracking.track(black_box(frame)).unwrap()));
             });
+        }
+        // The same frame with sensor noise of σ = 8 grey levels: measured as noisy on the first
+        // frame, every tracked frame smoothed before the stages read it (`[denoise]`).
+        if *name == "udacity_320x240" {
+            let noisy_frame = noisy(frame);
+            let mut tracking = warmed_up(&tracked_only, Estimator::Kif, &noisy_frame);
+            assert!(tracking.frame_noise().denoised, "σ 8 must be smoothed");
+            if !tracking.track(&noisy_frame).unwrap().full_gradient {
+                group.bench_function(BenchmarkId::new("kif_default_noisy", name), |b| {
+                    b.iter(|| black_box(tracking.track(black_box(&noisy_frame)).unwrap()));
+                });
+            }
         }
         let mut every_frame = default;
         every_frame.track.revalidate_every_frames = 1;

@@ -144,3 +144,38 @@ fn frames_of_other_widths_tracked_at_the_working_width_do_not_allocate() {
         assert_eq!(n, 0, "reset at {w}×{h}");
     }
 }
+
+#[test]
+fn noisy_frames_smoothed_before_tracking_do_not_allocate() {
+    // A noisy camera (module `lane_tracker::tracker::denoise`): the frames measured and smoothed
+    // into the stage's own buffer, at 320×240 and resampled from 640×480. The noise (a fixed
+    // pseudo-random pattern: σ ≈ 9 grey levels at 320×240, twice that at 640×480, where the
+    // 2 × 2 average halves it) is added outside the count.
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let spec = SCENES.iter().find(|s| s.name == "wall_recovery").unwrap();
+    for (w, h, divisor) in [(320, 240, 16), (640, 480, 8)] {
+        let mut renderer = SceneRenderer::new(*spec, w, h);
+        let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+        let mut frame = GreyFrame::default();
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut allocs = 0;
+        for i in 0..spec.frames {
+            renderer.render(i, &mut frame);
+            for v in frame.data_mut() {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                // Four uniform bytes' deviations (σ 74 each), summed (σ 148), over the divisor.
+                let n: i32 = (0..4)
+                    .map(|k| i32::from((state >> (8 * k)) as u8) - 128)
+                    .sum();
+                *v = (i32::from(*v) + n / divisor).clamp(0, 255) as u8;
+            }
+            let (report, n) = allocations_in(|| tracker.track(&frame));
+            report.unwrap();
+            assert!(tracker.frame_noise().denoised, "{w}×{h} frame {i}");
+            allocs += n;
+        }
+        assert_eq!(allocs, 0, "{w}×{h}: {allocs} allocations");
+    }
+}

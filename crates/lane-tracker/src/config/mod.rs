@@ -466,6 +466,18 @@ impl Default for FrameConfig {
     }
 }
 
+/// The frame's noise (an addition beyond the paper; module `tracker::denoise`): measured on the
+/// rows searched when a scene starts and every 30 frames, and the working frame smoothed where it
+/// is far above what the grey-level settings assume. Absent: never.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DenoiseConfig {
+    /// Noise σ̂ (the robust Laplacian estimate), grey levels, above which the frame is smoothed
+    /// by a 3 × 3 binomial (and stretched by 4/3) before the stages read it; 0 = never (the
+    /// default when absent).
+    pub above_noise_grey: f64,
+}
+
 /// The whole tracker configuration (one TOML file).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -473,6 +485,9 @@ pub struct TrackerConfig {
     /// The working resolution (`[frame]`; absent: 320 px wide).
     #[serde(default)]
     pub frame: FrameConfig,
+    /// The frame's noise (`[denoise]`; absent: never smoothed).
+    #[serde(default)]
+    pub denoise: DenoiseConfig,
     /// Stage I.
     pub gradient: GradientConfig,
     /// Rows searched.

@@ -64,6 +64,12 @@ fn each_out_of_range_field_is_named() {
     type Edit = fn(&mut TrackerConfig);
     let cases: &[(&str, Edit)] = &[
         ("frame.working_width_px", |c| c.frame.working_width_px = 15),
+        ("denoise.above_noise_grey", |c| {
+            c.denoise.above_noise_grey = -1.0
+        }),
+        ("denoise.above_noise_grey", |c| {
+            c.denoise.above_noise_grey = f64::NAN
+        }),
         ("frame.working_width_px", |c| {
             c.frame.working_width_px = 16385
         }),
@@ -416,5 +422,33 @@ fn the_working_width_is_320_when_absent_and_located_in_a_file_when_out_of_range(
             .frame
             .working_width_px,
         0
+    );
+}
+
+#[test]
+fn denoising_is_off_when_absent_and_its_limit_is_located_in_a_file_when_out_of_range() {
+    for preset in [OUTDOOR_TOML, INDOOR_TOML] {
+        let c = TrackerConfig::from_toml_str("p.toml", preset).unwrap();
+        assert_eq!(c.denoise.above_noise_grey, 0.0);
+    }
+    assert_eq!(
+        TrackerConfig::default_preset()
+            .unwrap()
+            .denoise
+            .above_noise_grey,
+        4.0
+    );
+    let text = DEFAULT_TOML.replace("above_noise_grey = 4.0", "above_noise_grey = 300.0");
+    let line = 1 + text[..text.find("above_noise_grey = 300").unwrap()]
+        .matches('\n')
+        .count();
+    let msg = TrackerConfig::from_toml_str("d.toml", &text)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.starts_with(&format!(
+            "d.toml:{line}:1: `denoise.above_noise_grey` = 300"
+        )),
+        "{msg}"
     );
 }

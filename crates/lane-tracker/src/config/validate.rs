@@ -13,6 +13,13 @@ impl TrackerConfig {
             w,
             "must be 0 (the input's own size) or in 16..=16384 px",
         )?;
+        let n = self.denoise.above_noise_grey;
+        check(
+            n.is_finite() && (0.0..=255.0).contains(&n),
+            "denoise.above_noise_grey",
+            n,
+            "must be in 0..=255 grey levels (0: never)",
+        )?;
         // Stage I and II: the component crates' own checks, named by the TOML key.
         let g = &self.gradient;
         g.params().validate().map_err(gradient_field)?;

@@ -25,6 +25,7 @@ use crate::{GreyFrame, RoadBottom, TrackerConfig, TrackerError};
 
 mod candidates;
 mod chosen_fit;
+mod denoise;
 mod double_line;
 mod edges;
 mod gates;
@@ -54,6 +55,8 @@ pub use report::{
     Side, TrackReport, TrackerCounters,
 };
 
+use denoise::Denoiser;
+pub use denoise::FrameNoise;
 use edges::EdgeStage;
 use init::Initialiser;
 use kerb::KerbReader;
@@ -75,6 +78,8 @@ pub struct LaneTracker {
     frame: WorkingFrame,
     /// Where the road ends at the bottom (`roi.road_bottom`, module `road`).
     road: RoadFinder,
+    /// The frame's noise (`[denoise]`, module `denoise`).
+    denoiser: Denoiser,
     /// Stage I.
     edges: EdgeStage,
     /// Stage II.
@@ -143,6 +148,7 @@ impl LaneTracker {
         Ok(LaneTracker {
             frame,
             road: RoadFinder::new(width, height, whole_frame),
+            denoiser: Denoiser::new(cfg.denoise.above_noise_grey, width, height),
             edges,
             init,
             points: PointSelector::new(capacity),
@@ -207,6 +213,12 @@ impl LaneTracker {
         self.road.last
     }
 
+    /// The last measurement of the frames' noise and whether it smooths them (`[denoise]`;
+    /// [`FrameNoise::NONE`] before the first measurement or with it off).
+    pub fn frame_noise(&self) -> FrameNoise {
+        self.denoiser.last()
+    }
+
     /// The configuration in use.
     pub fn config(&self) -> &TrackerConfig {
         &self.setup.cfg
@@ -230,6 +242,7 @@ impl LaneTracker {
         self.init.found.clear();
         self.health = Health::default();
         self.road.reset();
+        self.denoiser.reset();
         // What the accessors hand out with a resampled input: the cleared lanes, mapped.
         if self.frame.resamples() {
             self.frame.publish(&self.lanes, &self.init.found);
@@ -349,12 +362,11 @@ impl LaneTracker {
             });
         }
         let input = GreyImage::new(data, width, height, stride_px)?;
-        let placing = self.setup.cfg.roi.road_bottom == RoadBottom::Found
-            && !self.lanes.iter().any(|l| l.has_estimate());
-        if placing {
+        let new_scene = !self.lanes.iter().any(|l| l.has_estimate());
+        if new_scene && self.setup.cfg.roi.road_bottom == RoadBottom::Found {
             self.place_road(&input);
         }
-        let (lanes, full_gradient) = self.track_view(&input)?;
+        let (lanes, full_gradient) = self.track_view(&input, new_scene)?;
         let view = self.frame.view;
         let search = view.rows_to_input(self.setup.roi, height);
         let bottom = view.rows_to_input((0, self.setup.height), height).1;
@@ -371,6 +383,7 @@ impl LaneTracker {
     fn track_view(
         &mut self,
         input: &GreyImage<'_>,
+        new_scene: bool,
     ) -> Result<([LaneReport; 2], bool), TrackerError> {
         Ok(if self.frame.resamples() {
             // The working frame (module `working`), in a buffer lent out of the stage for the
@@ -379,16 +392,37 @@ impl LaneTracker {
             let (w, h) = (self.setup.width, self.setup.height);
             let tracked = GreyImage::new(&pixels, w, h, w)
                 .map_err(TrackerError::from)
-                .and_then(|image| self.track_working(image));
+                .and_then(|image| self.track_denoised(image, new_scene));
             self.frame.put_back(pixels);
             // Published whatever happened, so the accessors read this frame's state as they
             // do without resampling (also after an error part-way through).
             self.frame.publish(&self.lanes, &self.init.found);
             (self.frame.lanes(), tracked?)
         } else {
-            let full_gradient = self.track_working(*input)?;
+            let full_gradient = self.track_denoised(*input, new_scene)?;
             (self.lanes.reports(), full_gradient)
         })
+    }
+
+    /// The working frame as the stages read it (module `denoise`): its noise measured when due
+    /// (`new_scene`: no lane had an estimate), and the frame smoothed where the last measurement
+    /// says so.
+    fn track_denoised(
+        &mut self,
+        image: GreyImage<'_>,
+        new_scene: bool,
+    ) -> Result<bool, TrackerError> {
+        self.denoiser
+            .measure_if_due(&image, self.setup.roi, new_scene);
+        let Some(pixels) = self.denoiser.smoothed(&image, self.frame.resampled_rows()) else {
+            return self.track_working(image);
+        };
+        let (w, h) = (self.setup.width, self.setup.height);
+        let tracked = GreyImage::new(&pixels, w, h, w)
+            .map_err(TrackerError::from)
+            .and_then(|smoothed| self.track_working(smoothed));
+        self.denoiser.put_back(pixels);
+        tracked
     }
 
     /// The working rows for this frame (`roi.road_bottom = "found"`, module `road`): the road's
