@@ -22,7 +22,12 @@ use ins_sim::logs::{
              (formats: ins_sim::logs; `nav-app ins sightings --help` writes sightings from a \
              reference trajectory)",
     after_help = "The filter settings come from --config (a filter file in datasheet units, \
-                  ins_sim::filter_file) or --preset (compiled in: mems, the default, or paper). \
+                  ins_sim::filter_file) or --preset (compiled in): mems, the default (sighting \
+                  σ 1 m, gate 0.9999, feedback from the start), or paper (the paper's: sighting \
+                  σ 6.32 m, no gate, feedback from 195 s after the start: a shorter log runs \
+                  open loop throughout, and the replay warns). --print-config prints every \
+                  setting in force; the replay's first line names the preset, σ, gate and \
+                  feedback start. \
                   The initial state comes from --init, or from the reference (--truth) at \
                   --start-s (default: its first row). The IMU log, the reference and the \
                   sightings must overlap in time (an error names each file's first and last \
@@ -34,8 +39,8 @@ struct InsArgs {
     /// IMU log (CSV; header `t_s,dv_x_mps,…,dtheta_z_rad` for increments or
     /// `t_s,gyro_x_radps,…,accel_z_mps2` for rates; body FRD), or a ROS 2 bag (`.mcap`) with a
     /// sensor_msgs/msg/Imu topic (ROS's FLU body axes are turned into FRD: y and z negated).
-    #[arg(long, value_name = "FILE")]
-    imu: PathBuf,
+    #[arg(long, value_name = "FILE", required_unless_present = "print_config")]
+    imu: Option<PathBuf>,
     /// With a bag: the IMU topic (default: the bag's only sensor_msgs/msg/Imu topic).
     #[arg(long, value_name = "TOPIC")]
     imu_topic: Option<String>,
@@ -85,8 +90,13 @@ struct InsArgs {
     #[arg(long, value_name = "HZ")]
     rate: Option<f64>,
     /// Solution CSV to write.
-    #[arg(long, value_name = "FILE")]
-    out: PathBuf,
+    #[arg(long, value_name = "FILE", required_unless_present = "print_config")]
+    out: Option<PathBuf>,
+    /// Print the filter settings in force (the filter file or preset with --gate applied) as a
+    /// filter file with units, to standard output, and exit; given back as --config it
+    /// reproduces the run. Needs no other option.
+    #[arg(long)]
+    print_config: bool,
     /// Also write the solution with its σ, each epoch's NIS and (with --truth) the errors as
     /// JSON channels of an MCAP file, plottable in Foxglove (/ins/solution, /ins/epochs,
     /// /ins/errors).
@@ -151,6 +161,42 @@ struct SightingsArgs {
     seed: u64,
 }
 
+/// Where the settings come from, for `--print-config` and the replay's header line.
+fn settings_origin(args: &InsArgs, settings: &FilterSettings) -> String {
+    match (settings, &args.config) {
+        (FilterSettings::File(f), Some(path)) => {
+            format!("{} over preset {}", path.display(), f.preset)
+        }
+        (FilterSettings::File(f), None) => format!("preset {}", f.preset),
+        (FilterSettings::Scenario(_), path) => format!(
+            "the [filter] of scenario {}",
+            path.as_deref().unwrap_or(Path::new("")).display()
+        ),
+    }
+}
+
+/// `--print-config`: the settings in force as a filter file, on standard output.
+fn print_config(args: &InsArgs) -> Result<()> {
+    let settings = filter_settings(args)?;
+    let FilterSettings::File(file) = &settings else {
+        bail!(
+            "--print-config: {} is a simulation scenario (the older way), not a filter file; \
+             its filter settings are its [filter] section",
+            args.config.as_deref().unwrap_or(Path::new("")).display()
+        );
+    };
+    let mut origin = settings_origin(args, &settings);
+    let file = match args.gate {
+        Some(p) => {
+            origin += &format!(", --gate {p}");
+            file.with_gate(p)?
+        }
+        None => *file,
+    };
+    print!("{}", file.to_toml(&origin));
+    Ok(())
+}
+
 fn filter_settings(args: &InsArgs) -> Result<FilterSettings> {
     if let Some(path) = &args.config {
         let text =
@@ -167,6 +213,13 @@ fn filter_settings(args: &InsArgs) -> Result<FilterSettings> {
 }
 
 fn run_ins(args: &InsArgs) -> Result<()> {
+    if args.print_config {
+        return print_config(args);
+    }
+    // clap requires both unless --print-config.
+    let (Some(imu), Some(out_path)) = (&args.imu, &args.out) else {
+        bail!("give --imu FILE and --out FILE (or --print-config)");
+    };
     let mode = Mode::from_name(&args.filter)
         .or((args.filter == "none").then_some(Mode::Standalone))
         .with_context(|| {
@@ -188,7 +241,7 @@ fn run_ins(args: &InsArgs) -> Result<()> {
         );
     }
     let request = logs::ReplayRequest {
-        imu: args.imu.clone(),
+        imu: imu.clone(),
         imu_topic: args.imu_topic.clone(),
         sightings: args.sightings.clone().zip(args.landmarks.clone()),
         initial: args.init.clone(),
@@ -207,11 +260,35 @@ fn run_ins(args: &InsArgs) -> Result<()> {
         bail!("the initial state: give --init FILE, or --truth FILE to take it from the reference");
     }
     let inputs = request.inputs()?;
-    let file = std::fs::File::create(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    let feedback_t_s = inputs.config.open_loop_until_s;
+    eprintln!(
+        "nav-app ins: settings: {}; --filter {}; sighting σ {:.3} m; gate {}; feedback from t = {:.3} s ({:.3} s after the start){}",
+        settings_origin(args, &request.settings),
+        args.filter,
+        inputs.config.r_var_m2.sqrt(),
+        inputs
+            .config
+            .gate_probability
+            .map_or("none".to_owned(), |p| format!("{p}")),
+        feedback_t_s,
+        feedback_t_s - inputs.initial.t_s,
+        if args.config.is_some() || args.preset.is_some() {
+            ""
+        } else {
+            " (all settings: --print-config)"
+        }
+    );
+    let file = std::fs::File::create(out_path)
+        .with_context(|| format!("creating {}", out_path.display()))?;
     let mut out = BufWriter::new(file);
-    let summary = logs::replay(inputs, &mut out, &args.out)?;
-    report(args, &summary)
+    let summary = logs::replay(inputs, &mut out, out_path)?;
+    if mode != Mode::Standalone && summary.end_t_s < feedback_t_s {
+        eprintln!(
+            "nav-app ins: warning: the IMU log ends at t = {:.3} s, before feedback starts at t = {:.3} s (filter.feedback_from_s after the start): the filter ran open loop throughout, its estimates never corrected the INS; lower feedback_from_s in a filter file (--print-config prints the settings in force)",
+            summary.end_t_s, feedback_t_s
+        );
+    }
+    report(args, out_path, &summary)
 }
 
 /// The input rows not used, as one clause of the summary line.
@@ -236,7 +313,7 @@ fn unused_text(args: &InsArgs, s: &ReplaySummary) -> String {
     text
 }
 
-fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
+fn report(args: &InsArgs, out_path: &Path, s: &ReplaySummary) -> Result<()> {
     eprintln!(
         "nav-app ins: {} IMU samples to t = {:.3} s from the start at t = {:.3} s, {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; {}; wrote {}",
         s.imu_samples,
@@ -248,7 +325,7 @@ fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
         s.sightings_used,
         s.sightings_rejected,
         unused_text(args, s),
-        args.out.display()
+        out_path.display()
     );
     if let Some(a) = &s.alignment {
         let [x, y, z] = a.gyro_bias_body_radps;
