@@ -11,7 +11,7 @@ use clap::Parser;
 use ins_sim::Mode;
 use ins_sim::filter_file::FilterFile;
 use ins_sim::logs::{
-    self, FilterSettings, ReplayMetrics, ReplaySummary, SightingPlan, SolutionRate,
+    self, FilterSettings, LosFrame, ReplayMetrics, ReplaySummary, SightingPlan, SolutionRate,
 };
 
 /// `nav-app ins`: replay an IMU log through the INS/SD filter.
@@ -119,8 +119,9 @@ struct InsArgs {
 #[command(
     name = "nav-app ins sightings",
     about = "Writes a pointed-sightings log from a reference trajectory and a landmark table \
-             (ins_sim::logs::write_sightings): body directions when the reference has an \
-             attitude, local-level ones otherwise; seeded."
+             (ins_sim::logs::write_sightings): by default body directions when the reference has \
+             an attitude, local-level (NED) ones otherwise, or the frame --frame asks for; \
+             seeded."
 )]
 struct SightingsArgs {
     /// Reference trajectory (CSV, radians or degrees, attitude optional).
@@ -159,6 +160,11 @@ struct SightingsArgs {
     /// Seed of the noise (and of the landmark placement).
     #[arg(long, value_name = "N", default_value_t = 1)]
     seed: u64,
+    /// The frame of the directions written: body (FRD; needs the reference's attitude in every
+    /// row) or ned (local level). Default: body when the reference has an attitude in every
+    /// row, else ned. The same seed gives the same draws in either frame.
+    #[arg(long, value_name = "FRAME", value_parser = ["body", "ned"])]
+    frame: Option<String>,
 }
 
 /// Where the settings come from, for `--print-config` and the replay's header line.
@@ -453,6 +459,7 @@ fn run_sightings(args: &SightingsArgs) -> Result<()> {
         field_of_regard_deg: args.field_of_regard_deg,
         max_per_epoch: args.max_per_epoch,
         seed: args.seed,
+        frame: args.frame.as_deref().and_then(LosFrame::parse),
         ..SightingPlan::default()
     };
     let file = std::fs::File::create(&args.out)
