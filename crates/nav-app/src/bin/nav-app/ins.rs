@@ -37,10 +37,25 @@ use ins_sim::logs::{
 )]
 struct InsArgs {
     /// IMU log (CSV; header `t_s,dv_x_mps,…,dtheta_z_rad` for increments or
-    /// `t_s,gyro_x_radps,…,accel_z_mps2` for rates; body FRD), or a ROS 2 bag (`.mcap`) with a
-    /// sensor_msgs/msg/Imu topic (ROS's FLU body axes are turned into FRD: y and z negated).
+    /// `t_s,gyro_x_radps,…,accel_z_mps2` for rates; body FRD), a ROS 2 bag (`.mcap`) with a
+    /// sensor_msgs/msg/Imu topic (ROS's FLU body axes are turned into FRD: y and z negated), or
+    /// an EuRoC/ASL folder (`mav0`, or the folder holding it: `imu0/data.csv`, nanosecond
+    /// stamps, ω then a, rotated into the body axes by --imu-to-body or its `sensor.yaml`'s
+    /// T_BS).
     #[arg(long, value_name = "FILE", required_unless_present = "print_config")]
     imu: Option<PathBuf>,
+    /// With an ASL folder: the rotation from the IMU's axes to the body's, C_B^S, as 9 numbers
+    /// row-major (R11,R12,…,R33; default: T_BS of the folder's imu0/sensor.yaml).
+    #[arg(long, value_name = "R11,…,R33")]
+    imu_to_body: Option<String>,
+    /// With a TUM or ASL reference (positions in a local frame): its origin, LAT,LON,ALT
+    /// (degrees, degrees, m above the WGS-84 ellipsoid). Also the origin of --tum-out.
+    #[arg(long, value_name = "LAT,LON,ALT", allow_hyphen_values = true)]
+    tum_origin: Option<String>,
+    /// The local frame's axes: enu (x east, y north, z up) or ned (x north, y east, z down);
+    /// with --tum-origin for a TUM or ASL reference; for --tum-out alone, default enu.
+    #[arg(long, value_name = "AXES", value_parser = ["enu", "ned"])]
+    tum_frame: Option<String>,
     /// With a bag: the IMU topic (default: the bag's only sensor_msgs/msg/Imu topic).
     #[arg(long, value_name = "TOPIC")]
     imu_topic: Option<String>,
@@ -102,10 +117,21 @@ struct InsArgs {
     /// /ins/errors).
     #[arg(long, value_name = "FILE")]
     mcap_out: Option<PathBuf>,
-    /// Reference trajectory (CSV, radians or degrees, attitude optional): print and write the
-    /// errors against it.
+    /// Reference trajectory: print and write the errors against it. CSV (radians or degrees,
+    /// attitude optional), a TUM trajectory (`t x y z qx qy qz qw`, blank-separated, body →
+    /// local quaternion) or an EuRoC/ASL folder's ground truth
+    /// (state_groundtruth_estimate0/data.csv); the last two need --tum-origin and --tum-frame.
     #[arg(long, value_name = "FILE")]
     truth: Option<PathBuf>,
+    /// Also write the solution as a TUM trajectory (`t x y z qx qy qz qw`, what `evo` reads):
+    /// positions in a local frame (--tum-frame, default enu) with origin --tum-origin, default
+    /// the first solution row; a header comment states the frame and origin.
+    #[arg(long, value_name = "FILE")]
+    tum_out: Option<PathBuf>,
+    /// With --truth: the reference as a TUM trajectory in the same local frame, at the times
+    /// the errors were computed (the rows of the printed RMS).
+    #[arg(long, value_name = "FILE", requires = "truth")]
+    tum_truth_out: Option<PathBuf>,
     /// With --truth: the error statistics as JSON.
     #[arg(long, value_name = "FILE", requires = "truth")]
     metrics_json: Option<PathBuf>,
@@ -165,6 +191,114 @@ struct SightingsArgs {
     /// row, else ned. The same seed gives the same draws in either frame.
     #[arg(long, value_name = "FRAME", value_parser = ["body", "ned"])]
     frame: Option<String>,
+}
+
+/// `--tum-frame` (default enu).
+fn tum_axes(args: &InsArgs) -> Result<logs::LocalAxes> {
+    logs::LocalAxes::parse(args.tum_frame.as_deref().unwrap_or("enu"))
+        .context("--tum-frame: enu or ned")
+}
+
+/// `--tum-out`, `--tum-truth-out`: the solution read back from its CSV, and the reference at the
+/// times the errors were computed, in one local frame.
+fn write_tum_files(
+    args: &InsArgs,
+    layouts: &logs::InputLayouts,
+    out_path: &Path,
+    reference: Option<&[logs::ReferenceRow]>,
+    summary: &ReplaySummary,
+) -> Result<()> {
+    if args.tum_out.is_none() && args.tum_truth_out.is_none() {
+        return Ok(());
+    }
+    let solution = logs::read_solution(out_path)?;
+    let frame = match (layouts.local_frame, solution.first()) {
+        (Some(frame), _) => frame,
+        (None, Some((_, first))) => logs::LocalFrame {
+            origin: first.pos,
+            axes: tum_axes(args)?,
+        },
+        (None, None) => bail!("--tum-out: the solution {} has no row", out_path.display()),
+    };
+    let create = |path: &Path| -> Result<BufWriter<std::fs::File>> {
+        Ok(BufWriter::new(
+            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
+        ))
+    };
+    if let Some(path) = &args.tum_out {
+        let rows = solution.iter().map(|(t, s)| (*t, s.pos, s.att_b_to_n));
+        logs::write_tum(
+            &mut create(path)?,
+            path,
+            &frame,
+            "nav-app ins solution",
+            rows,
+        )?;
+    }
+    if let (Some(path), Some(rows), Some(m)) = (&args.tum_truth_out, reference, &summary.metrics) {
+        // The reference interpolated at each compared time exactly as the metrics did (the
+        // same function and gap), so a trajectory tool's RMS over these rows is the printed one.
+        let has_attitude = rows.iter().all(|r| r.att_b_to_n.is_some());
+        let mut cursor = 0;
+        let poses = m.series.iter().filter_map(|e| {
+            logs::interpolate(rows, e.t_s, logs::METRICS_MAX_REFERENCE_GAP_S, &mut cursor)
+                .map(|r| (e.t_s, r.pos, r.att_b_to_n.unwrap_or_default()))
+        });
+        let what = if has_attitude {
+            "nav-app ins reference at the compared times"
+        } else {
+            "nav-app ins reference at the compared times (no attitude in the reference: identity quaternions, compare positions only)"
+        };
+        logs::write_tum(&mut create(path)?, path, &frame, what, poses)?;
+    }
+    Ok(())
+}
+
+/// `--imu-to-body`, `--tum-origin`, `--tum-frame`.
+fn input_layouts(args: &InsArgs) -> Result<logs::InputLayouts> {
+    let imu_to_body = match &args.imu_to_body {
+        Some(text) => {
+            let v: Vec<f64> = text
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .ok()
+                .filter(|v: &Vec<f64>| v.len() == 9)
+                .with_context(|| {
+                    format!("--imu-to-body: `{text}` is not 9 numbers R11,R12,…,R33 (row-major)")
+                })?;
+            Some(logs::check_rotation(
+                nalgebra::Matrix3::from_row_slice(&v),
+                "--imu-to-body",
+            )?)
+        }
+        None => None,
+    };
+    let local_frame = match (&args.tum_origin, &args.tum_frame) {
+        (Some(origin), Some(_)) => Some(logs::LocalFrame::from_text(origin, tum_axes(args)?)?),
+        (Some(_), None) => {
+            bail!("--tum-origin: give the local frame's axes too, --tum-frame enu|ned")
+        }
+        _ => None,
+    };
+    let local_truth = match &args.truth {
+        Some(path) => logs::is_local_reference(path)?,
+        None => false,
+    };
+    if args.tum_origin.is_some()
+        && !local_truth
+        && args.tum_out.is_none()
+        && args.tum_truth_out.is_none()
+    {
+        bail!(
+            "--tum-origin: the local frame of a TUM or ASL reference (--truth) or of --tum-out; \
+             neither is given"
+        );
+    }
+    Ok(logs::InputLayouts {
+        imu_to_body,
+        local_frame,
+    })
 }
 
 /// Where the settings come from, for `--print-config` and the replay's header line.
@@ -261,11 +395,17 @@ fn run_ins(args: &InsArgs) -> Result<()> {
         max_gap_s: args.max_gap_s,
         rate: args.rate.map_or(SolutionRate::EveryImu, SolutionRate::Hz),
         mcap_out: args.mcap_out.clone(),
+        layouts: input_layouts(args)?,
     };
     if args.init.is_none() && args.truth.is_none() {
         bail!("the initial state: give --init FILE, or --truth FILE to take it from the reference");
     }
     let inputs = request.inputs()?;
+    let reference = args
+        .tum_truth_out
+        .as_ref()
+        .and(inputs.reference.as_ref())
+        .map(|(_, rows)| rows.clone());
     let feedback_t_s = inputs.config.open_loop_until_s;
     eprintln!(
         "nav-app ins: settings: {}; --filter {}; sighting σ {:.3} m; gate {}; feedback from t = {:.3} s ({:.3} s after the start){}",
@@ -294,7 +434,14 @@ fn run_ins(args: &InsArgs) -> Result<()> {
             summary.end_t_s, feedback_t_s
         );
     }
-    report(args, out_path, &summary)
+    report(args, out_path, &summary)?;
+    write_tum_files(
+        args,
+        &request.layouts,
+        out_path,
+        reference.as_deref(),
+        &summary,
+    )
 }
 
 /// The input rows not used, as one clause of the summary line.
