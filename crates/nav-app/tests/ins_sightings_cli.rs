@@ -153,3 +153,76 @@ fn ins_sightings_body_frame_without_a_reference_attitude_is_refused() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(rows(&dir.join("default.csv")).iter().all(|r| r.2 == "ned"));
 }
+
+/// Hamilton product of (w, x, y, z) quaternions.
+fn mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+/// `--reference` takes a TUM trajectory in a local frame too (as `nav-app ins --truth`): the
+/// same reference as CSV and as TUM (ENU) gives the same sightings to round-off.
+#[test]
+fn ins_sightings_from_a_tum_reference_equal_those_from_the_csv_reference() {
+    let dir = scratch("frames-tum");
+    write_reference(&dir.join("truth.csv"), true);
+    // body → ENU = (NED → ENU) ⊗ (body → NED); NED → ENU: 180° about (1, 1, 0)/√2.
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let [w, x, y, z] = mul([0.0, h, h, 0.0], attitude_wxyz());
+    let mut tum = String::from("# t x y z qx qy qz qw\n");
+    for k in 0..=200 {
+        writeln!(tum, "{:.1} 0 0 0 {x:e} {y:e} {z:e} {w:e}", k as f64 * 0.1).unwrap();
+    }
+    std::fs::write(dir.join("truth.tum"), tum).unwrap();
+    let o = sightings(&dir, "csv.csv", None);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let p = |n: &str| dir.join(n).display().to_string();
+    let run_tum = |extra: &[&str]| {
+        let mut args = vec![
+            "ins",
+            "sightings",
+            "--reference",
+            &p("truth.tum"),
+            "--landmarks",
+            &p("lm2.toml"),
+            "--make-landmarks",
+            "8",
+            "--landmark-range-m",
+            "30",
+            "100",
+            "--seed",
+            "3",
+            "--out",
+            &p("tum.csv"),
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
+        args.extend(extra.iter().map(|s| s.to_string()));
+        nav_app(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let o = run_tum(&[]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains(&format!(
+            "{}:2:1: a TUM trajectory holds positions in a local frame",
+            p("truth.tum")
+        )),
+        "{e}"
+    );
+    let o = run_tum(&["--tum-origin", "40,-105,1600", "--tum-frame", "enu"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (a, b) = (rows(&dir.join("csv.csv")), rows(&dir.join("tum.csv")));
+    assert_eq!(a.len(), b.len());
+    for (a, b) in a.iter().zip(&b) {
+        assert_eq!((&a.0, &a.1, &a.2), (&b.0, &b.1, &b.2));
+        for i in 0..3 {
+            assert!((a.3[i] - b.3[i]).abs() < 1e-9, "{a:?} vs {b:?}");
+        }
+    }
+}

@@ -150,9 +150,27 @@ struct InsArgs {
              seeded."
 )]
 struct SightingsArgs {
-    /// Reference trajectory (CSV, radians or degrees, attitude optional).
+    /// Reference trajectory: CSV (radians or degrees, attitude optional), a TUM trajectory or an
+    /// EuRoC/ASL folder's ground truth (the last two with --tum-origin and --tum-frame, as for
+    /// `nav-app ins --truth`).
     #[arg(long, value_name = "FILE")]
     reference: PathBuf,
+    /// With a TUM or ASL reference: its local frame's origin, LAT,LON,ALT (degrees, degrees, m).
+    #[arg(
+        long,
+        value_name = "LAT,LON,ALT",
+        allow_hyphen_values = true,
+        requires = "tum_frame"
+    )]
+    tum_origin: Option<String>,
+    /// With an ASL folder's ground truth: the rotation IMU → body, as for `nav-app ins`
+    /// (default: the folder's imu0/sensor.yaml, else the identity), so that body directions are
+    /// in the body axes the replay uses.
+    #[arg(long, value_name = "R11,…,R33")]
+    imu_to_body: Option<String>,
+    /// With --tum-origin: the local frame's axes, enu or ned.
+    #[arg(long, value_name = "AXES", value_parser = ["enu", "ned"], requires = "tum_origin")]
+    tum_frame: Option<String>,
     /// Landmark table to read, or with --make-landmarks to write.
     #[arg(long, value_name = "FILE")]
     landmarks: PathBuf,
@@ -254,9 +272,9 @@ fn write_tum_files(
     Ok(())
 }
 
-/// `--imu-to-body`, `--tum-origin`, `--tum-frame`.
-fn input_layouts(args: &InsArgs) -> Result<logs::InputLayouts> {
-    let imu_to_body = match &args.imu_to_body {
+/// `--imu-to-body R11,…,R33` (row-major), checked to be a rotation.
+fn parse_rotation(text: Option<&str>) -> Result<Option<nalgebra::Matrix3<f64>>> {
+    Ok(match text {
         Some(text) => {
             let v: Vec<f64> = text
                 .split(',')
@@ -273,7 +291,12 @@ fn input_layouts(args: &InsArgs) -> Result<logs::InputLayouts> {
             )?)
         }
         None => None,
-    };
+    })
+}
+
+/// `--imu-to-body`, `--tum-origin`, `--tum-frame`.
+fn input_layouts(args: &InsArgs) -> Result<logs::InputLayouts> {
+    let imu_to_body = parse_rotation(args.imu_to_body.as_deref())?;
     let local_frame = match (&args.tum_origin, &args.tum_frame) {
         (Some(origin), Some(_)) => Some(logs::LocalFrame::from_text(origin, tum_axes(args)?)?),
         (Some(_), None) => {
@@ -285,14 +308,14 @@ fn input_layouts(args: &InsArgs) -> Result<logs::InputLayouts> {
         Some(path) => logs::is_local_reference(path)?,
         None => false,
     };
-    if args.tum_origin.is_some()
+    if (args.tum_origin.is_some() || args.tum_frame.is_some())
         && !local_truth
         && args.tum_out.is_none()
         && args.tum_truth_out.is_none()
     {
         bail!(
-            "--tum-origin: the local frame of a TUM or ASL reference (--truth) or of --tum-out; \
-             neither is given"
+            "--tum-origin, --tum-frame: the local frame of a TUM or ASL reference (--truth) or of \
+             --tum-out; neither is given"
         );
     }
     Ok(logs::InputLayouts {
@@ -587,7 +610,35 @@ fn print_metrics(truth: &Path, m: &ReplayMetrics) {
 }
 
 fn run_sightings(args: &SightingsArgs) -> Result<()> {
-    let reference = logs::read_reference(&args.reference)?;
+    let local = match (&args.tum_origin, &args.tum_frame) {
+        (Some(origin), Some(axes)) => Some(logs::LocalFrame::from_text(
+            origin,
+            logs::LocalAxes::parse(axes).context("--tum-frame: enu or ned")?,
+        )?),
+        _ => None,
+    };
+    if local.is_some() && !logs::is_local_reference(&args.reference)? {
+        bail!(
+            "--tum-origin: {} is a CSV reference (geodetic): it has no local frame",
+            args.reference.display()
+        );
+    }
+    let given = parse_rotation(args.imu_to_body.as_deref())?;
+    // An ASL folder: its IMU's rotation as the replay takes it (given, else sensor.yaml).
+    let folder_imu = Some(&args.reference)
+        .filter(|p| p.is_dir())
+        .and_then(|p| logs::asl_imu_file(p));
+    let body_from_imu = match (folder_imu, given) {
+        (Some(imu), given) if given.is_some() || imu.with_file_name("sensor.yaml").is_file() => {
+            Some(logs::asl_body_from_imu(&imu, given)?)
+        }
+        (None, Some(_)) => {
+            bail!("--imu-to-body: applies to an EuRoC/ASL folder's ground truth (--reference DIR)")
+        }
+        _ => None,
+    };
+    let reference =
+        logs::read_reference_in(&args.reference, local.as_ref(), body_from_imu.as_ref())?;
     if let Some(n) = args.make_landmarks {
         let (lo, hi) = (args.landmark_range_m[0], args.landmark_range_m[1]);
         let entries = logs::landmarks_around(&reference, n, lo, hi, args.seed)?;
