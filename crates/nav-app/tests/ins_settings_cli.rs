@@ -114,3 +114,24 @@ fn ins_warns_when_the_log_ends_before_feedback_starts() {
         "{help}"
     );
 }
+
+/// `--print-config` prints filter files only: a simulation scenario (the older way) is an error
+/// naming it; a gate outside (0, 1) is refused.
+#[test]
+fn ins_print_config_refuses_a_scenario_and_a_bad_gate() {
+    let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/paper.toml");
+    let o = nav_app(&["ins", "--print-config", "--config", scenario]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("is a simulation scenario (the older way), not a filter file"),
+        "{e}"
+    );
+    let o = nav_app(&["ins", "--print-config", "--gate", "1.5"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("gate: must be within (0, 1), or 0 for no gate"),
+        "{e}"
+    );
+}

@@ -74,8 +74,13 @@ fn in_folder(path: &Path, sub: &str) -> Option<PathBuf> {
         .find(|p| p.is_file())
 }
 
-/// True when `path` is a file whose first line starts with `#timestamp` (an ASL `data.csv`).
+/// True when `path` is a regular file whose first line starts with `#timestamp` (an ASL
+/// `data.csv`). Only regular files are looked into: a pipe's first line would be consumed
+/// (a log read from a pipe is read once, by its reader, as this project's CSV).
 fn has_asl_header(path: &Path) -> bool {
+    if !path.is_file() {
+        return false;
+    }
     let Ok(file) = std::fs::File::open(path) else {
         return false;
     };
