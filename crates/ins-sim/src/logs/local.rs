@@ -183,10 +183,22 @@ fn tum_fields(path: &Path, line_no: usize, text: &str) -> Result<[f64; 8], SimEr
         column,
         message,
     };
-    let fields: Vec<(usize, &str)> = text
-        .split_whitespace()
-        .map(|f| (f.as_ptr() as usize - text.as_ptr() as usize + 1, f))
-        .collect();
+    // (1-based column, text) of each blank-separated field.
+    let mut fields: Vec<(usize, &str)> = Vec::with_capacity(8);
+    let mut start = None;
+    for (i, c) in text
+        .char_indices()
+        .chain(std::iter::once((text.len(), ' ')))
+    {
+        match (c.is_whitespace(), start) {
+            (false, None) => start = Some(i),
+            (true, Some(s)) => {
+                fields.push((s + 1, &text[s..i]));
+                start = None;
+            }
+            _ => {}
+        }
+    }
     if fields.len() != 8 {
         return Err(err(
             text.len() + 1,
