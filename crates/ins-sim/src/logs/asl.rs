@@ -35,7 +35,7 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use super::csv::{CsvReader, Record, io_err};
 use super::imu::ImuRecord;
-use super::local::{LocalFrame, LocalPose, quat_of, rows_from_local};
+use super::local::{LocalFrame, LocalPose, MAX_LOCAL_DISTANCE_M, quat_of, rows_from_local};
 use super::reference::ReferenceRow;
 use crate::SimError;
 
@@ -348,6 +348,17 @@ pub(super) fn read_asl_truth(
         for (i, x) in v.iter_mut().enumerate() {
             *x = r.f64(&rec, i + 1, ASL_TRUTH_NAMES[i + 1])?;
         }
+        let p_local_m = Vector3::new(v[0], v[1], v[2]);
+        if p_local_m.norm() > MAX_LOCAL_DISTANCE_M {
+            return Err(r.parse_err(
+                rec.line,
+                rec.starts[1] + 1,
+                format!(
+                    "position {:.0} m from the origin: beyond {MAX_LOCAL_DISTANCE_M:e} m, not a local frame",
+                    p_local_m.norm()
+                ),
+            ));
+        }
         let q = Quaternion::new(v[3], v[4], v[5], v[6]);
         if !(q.norm() > 0.5 && q.norm() < 2.0) {
             return Err(r.parse_err(
@@ -358,7 +369,7 @@ pub(super) fn read_asl_truth(
         }
         poses.push(LocalPose {
             t_s,
-            p_local_m: Vector3::new(v[0], v[1], v[2]),
+            p_local_m,
             q_local_body: UnitQuaternion::new_normalize(q) * q_s_b,
             v_local_mps: Some(Vector3::new(v[7], v[8], v[9])),
         });

@@ -134,6 +134,10 @@ impl LocalFrame {
     }
 }
 
+/// Farthest a local position may lie from its origin, m: beyond, it is not in a local frame
+/// (and through ECEF it would leave the Earth model's range).
+pub(super) const MAX_LOCAL_DISTANCE_M: f64 = 1.0e6;
+
 /// A rotation matrix as a unit quaternion.
 pub(super) fn quat_of(m: &Matrix3<f64>) -> UnitQuaternion<f64> {
     UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(*m))
@@ -260,6 +264,16 @@ pub(super) fn read_tum(
             ));
         }
         let v = tum_fields(path, line_no, &text)?;
+        let p_local_m = Vector3::new(v[1], v[2], v[3]);
+        if p_local_m.norm() > MAX_LOCAL_DISTANCE_M {
+            return Err(err(
+                1,
+                format!(
+                    "position {:.0} m from the origin: beyond {MAX_LOCAL_DISTANCE_M:e} m, not a local frame",
+                    p_local_m.norm()
+                ),
+            ));
+        }
         let q = Quaternion::new(v[7], v[4], v[5], v[6]);
         if !(q.norm() > 0.5 && q.norm() < 2.0) {
             return Err(err(
@@ -280,7 +294,7 @@ pub(super) fn read_tum(
         }
         poses.push(LocalPose {
             t_s: v[0],
-            p_local_m: Vector3::new(v[1], v[2], v[3]),
+            p_local_m,
             q_local_body: UnitQuaternion::new_normalize(q),
             v_local_mps: None,
         });
