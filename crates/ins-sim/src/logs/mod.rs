@@ -19,7 +19,7 @@
 //!
 //! An EuRoC/ASL folder is read as an IMU log (`imu0/data.csv`, rotated by `T_BS`) and as a
 //! reference (its ground truth), and a TUM trajectory as a reference, both in a local frame
-//! given by its geodetic origin and axes: modules `asl` and `local` ([`asl_imu_file`],
+//! given by its geodetic origin and axes: modules [`asl`] and [`local`] ([`asl_imu_file`],
 //! [`read_reference_in`], [`LocalFrame`]) document the stamps, units and axes converted.
 //!
 //! The landmark table is TOML, one `[[landmarks]]` table per landmark with `id` (integer),
@@ -98,10 +98,10 @@ pub mod names {
 }
 
 mod align;
-mod asl;
+pub mod asl;
 mod csv;
 mod imu;
-mod local;
+pub mod local;
 mod mcap_out;
 mod metrics;
 mod read;
