@@ -1,7 +1,8 @@
 //! `cargo xtask python`: build the `ita_nav` wheel (crates/ita-nav-py, maturin) into the virtual
 //! environment `target/py-venv` and run its pytest suite against the `nav-app` binary.
 //!
-//! Everything it needs comes from PyPI into the venv on first use (maturin, pytest, numpy): a
+//! Everything it needs comes from PyPI into the venv on first use (maturin, pytest, numpy, and
+//! the independent peers of the interop tests: mcap, jsonschema, pillow, evo): a
 //! fresh machine needs only `python3` with its `venv` module (Debian `python3-venv`, installed with
 //! apt-get when missing and running as root or under CI with passwordless sudo).
 
@@ -24,6 +25,8 @@ const REQUIREMENTS: &[&str] = &[
     "mcap-ros2-support>=0.5",
     "jsonschema>=4",
     "pillow>=9",
+    // The field's usual trajectory evaluator: `evo_ape` reads nav-app's --tum-out (test_evo.py).
+    "evo>=1.28",
 ];
 
 /// Arguments of `cargo xtask python`.
@@ -64,7 +67,7 @@ fn ensure_venv(root: &Path) -> Result<PathBuf> {
         root,
         "py-venv",
         REQUIREMENTS,
-        "import numpy, pytest, mcap, mcap_ros2, jsonschema, PIL",
+        "import numpy, pytest, mcap, mcap_ros2, jsonschema, PIL, evo",
         Some("bin/maturin"),
     )
 }

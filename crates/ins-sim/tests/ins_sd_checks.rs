@@ -135,6 +135,7 @@ fn request(dir: &Path, sightings: Option<(PathBuf, PathBuf)>) -> ReplayRequest {
         max_gap_s: 5.0,
         rate: SolutionRate::Hz(1.0),
         mcap_out: None,
+        layouts: Default::default(),
     }
 }
 

@@ -145,3 +145,45 @@ fn bad_filter_files_name_the_line_and_the_key() {
         FilterFile::preset("mems").unwrap()
     );
 }
+
+/// `nav-app ins --print-config` (issue 54, item 3): the printed settings read back to the same
+/// settings, field for field, for both presets, overrides with awkward floats, and the gate
+/// override (none written as 0).
+#[test]
+fn printed_settings_read_back_to_the_same_settings() {
+    let over = "preset = \"paper\"\n[imu]\ngyro_arw_deg_per_rt_h = 0.1234567890123456789\n\
+                [sighting]\nsigma_m = 1e-7\n[filter]\nfeedback_from_s = 12.5\nakf_window = 7\n\
+                [align]\nmax_speed_mps = 3e20\n";
+    let cases = [
+        FilterFile::preset("mems").unwrap(),
+        FilterFile::preset("paper").unwrap(),
+        FilterFile::from_toml_str(over, "over.toml").unwrap(),
+        FilterFile::preset("mems").unwrap().with_gate(0.0).unwrap(),
+        FilterFile::preset("paper")
+            .unwrap()
+            .with_gate(0.95)
+            .unwrap(),
+    ];
+    for f in cases {
+        let text = f.to_toml("test");
+        let back = FilterFile::from_toml_str(&text, "printed.toml").unwrap();
+        assert_eq!(back, f, "{text}");
+        assert!(
+            text.contains("feedback_from_s") && text.contains(", s"),
+            "{text}"
+        );
+    }
+    assert_eq!(
+        FilterFile::preset("mems")
+            .unwrap()
+            .with_gate(0.0)
+            .unwrap()
+            .gate_probability,
+        None
+    );
+    let e = FilterFile::preset("mems")
+        .unwrap()
+        .with_gate(1.5)
+        .unwrap_err();
+    assert!(e.to_string().contains("gate"), "{e}");
+}

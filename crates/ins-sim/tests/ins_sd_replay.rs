@@ -428,6 +428,7 @@ fn a_replay_reads_its_imu_log_once() {
         max_gap_s: 1.0,
         rate: SolutionRate::EveryImu,
         mcap_out: None,
+        layouts: Default::default(),
     };
     let from_file = replay_to(&dir, request(&dir, dir.join(names::IMU)).inputs().unwrap()).unwrap();
     let expected = std::fs::read(dir.join("solution_replayed.csv")).unwrap();

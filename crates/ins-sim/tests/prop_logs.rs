@@ -1,5 +1,6 @@
 //! Property tests of the INS/SD log readers (`ins_sim::logs`): IMU and sightings CSV,
-//! landmark table and initial state TOML. Mutated files (flipped bytes, truncation, inserted
+//! landmark table and initial state TOML, and the data sets' layouts (TUM trajectories, EuRoC/ASL
+//! ground truth, IMU and `sensor.yaml`; module `layouts`). Mutated files (flipped bytes, truncation, inserted
 //! bytes, NaN/∞/huge or empty fields, duplicated or deleted lines) never panic and either replay
 //! or fail with an error naming the file, a line inside it and a column; valid files round-trip.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -313,4 +314,154 @@ fn a_duplicate_landmark_is_located_at_its_entry() {
         e.to_string().contains("twice") || e.to_string().to_lowercase().contains("duplicate"),
         "{e}"
     );
+}
+
+/// The data sets' layouts (issue 54, item 6): a TUM trajectory, an EuRoC/ASL ground truth and
+/// IMU, and `sensor.yaml`, valid before mutation.
+mod layouts {
+    use std::fmt::Write as _;
+    use std::path::PathBuf;
+
+    use ins_sim::logs::{self, LocalAxes, LocalFrame};
+    use proptest::prelude::*;
+
+    use super::{apply, case_dir, check_located, config, mutation};
+
+    fn frame() -> LocalFrame {
+        LocalFrame::from_text("47.3667,8.55,400", LocalAxes::Enu).unwrap()
+    }
+
+    fn tum_text() -> String {
+        let mut t = String::from("# t x y z qx qy qz qw\n");
+        for k in 0..20 {
+            let s = k as f64 * 0.05;
+            writeln!(t, "{s} {} {} {} 0.1 -0.2 0.3 0.927", 2.0 * s, -s, 0.1 * s).unwrap();
+        }
+        t
+    }
+
+    fn gt_text() -> String {
+        let mut t = String::from(
+            "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n",
+        );
+        for k in 0..20u64 {
+            let s = k as f64 * 0.005;
+            writeln!(
+                t,
+                "{},{},{},0.5,0.8,0.1,-0.2,0.55,2,-1,0,0,0,0,0,0,0",
+                1_403_636_579_758_555_392 + k * 5_000_000,
+                2.0 * s,
+                -s
+            )
+            .unwrap();
+        }
+        t
+    }
+
+    fn imu_text() -> String {
+        let mut t = String::from(
+            "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
+        );
+        for k in 0..50u64 {
+            writeln!(
+                t,
+                "{},-0.0027,0.0209,0.0795,9.1,0.2,-2.9",
+                1_403_636_579_758_555_392 + k * 5_000_000
+            )
+            .unwrap();
+        }
+        t
+    }
+
+    const YAML: &str = "sensor_type: imu\nT_BS:\n  cols: 4\n  rows: 4\n  data: [0.0, 0.0, 1.0, 0.0,\n         0.0, 1.0, 0.0, 0.0,\n        -1.0, 0.0, 0.0, 0.0,\n         0.0, 0.0, 0.0, 1.0]\nrate_hz: 200\n";
+
+    /// Writes `mav0/<sub>` under a fresh case directory; returns (the folder, the file).
+    fn asl(tag: &str, sub: &str, bytes: &[u8], yaml: &[u8]) -> (PathBuf, PathBuf) {
+        let root = case_dir(tag);
+        let file = root.join("mav0").join(sub);
+        std::fs::create_dir_all(file.parent().unwrap()).unwrap();
+        std::fs::write(&file, bytes).unwrap();
+        std::fs::write(root.join("mav0/imu0/sensor.yaml"), yaml).ok();
+        (root, file)
+    }
+
+    fn located<T>(r: Result<T, ins_sim::SimError>, files: &[PathBuf]) -> Result<(), TestCaseError> {
+        match r {
+            Ok(_) => Ok(()),
+            Err(e) => check_located(&e, files),
+        }
+    }
+
+    fn write(tag: &str, name: &str, bytes: &[u8]) -> PathBuf {
+        let dir = case_dir(tag);
+        std::fs::create_dir_all(&dir).unwrap();
+        let p: PathBuf = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    }
+
+    #[test]
+    fn the_valid_layouts_read() {
+        let p = write("tum-valid", "t.tum", tum_text().as_bytes());
+        assert_eq!(
+            logs::read_reference_in(&p, Some(&frame()), None)
+                .unwrap()
+                .len(),
+            20
+        );
+        let (root, _) = asl(
+            "gt-valid",
+            "state_groundtruth_estimate0/data.csv",
+            gt_text().as_bytes(),
+            YAML.as_bytes(),
+        );
+        assert_eq!(
+            logs::read_reference_in(&root, Some(&frame()), None)
+                .unwrap()
+                .len(),
+            20
+        );
+        let (root, _) = asl(
+            "imu-valid",
+            "imu0/data.csv",
+            imu_text().as_bytes(),
+            YAML.as_bytes(),
+        );
+        let step = logs::imu_nominal_step_s(&root, None).unwrap();
+        // EuRoC's stamps (1.4e9 s) resolve to 0.24 µs as f64 seconds (module `asl`).
+        assert!((step - 0.005).abs() < 5e-7, "{step}");
+        let yaml = write("yaml-valid", "sensor.yaml", YAML.as_bytes());
+        assert_eq!(logs::read_sensor_yaml(&yaml).unwrap()[(0, 2)], 1.0);
+    }
+
+    proptest! {
+        #![proptest_config(config())]
+
+        #[test]
+        fn mutated_tum_trajectories_read_or_name_file_line_and_column(m in mutation()) {
+            let p = write("tum", "t.tum", &apply(tum_text().as_bytes(), &m));
+            located(logs::read_reference_in(&p, Some(&frame()), None), std::slice::from_ref(&p))?;
+            located(logs::read_reference_in(&p, None, None), &[p])?;
+        }
+
+        #[test]
+        fn mutated_asl_ground_truths_read_or_name_file_line_and_column(m in mutation()) {
+            let (root, file) = asl("gt", "state_groundtruth_estimate0/data.csv", &apply(gt_text().as_bytes(), &m), YAML.as_bytes());
+            located(logs::read_reference_in(&root, Some(&frame()), None), &[file])?;
+        }
+
+        #[test]
+        fn mutated_asl_imu_logs_read_or_name_file_line_and_column(m in mutation()) {
+            let (root, file) = asl("imu", "imu0/data.csv", &apply(imu_text().as_bytes(), &m), YAML.as_bytes());
+            located(logs::imu_nominal_step_s(&root, None), &[file])?;
+        }
+
+        #[test]
+        fn mutated_sensor_yamls_read_or_name_file_and_line(m in mutation()) {
+            let p = write("yaml", "sensor.yaml", &apply(YAML.as_bytes(), &m));
+            located(logs::read_sensor_yaml(&p), std::slice::from_ref(&p))?;
+            let (root, data) = asl("imu-yaml", "imu0/data.csv", imu_text().as_bytes(), &apply(YAML.as_bytes(), &m));
+            located(logs::imu_nominal_step_s(&root, None), &[data, root.join("mav0/imu0/sensor.yaml")])?;
+        }
+    }
 }

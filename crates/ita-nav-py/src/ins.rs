@@ -488,6 +488,7 @@ pub fn replay<'py>(
         max_gap_s,
         rate: rate_hz.map_or(logs::SolutionRate::EveryImu, logs::SolutionRate::Hz),
         mcap_out: None,
+        layouts: Default::default(),
     };
     let inputs = request.inputs().map_err(err)?;
     let summary = py

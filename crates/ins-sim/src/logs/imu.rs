@@ -1,6 +1,8 @@
-//! The IMU samples of a replay, from a CSV log (increments or rates, by its header) or from a
+//! The IMU samples of a replay, from a CSV log (increments or rates, by its header), from a
 //! ROS 2 bag's `sensor_msgs/msg/Imu` topic (rates; ROS's FLU body axes turned into the filter's
-//! FRD, `ros_bag::msgs::Imu::frd`; the time is the message header's stamp).
+//! FRD, `ros_bag::msgs::Imu::frd`; the time is the message header's stamp), or from an
+//! EuRoC/ASL folder (rates; nanosecond stamps; the IMU's axes rotated into the body's,
+//! [`super::asl`]).
 //!
 //! A replay opens its log once, as an [`ImuLog`]: what is read before the replay proper (the
 //! nominal step, [`ImuLog::nominal_step_s`]; a static alignment, [`super::align_at_rest`]) is
@@ -9,10 +11,11 @@
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use ros_bag::bag::{TopicReader, choose_topic, topics};
 use ros_bag::msgs::{IMU, Imu};
 
+use super::asl::{ASL_IMU_NAMES, asl_body_from_imu, asl_imu_file, next_imu, open_asl};
 use super::csv::CsvReader;
 use super::{IMU_HEADER, IMU_RATES_HEADER};
 use crate::SimError;
@@ -38,6 +41,12 @@ enum ImuStream {
         path: PathBuf,
         count: usize,
     },
+    /// An ASL `imu0/data.csv`: rates, nanosecond stamps, rotated into the body axes.
+    Asl {
+        reader: CsvReader,
+        body_from_imu: Matrix3<f64>,
+        prev_ns: Option<u64>,
+    },
 }
 
 fn bag_err(source: ros_bag::BagError) -> SimError {
@@ -51,8 +60,28 @@ pub fn is_bag(path: &Path) -> bool {
 }
 
 impl ImuStream {
-    /// Opens a CSV log, or a bag's IMU topic (`topic`, or its only `sensor_msgs/msg/Imu`).
-    fn open(path: &Path, topic: Option<&str>) -> Result<Self, SimError> {
+    /// Opens a CSV log, a bag's IMU topic (`topic`, or its only `sensor_msgs/msg/Imu`), or an
+    /// ASL folder's IMU (rotated by `body_from_imu`, else by its `sensor.yaml`).
+    fn open(
+        path: &Path,
+        topic: Option<&str>,
+        body_from_imu: Option<Matrix3<f64>>,
+    ) -> Result<Self, SimError> {
+        if let Some(file) = asl_imu_file(path) {
+            let body_from_imu = asl_body_from_imu(&file, body_from_imu)?;
+            return Ok(ImuStream::Asl {
+                reader: open_asl(&file, &ASL_IMU_NAMES)?,
+                body_from_imu,
+                prev_ns: None,
+            });
+        }
+        if body_from_imu.is_some() {
+            return Err(SimError::invalid(
+                "imu_to_body",
+                "applies to an EuRoC/ASL folder's IMU only (a CSV log or a bag is in body axes)",
+                path,
+            ));
+        }
         if is_bag(path) {
             let name = path.display().to_string();
             let all = topics(&name).map_err(bag_err)?;
@@ -74,7 +103,7 @@ impl ImuStream {
     fn rates(&self) -> bool {
         match self {
             ImuStream::Csv { rates, .. } => *rates,
-            ImuStream::Bag { .. } => true,
+            ImuStream::Bag { .. } | ImuStream::Asl { .. } => true,
         }
     }
 
@@ -135,6 +164,11 @@ impl ImuStream {
                     line: *count,
                 }))
             }
+            ImuStream::Asl {
+                reader,
+                body_from_imu,
+                prev_ns,
+            } => next_imu(reader, body_from_imu, prev_ns),
         }
     }
 }
@@ -146,6 +180,7 @@ impl ImuStream {
 pub struct ImuLog {
     path: PathBuf,
     topic: Option<String>,
+    body_from_imu: Option<Matrix3<f64>>,
     stream: Option<ImuStream>,
     /// Samples read ahead and not yet taken by [`ImuLog::next`].
     ahead: VecDeque<ImuRecord>,
@@ -170,9 +205,17 @@ impl ImuLog {
         Self {
             path: path.into(),
             topic,
+            body_from_imu: None,
             stream: None,
             ahead: VecDeque::new(),
         }
+    }
+
+    /// For an EuRoC/ASL folder: the rotation IMU axes → body axes, C_B^S (default: its
+    /// `sensor.yaml`'s `T_BS`); refused at the first read for any other log.
+    pub fn with_body_from_imu(mut self, body_from_imu: Option<Matrix3<f64>>) -> Self {
+        self.body_from_imu = body_from_imu;
+        self
     }
 
     /// The file.
@@ -183,7 +226,7 @@ impl ImuLog {
     fn stream(&mut self) -> Result<&mut ImuStream, SimError> {
         let stream = match self.stream.take() {
             Some(s) => s,
-            None => ImuStream::open(&self.path, self.topic.as_deref())?,
+            None => ImuStream::open(&self.path, self.topic.as_deref(), self.body_from_imu)?,
         };
         Ok(self.stream.insert(stream))
     }

@@ -98,6 +98,9 @@ pub(super) struct MetricsAcc {
     pub(super) out: ReplayMetrics,
 }
 
+/// The metrics compare with the reference interpolated between rows at most this far apart, s.
+pub const METRICS_MAX_REFERENCE_GAP_S: f64 = 1.5;
+
 impl MetricsAcc {
     pub(super) fn new(reference: Vec<ReferenceRow>) -> Self {
         let n = reference.len();
@@ -105,7 +108,7 @@ impl MetricsAcc {
             reference,
             next: 0,
             cursor: 0,
-            max_ref_gap_s: 1.5,
+            max_ref_gap_s: METRICS_MAX_REFERENCE_GAP_S,
             sum2: [[0.0; 3]; 3],
             sum2_norm: [0.0; 3],
             max: [0.0; 3],

@@ -17,6 +17,11 @@
 //! | truth / reference | `t_s,lat_rad,lon_rad,alt_m,vel_n_mps,vel_e_mps,vel_d_mps,q_w,q_x,q_y,q_z` or `t_s,lat_deg,lon_deg,alt_m,vn_mps,ve_mps,vd_mps,qw,qx,qy,qz` | navigation state (WGS-84 geodetic, NED velocity, body→NED quaternion) at any increasing times; in the degrees form the four quaternion fields may all be empty (no attitude) |
 //! | solution (output) | the truth header plus `,sigma_n_m,sigma_e_m,sigma_d_m,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,sigma_psi_n_rad,sigma_psi_e_rad,sigma_psi_d_rad,nis,used,rejected` | the navigation solution at every IMU sample, at a rate, or after each epoch ([`SolutionRate`]), with the 1σ of its position, velocity and attitude (ψ) errors from P at that time (empty without an estimator); `nis`, `used`, `rejected` after an epoch, empty otherwise |
 //!
+//! An EuRoC/ASL folder is read as an IMU log (`imu0/data.csv`, rotated by `T_BS`) and as a
+//! reference (its ground truth), and a TUM trajectory as a reference, both in a local frame
+//! given by its geodetic origin and axes: modules [`asl`] and [`local`] ([`asl_imu_file`],
+//! [`read_reference_in`], [`LocalFrame`]) document the stamps, units and axes converted.
+//!
 //! The landmark table is TOML, one `[[landmarks]]` table per landmark with `id` (integer),
 //! `lat_deg`, `lon_deg` (WGS-84, degrees) and `alt_m` (above the ellipsoid, m). The INS's
 //! initial state is TOML too: `t_s`, `lat_rad`, `lon_rad`, `alt_m`, `vel_ned_mps = [n, e, d]`,
@@ -93,8 +98,10 @@ pub mod names {
 }
 
 mod align;
+pub mod asl;
 mod csv;
 mod imu;
+pub mod local;
 mod mcap_out;
 mod metrics;
 mod read;
@@ -106,7 +113,12 @@ mod spans;
 mod write;
 
 pub use align::*;
+pub use asl::{
+    ASL_IMU_NAMES, ASL_TRUTH_NAMES, asl_body_from_imu, asl_imu_file, check_rotation,
+    read_sensor_yaml,
+};
 pub use imu::{ImuLog, imu_nominal_step_s, is_bag};
+pub use local::{LocalAxes, LocalFrame, write_tum};
 pub use mcap_out::InsMcapSink;
 pub use metrics::*;
 pub use read::*;

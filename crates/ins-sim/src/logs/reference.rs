@@ -1,13 +1,18 @@
 //! Reference trajectories (truth) as real systems give them: radians or degrees, attitude
-//! optional; interpolation at any time; the initial state of a replay taken from the reference.
+//! optional; a TUM trajectory or an EuRoC/ASL ground truth in a local frame
+//! ([`read_reference_in`], [`super::local`], [`super::asl`]); interpolation at any time; the
+//! initial state of a replay taken from the reference.
 
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 use ins_errors::earth::Geodetic;
 use ins_errors::strapdown::NavState;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-use super::csv::CsvReader;
+use super::asl::{asl_truth_file, read_asl_truth};
+use super::csv::{CsvReader, io_err};
+use super::local::{LocalFrame, read_tum};
 use super::read::InitialState;
 use super::{REFERENCE_DEG_HEADER, TRUTH_HEADER};
 use crate::SimError;
@@ -108,6 +113,53 @@ pub fn read_reference(path: &Path) -> Result<Vec<ReferenceRow>, SimError> {
         });
     }
     Ok(out)
+}
+
+/// True when the first line of `path` that is neither blank nor a `#` comment has no comma: a
+/// TUM trajectory (blank-separated), not a CSV file.
+fn is_tum(path: &Path) -> Result<bool, SimError> {
+    let file = std::fs::File::open(path).map_err(io_err(path))?;
+    for line in BufReader::new(file).lines() {
+        let line = line.map_err(io_err(path))?;
+        let t = line.trim();
+        if !(t.is_empty() || t.starts_with('#')) {
+            return Ok(!t.contains(','));
+        }
+    }
+    Ok(false)
+}
+
+/// Reads a reference in any layout `nav-app ins --truth` accepts: an EuRoC/ASL folder (`mav0`
+/// or the folder holding it) or its `state_groundtruth_estimate0/data.csv`, a TUM trajectory
+/// (lines without commas), or this project's CSV ([`read_reference`]). The first two are in a
+/// local frame: `local` gives its origin and axes (an error naming the file without it; unused
+/// for a CSV reference, which is geodetic); `body_from_imu` turns an ASL ground truth's sensor
+/// attitude into the body's.
+///
+/// # Errors
+/// As [`read_reference`]; [`SimError::LogParse`] naming the file and line for a missing local
+/// frame, a bad TUM or ASL line.
+pub fn read_reference_in(
+    path: &Path,
+    local: Option<&LocalFrame>,
+    body_from_imu: Option<&nalgebra::Matrix3<f64>>,
+) -> Result<Vec<ReferenceRow>, SimError> {
+    if let Some(file) = asl_truth_file(path) {
+        return read_asl_truth(&file, local, body_from_imu);
+    }
+    if path.is_file() && is_tum(path)? {
+        return read_tum(path, local);
+    }
+    read_reference(path)
+}
+
+/// True when `path` is a reference in a local frame (an ASL folder or ground truth, or a TUM
+/// trajectory), which [`read_reference_in`] reads only with a [`LocalFrame`].
+///
+/// # Errors
+/// [`SimError::LogIo`] when the file cannot be read.
+pub fn is_local_reference(path: &Path) -> Result<bool, SimError> {
+    Ok(asl_truth_file(path).is_some() || (path.is_file() && is_tum(path)?))
 }
 
 /// The reference at `t_s` by linear interpolation between the rows around it (attitude by

@@ -3,12 +3,15 @@
 
 use std::path::PathBuf;
 
+use nalgebra::Matrix3;
 use toml_config::TomlDoc;
 
 use super::align::AlignLimits;
+use super::asl::{asl_body_from_imu, asl_imu_file};
 use super::imu::ImuLog;
+use super::local::LocalFrame;
 use super::read::read_initial;
-use super::reference::{initial_from_reference, read_reference};
+use super::reference::{initial_from_reference, read_reference_in};
 use super::replay::{ReplayInputs, SolutionRate};
 use crate::filter_file::FilterFile;
 use crate::{Mode, Scenario, SimError};
@@ -45,6 +48,17 @@ impl FilterSettings {
     }
 }
 
+/// Inputs in the data sets' own layouts (`nav-app ins --imu-to-body`, `--tum-origin`,
+/// `--tum-frame`; [`super::asl`], [`super::local`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InputLayouts {
+    /// For an EuRoC/ASL folder's IMU: the rotation IMU axes → body axes, C_B^S (default: the
+    /// folder's `sensor.yaml`); refused for other IMU logs.
+    pub imu_to_body: Option<Matrix3<f64>>,
+    /// The local frame of a TUM or ASL reference (required by them, refused for a CSV one).
+    pub local_frame: Option<LocalFrame>,
+}
+
 /// A replay request ([`ReplayRequest::inputs`]).
 #[derive(Clone, Debug)]
 pub struct ReplayRequest {
@@ -79,6 +93,8 @@ pub struct ReplayRequest {
     pub rate: SolutionRate,
     /// Also write the results to this MCAP file.
     pub mcap_out: Option<PathBuf>,
+    /// How inputs in the data sets' own layouts are read.
+    pub layouts: InputLayouts,
 }
 
 impl ReplayRequest {
@@ -109,8 +125,20 @@ impl ReplayRequest {
         {
             return Err(SimError::invalid("rate", "must be a rate > 0 Hz", hz));
         }
+        // An ASL folder's IMU rotation, resolved once: its IMU and its ground truth use it.
+        let body_from_imu = match asl_imu_file(&self.imu) {
+            Some(file) => Some(asl_body_from_imu(&file, self.layouts.imu_to_body)?),
+            None => self.layouts.imu_to_body,
+        };
         let reference = match &self.reference {
-            Some(path) => Some((path.clone(), read_reference(path)?)),
+            Some(path) => Some((
+                path.clone(),
+                read_reference_in(
+                    path,
+                    self.layouts.local_frame.as_ref(),
+                    body_from_imu.as_ref(),
+                )?,
+            )),
             None => None,
         };
         let mut level = false;
@@ -132,7 +160,8 @@ impl ReplayRequest {
             }
         };
         // The log is opened here once; what the nominal step reads is kept for the replay.
-        let mut imu = ImuLog::new(self.imu.clone(), self.imu_topic.clone());
+        let mut imu =
+            ImuLog::new(self.imu.clone(), self.imu_topic.clone()).with_body_from_imu(body_from_imu);
         let mut config = match &self.settings {
             FilterSettings::File(f) => {
                 f.filter_config(self.mode, imu.nominal_step_s()?, initial.t_s)?

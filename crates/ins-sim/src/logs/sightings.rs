@@ -9,15 +9,18 @@
 //! reference without attitude) is a candidate; the `max_per_epoch` nearest are sighted. Each
 //! sighting is the true line of sight displaced by independent N(0, σ²) offsets in metres at the
 //! landmark along the true camera's image axes (`sighting_model::los_from_truth`), written as a
-//! unit vector in body axes when the reference has an attitude, else in local-level axes
-//! ([`sighting_model::LosFrame`]; a body direction needs the true attitude). Everything is drawn
+//! unit vector in body axes when the reference has an attitude, else in local-level axes, or in
+//! the frame the plan asks for ([`SightingPlan::frame`], [`sighting_model::LosFrame`]; a body
+//! direction needs the true attitude). Everything is drawn
 //! from one ChaCha8 stream seeded with `seed`: the same inputs give the same file.
 
 use std::io::Write;
 use std::path::Path;
 
 use ins_errors::earth::Geodetic;
-use ins_sd_filter::{LandmarkEntry, LandmarkTable, LosFrame, nav_pose};
+/// The frame of a sighting's direction ([`SightingPlan::frame`]).
+pub use ins_sd_filter::LosFrame;
+use ins_sd_filter::{LandmarkEntry, LandmarkTable, nav_pose};
 use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -47,6 +50,12 @@ pub struct SightingPlan {
     pub max_reference_gap_s: f64,
     /// Seed of the noise.
     pub seed: u64,
+    /// The frame of the directions written: `None` (the default) body axes when every reference
+    /// row has an attitude, else local-level (NED) axes; `Some(LosFrame::Body)` needs the
+    /// attitude in every row; `Some(LosFrame::LocalLevel)` writes NED directions whatever the
+    /// reference holds (the same draws: a NED direction is the body one rotated by the
+    /// reference attitude).
+    pub frame: Option<LosFrame>,
 }
 
 impl Default for SightingPlan {
@@ -60,6 +69,7 @@ impl Default for SightingPlan {
             max_per_epoch: 6,
             max_reference_gap_s: 1.5,
             seed: 1,
+            frame: None,
         }
     }
 }
@@ -138,10 +148,19 @@ pub fn write_sightings(
             what: "the reference trajectory is empty",
         });
     };
-    let frame = if reference.iter().all(|r| r.att_b_to_n.is_some()) {
-        LosFrame::Body
-    } else {
-        LosFrame::LocalLevel
+    let attitude_in_every_row = reference.iter().all(|r| r.att_b_to_n.is_some());
+    let frame = match plan.frame {
+        Some(LosFrame::Body) if !attitude_in_every_row => {
+            return Err(SimError::invalid(
+                "frame",
+                "body directions need the reference's attitude in every row (this reference \
+                 has rows without one): write local-level directions (ned)",
+                "body",
+            ));
+        }
+        Some(frame) => frame,
+        None if attitude_in_every_row => LosFrame::Body,
+        None => LosFrame::LocalLevel,
     };
     let wio = io_err(out_path);
     writeln!(out, "{POINTED_SIGHTINGS_HEADER}").map_err(&wio)?;

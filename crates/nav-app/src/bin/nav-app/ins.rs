@@ -10,9 +10,12 @@ use anyhow::{Context, Result, bail};
 use clap::Parser;
 use ins_sim::Mode;
 use ins_sim::filter_file::FilterFile;
+mod layouts;
+
 use ins_sim::logs::{
-    self, FilterSettings, ReplayMetrics, ReplaySummary, SightingPlan, SolutionRate,
+    self, FilterSettings, LosFrame, ReplayMetrics, ReplaySummary, SightingPlan, SolutionRate,
 };
+use layouts::{input_layouts, parse_rotation, write_tum_files};
 
 /// `nav-app ins`: replay an IMU log through the INS/SD filter.
 #[derive(Parser, Debug)]
@@ -22,7 +25,12 @@ use ins_sim::logs::{
              (formats: ins_sim::logs; `nav-app ins sightings --help` writes sightings from a \
              reference trajectory)",
     after_help = "The filter settings come from --config (a filter file in datasheet units, \
-                  ins_sim::filter_file) or --preset (compiled in: mems, the default, or paper). \
+                  ins_sim::filter_file) or --preset (compiled in): mems, the default (sighting \
+                  σ 1 m, gate 0.9999, feedback from the start), or paper (the paper's: sighting \
+                  σ 6.32 m, no gate, feedback from 195 s after the start: a shorter log runs \
+                  open loop throughout, and the replay warns). --print-config prints every \
+                  setting in force; the replay's first line names the preset, σ, gate and \
+                  feedback start. \
                   The initial state comes from --init, or from the reference (--truth) at \
                   --start-s (default: its first row). The IMU log, the reference and the \
                   sightings must overlap in time (an error names each file's first and last \
@@ -32,10 +40,25 @@ use ins_sim::logs::{
 )]
 struct InsArgs {
     /// IMU log (CSV; header `t_s,dv_x_mps,…,dtheta_z_rad` for increments or
-    /// `t_s,gyro_x_radps,…,accel_z_mps2` for rates; body FRD), or a ROS 2 bag (`.mcap`) with a
-    /// sensor_msgs/msg/Imu topic (ROS's FLU body axes are turned into FRD: y and z negated).
-    #[arg(long, value_name = "FILE")]
-    imu: PathBuf,
+    /// `t_s,gyro_x_radps,…,accel_z_mps2` for rates; body FRD), a ROS 2 bag (`.mcap`) with a
+    /// sensor_msgs/msg/Imu topic (ROS's FLU body axes are turned into FRD: y and z negated), or
+    /// an EuRoC/ASL folder (`mav0`, or the folder holding it: `imu0/data.csv`, nanosecond
+    /// stamps, ω then a, rotated into the body axes by --imu-to-body or its `sensor.yaml`'s
+    /// T_BS).
+    #[arg(long, value_name = "FILE", required_unless_present = "print_config")]
+    imu: Option<PathBuf>,
+    /// With an ASL folder: the rotation from the IMU's axes to the body's, C_B^S, as 9 numbers
+    /// row-major (R11,R12,…,R33; default: T_BS of the folder's imu0/sensor.yaml).
+    #[arg(long, value_name = "R11,…,R33")]
+    imu_to_body: Option<String>,
+    /// With a TUM or ASL reference (positions in a local frame): its origin, LAT,LON,ALT
+    /// (degrees, degrees, m above the WGS-84 ellipsoid). Also the origin of --tum-out.
+    #[arg(long, value_name = "LAT,LON,ALT", allow_hyphen_values = true)]
+    tum_origin: Option<String>,
+    /// The local frame's axes: enu (x east, y north, z up) or ned (x north, y east, z down);
+    /// with --tum-origin for a TUM or ASL reference; for --tum-out alone, default enu.
+    #[arg(long, value_name = "AXES", value_parser = ["enu", "ned"])]
+    tum_frame: Option<String>,
     /// With a bag: the IMU topic (default: the bag's only sensor_msgs/msg/Imu topic).
     #[arg(long, value_name = "TOPIC")]
     imu_topic: Option<String>,
@@ -85,17 +108,33 @@ struct InsArgs {
     #[arg(long, value_name = "HZ")]
     rate: Option<f64>,
     /// Solution CSV to write.
-    #[arg(long, value_name = "FILE")]
-    out: PathBuf,
+    #[arg(long, value_name = "FILE", required_unless_present = "print_config")]
+    out: Option<PathBuf>,
+    /// Print the filter settings in force (the filter file or preset with --gate applied) as a
+    /// filter file with units, to standard output, and exit; given back as --config it
+    /// reproduces the run. Needs no other option.
+    #[arg(long)]
+    print_config: bool,
     /// Also write the solution with its σ, each epoch's NIS and (with --truth) the errors as
     /// JSON channels of an MCAP file, plottable in Foxglove (/ins/solution, /ins/epochs,
     /// /ins/errors).
     #[arg(long, value_name = "FILE")]
     mcap_out: Option<PathBuf>,
-    /// Reference trajectory (CSV, radians or degrees, attitude optional): print and write the
-    /// errors against it.
+    /// Reference trajectory: print and write the errors against it. CSV (radians or degrees,
+    /// attitude optional), a TUM trajectory (`t x y z qx qy qz qw`, blank-separated, body →
+    /// local quaternion) or an EuRoC/ASL folder's ground truth
+    /// (state_groundtruth_estimate0/data.csv); the last two need --tum-origin and --tum-frame.
     #[arg(long, value_name = "FILE")]
     truth: Option<PathBuf>,
+    /// Also write the solution as a TUM trajectory (`t x y z qx qy qz qw`, what `evo` reads):
+    /// positions in a local frame (--tum-frame, default enu) with origin --tum-origin, default
+    /// the first solution row; a header comment states the frame and origin.
+    #[arg(long, value_name = "FILE")]
+    tum_out: Option<PathBuf>,
+    /// With --truth: the reference as a TUM trajectory in the same local frame, at the times
+    /// the errors were computed (the rows of the printed RMS).
+    #[arg(long, value_name = "FILE", requires = "truth")]
+    tum_truth_out: Option<PathBuf>,
     /// With --truth: the error statistics as JSON.
     #[arg(long, value_name = "FILE", requires = "truth")]
     metrics_json: Option<PathBuf>,
@@ -109,13 +148,32 @@ struct InsArgs {
 #[command(
     name = "nav-app ins sightings",
     about = "Writes a pointed-sightings log from a reference trajectory and a landmark table \
-             (ins_sim::logs::write_sightings): body directions when the reference has an \
-             attitude, local-level ones otherwise; seeded."
+             (ins_sim::logs::write_sightings): by default body directions when the reference has \
+             an attitude, local-level (NED) ones otherwise, or the frame --frame asks for; \
+             seeded."
 )]
 struct SightingsArgs {
-    /// Reference trajectory (CSV, radians or degrees, attitude optional).
+    /// Reference trajectory: CSV (radians or degrees, attitude optional), a TUM trajectory or an
+    /// EuRoC/ASL folder's ground truth (the last two with --tum-origin and --tum-frame, as for
+    /// `nav-app ins --truth`).
     #[arg(long, value_name = "FILE")]
     reference: PathBuf,
+    /// With a TUM or ASL reference: its local frame's origin, LAT,LON,ALT (degrees, degrees, m).
+    #[arg(
+        long,
+        value_name = "LAT,LON,ALT",
+        allow_hyphen_values = true,
+        requires = "tum_frame"
+    )]
+    tum_origin: Option<String>,
+    /// With an ASL folder's ground truth: the rotation IMU → body, as for `nav-app ins`
+    /// (default: the folder's imu0/sensor.yaml, else the identity), so that body directions are
+    /// in the body axes the replay uses.
+    #[arg(long, value_name = "R11,…,R33")]
+    imu_to_body: Option<String>,
+    /// With --tum-origin: the local frame's axes, enu or ned.
+    #[arg(long, value_name = "AXES", value_parser = ["enu", "ned"], requires = "tum_origin")]
+    tum_frame: Option<String>,
     /// Landmark table to read, or with --make-landmarks to write.
     #[arg(long, value_name = "FILE")]
     landmarks: PathBuf,
@@ -149,6 +207,47 @@ struct SightingsArgs {
     /// Seed of the noise (and of the landmark placement).
     #[arg(long, value_name = "N", default_value_t = 1)]
     seed: u64,
+    /// The frame of the directions written: body (FRD; needs the reference's attitude in every
+    /// row) or ned (local level). Default: body when the reference has an attitude in every
+    /// row, else ned. The same seed gives the same draws in either frame.
+    #[arg(long, value_name = "FRAME", value_parser = ["body", "ned"])]
+    frame: Option<String>,
+}
+
+/// Where the settings come from, for `--print-config` and the replay's header line.
+fn settings_origin(args: &InsArgs, settings: &FilterSettings) -> String {
+    match (settings, &args.config) {
+        (FilterSettings::File(f), Some(path)) => {
+            format!("{} over preset {}", path.display(), f.preset)
+        }
+        (FilterSettings::File(f), None) => format!("preset {}", f.preset),
+        (FilterSettings::Scenario(_), path) => format!(
+            "the [filter] of scenario {}",
+            path.as_deref().unwrap_or(Path::new("")).display()
+        ),
+    }
+}
+
+/// `--print-config`: the settings in force as a filter file, on standard output.
+fn print_config(args: &InsArgs) -> Result<()> {
+    let settings = filter_settings(args)?;
+    let FilterSettings::File(file) = &settings else {
+        bail!(
+            "--print-config: {} is a simulation scenario (the older way), not a filter file; \
+             its filter settings are its [filter] section",
+            args.config.as_deref().unwrap_or(Path::new("")).display()
+        );
+    };
+    let mut origin = settings_origin(args, &settings);
+    let file = match args.gate {
+        Some(p) => {
+            origin += &format!(", --gate {p}");
+            file.with_gate(p)?
+        }
+        None => *file,
+    };
+    print!("{}", file.to_toml(&origin));
+    Ok(())
 }
 
 fn filter_settings(args: &InsArgs) -> Result<FilterSettings> {
@@ -167,6 +266,13 @@ fn filter_settings(args: &InsArgs) -> Result<FilterSettings> {
 }
 
 fn run_ins(args: &InsArgs) -> Result<()> {
+    if args.print_config {
+        return print_config(args);
+    }
+    // clap requires both unless --print-config.
+    let (Some(imu), Some(out_path)) = (&args.imu, &args.out) else {
+        bail!("give --imu FILE and --out FILE (or --print-config)");
+    };
     let mode = Mode::from_name(&args.filter)
         .or((args.filter == "none").then_some(Mode::Standalone))
         .with_context(|| {
@@ -188,7 +294,7 @@ fn run_ins(args: &InsArgs) -> Result<()> {
         );
     }
     let request = logs::ReplayRequest {
-        imu: args.imu.clone(),
+        imu: imu.clone(),
         imu_topic: args.imu_topic.clone(),
         sightings: args.sightings.clone().zip(args.landmarks.clone()),
         initial: args.init.clone(),
@@ -202,16 +308,53 @@ fn run_ins(args: &InsArgs) -> Result<()> {
         max_gap_s: args.max_gap_s,
         rate: args.rate.map_or(SolutionRate::EveryImu, SolutionRate::Hz),
         mcap_out: args.mcap_out.clone(),
+        layouts: input_layouts(args)?,
     };
     if args.init.is_none() && args.truth.is_none() {
         bail!("the initial state: give --init FILE, or --truth FILE to take it from the reference");
     }
     let inputs = request.inputs()?;
-    let file = std::fs::File::create(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    let reference = args
+        .tum_truth_out
+        .as_ref()
+        .and(inputs.reference.as_ref())
+        .map(|(_, rows)| rows.clone());
+    let feedback_t_s = inputs.config.open_loop_until_s;
+    eprintln!(
+        "nav-app ins: settings: {}; --filter {}; sighting σ {:.3} m; gate {}; feedback from t = {:.3} s ({:.3} s after the start){}",
+        settings_origin(args, &request.settings),
+        args.filter,
+        inputs.config.r_var_m2.sqrt(),
+        inputs
+            .config
+            .gate_probability
+            .map_or("none".to_owned(), |p| format!("{p}")),
+        feedback_t_s,
+        feedback_t_s - inputs.initial.t_s,
+        if args.config.is_some() || args.preset.is_some() {
+            ""
+        } else {
+            " (all settings: --print-config)"
+        }
+    );
+    let file = std::fs::File::create(out_path)
+        .with_context(|| format!("creating {}", out_path.display()))?;
     let mut out = BufWriter::new(file);
-    let summary = logs::replay(inputs, &mut out, &args.out)?;
-    report(args, &summary)
+    let summary = logs::replay(inputs, &mut out, out_path)?;
+    if mode != Mode::Standalone && summary.end_t_s < feedback_t_s {
+        eprintln!(
+            "nav-app ins: warning: the IMU log ends at t = {:.3} s, before feedback starts at t = {:.3} s (filter.feedback_from_s after the start): the filter ran open loop throughout, its estimates never corrected the INS; lower feedback_from_s in a filter file (--print-config prints the settings in force)",
+            summary.end_t_s, feedback_t_s
+        );
+    }
+    report(args, out_path, &summary)?;
+    write_tum_files(
+        args,
+        &request.layouts,
+        out_path,
+        reference.as_deref(),
+        &summary,
+    )
 }
 
 /// The input rows not used, as one clause of the summary line.
@@ -236,7 +379,7 @@ fn unused_text(args: &InsArgs, s: &ReplaySummary) -> String {
     text
 }
 
-fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
+fn report(args: &InsArgs, out_path: &Path, s: &ReplaySummary) -> Result<()> {
     eprintln!(
         "nav-app ins: {} IMU samples to t = {:.3} s from the start at t = {:.3} s, {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; {}; wrote {}",
         s.imu_samples,
@@ -248,7 +391,7 @@ fn report(args: &InsArgs, s: &ReplaySummary) -> Result<()> {
         s.sightings_used,
         s.sightings_rejected,
         unused_text(args, s),
-        args.out.display()
+        out_path.display()
     );
     if let Some(a) = &s.alignment {
         let [x, y, z] = a.gyro_bias_body_radps;
@@ -357,7 +500,35 @@ fn print_metrics(truth: &Path, m: &ReplayMetrics) {
 }
 
 fn run_sightings(args: &SightingsArgs) -> Result<()> {
-    let reference = logs::read_reference(&args.reference)?;
+    let local = match (&args.tum_origin, &args.tum_frame) {
+        (Some(origin), Some(axes)) => Some(logs::LocalFrame::from_text(
+            origin,
+            logs::LocalAxes::parse(axes).context("--tum-frame: enu or ned")?,
+        )?),
+        _ => None,
+    };
+    if local.is_some() && !logs::is_local_reference(&args.reference)? {
+        bail!(
+            "--tum-origin: {} is a CSV reference (geodetic): it has no local frame",
+            args.reference.display()
+        );
+    }
+    let given = parse_rotation(args.imu_to_body.as_deref())?;
+    // An ASL folder: its IMU's rotation as the replay takes it (given, else sensor.yaml).
+    let folder_imu = Some(&args.reference)
+        .filter(|p| p.is_dir())
+        .and_then(|p| logs::asl_imu_file(p));
+    let body_from_imu = match (folder_imu, given) {
+        (Some(imu), given) if given.is_some() || imu.with_file_name("sensor.yaml").is_file() => {
+            Some(logs::asl_body_from_imu(&imu, given)?)
+        }
+        (None, Some(_)) => {
+            bail!("--imu-to-body: applies to an EuRoC/ASL folder's ground truth (--reference DIR)")
+        }
+        _ => None,
+    };
+    let reference =
+        logs::read_reference_in(&args.reference, local.as_ref(), body_from_imu.as_ref())?;
     if let Some(n) = args.make_landmarks {
         let (lo, hi) = (args.landmark_range_m[0], args.landmark_range_m[1]);
         let entries = logs::landmarks_around(&reference, n, lo, hi, args.seed)?;
@@ -376,6 +547,7 @@ fn run_sightings(args: &SightingsArgs) -> Result<()> {
         field_of_regard_deg: args.field_of_regard_deg,
         max_per_epoch: args.max_per_epoch,
         seed: args.seed,
+        frame: args.frame.as_deref().and_then(LosFrame::parse),
         ..SightingPlan::default()
     };
     let file = std::fs::File::create(&args.out)

@@ -98,10 +98,12 @@ use toml_config::TomlDoc;
 
 use crate::{Mode, ScenarioFilterConfig, SimError};
 
+mod print;
+
 /// The `mems` preset (the default): a consumer / industrial MEMS IMU.
-pub const PRESET_MEMS: &str = include_str!("../presets/mems.toml");
+pub const PRESET_MEMS: &str = include_str!("../../presets/mems.toml");
 /// The `paper` preset: the paper's IMU and manually tuned KF.
-pub const PRESET_PAPER: &str = include_str!("../presets/paper.toml");
+pub const PRESET_PAPER: &str = include_str!("../../presets/paper.toml");
 
 /// The preset names and texts.
 pub const PRESETS: [(&str, &str); 2] = [("mems", PRESET_MEMS), ("paper", PRESET_PAPER)];
@@ -216,6 +218,8 @@ impl RawFile {
 /// The replay's filter settings, validated, in datasheet units (module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FilterFile {
+    /// The preset the file's keys were laid over (`mems` when it names none).
+    pub preset: &'static str,
     /// Angle random walk, °/√h.
     pub gyro_arw_deg_per_rt_h: f64,
     /// Velocity random walk, m/s/√h.
@@ -259,6 +263,11 @@ pub struct FilterFile {
     pub align_max_speed_mps: f64,
 }
 
+/// A gate probability the filter accepts (the file writes 0 for no gate).
+fn gate_in_range(p: f64) -> bool {
+    p > 0.0 && p < 1.0
+}
+
 fn toml_err(path: &str, error: toml_config::TomlError) -> SimError {
     SimError::LogToml {
         path: path.into(),
@@ -291,7 +300,7 @@ impl FilterFile {
     pub(crate) fn from_doc(doc: &TomlDoc<'_>, path: &str) -> Result<Self, SimError> {
         let user: RawFile = doc.deserialize().map_err(|e| toml_err(path, e))?;
         let name = user.preset.as_deref().unwrap_or("mems");
-        let Some((_, preset_text)) = PRESETS.iter().find(|(n, _)| *n == name) else {
+        let Some(&(preset, preset_text)) = PRESETS.iter().find(|(n, _)| *n == name) else {
             return Err(toml_err(
                 path,
                 doc.error_at(
@@ -314,6 +323,7 @@ impl FilterFile {
         let (i, n, s, f, a) = (raw.imu, raw.initial, raw.sighting, raw.filter, raw.align);
         let defaults = crate::logs::AlignLimits::default();
         let out = FilterFile {
+            preset,
             gyro_arw_deg_per_rt_h: get(i.gyro_arw_deg_per_rt_h, "imu.gyro_arw_deg_per_rt_h")?,
             accel_vrw_mps_per_rt_h: get(i.accel_vrw_mps_per_rt_h, "imu.accel_vrw_mps_per_rt_h")?,
             gyro_bias_instability_deg_per_h: get(
@@ -426,7 +436,7 @@ impl FilterFile {
             }
         }
         if let Some(p) = out.gate_probability
-            && !(p > 0.0 && p < 1.0)
+            && !gate_in_range(p)
         {
             return Err(bad(
                 "sighting.gate_probability",
@@ -445,6 +455,25 @@ impl FilterFile {
             ));
         }
         Ok(out)
+    }
+
+    /// These settings with the gate probability replaced (`nav-app ins --gate P`; 0 = no gate),
+    /// so that [`FilterFile::to_toml`] prints the settings in force.
+    ///
+    /// # Errors
+    /// [`SimError::ScenarioInvalid`] (field `gate`) for a probability outside (0, 1) other than 0.
+    pub fn with_gate(self, gate_probability: f64) -> Result<Self, SimError> {
+        if gate_probability != 0.0 && !gate_in_range(gate_probability) {
+            return Err(SimError::invalid(
+                "gate",
+                "must be within (0, 1), or 0 for no gate",
+                gate_probability,
+            ));
+        }
+        Ok(Self {
+            gate_probability: (gate_probability != 0.0).then_some(gate_probability),
+            ..self
+        })
     }
 
     /// The rest check of `--align-s` (section `[align]`).
