@@ -130,6 +130,37 @@ fn a_lanes_rows_reach_up_as_far_as_its_mark_is_seen() {
 }
 
 #[test]
+fn a_lane_on_a_roads_edge_is_followed_up_along_its_step() {
+    // The rendered straight scene with a bright floor from the right mark outwards (a road's
+    // edge, a kerb: one step, no bright mark on a darker floor): the right lane is followed up
+    // along the step as far as the mark ran (module `lane_tracker::tracker::reach`, the mark's
+    // kind read on the near parabola's last rows), not left at the ROI's top.
+    let spec = scene("straight_solid");
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let (w, h) = (320usize, 240usize);
+    let mut renderer = SceneRenderer::new(spec, w, h);
+    let mut frame = GreyFrame::default();
+    renderer.render(0, &mut frame);
+    let truth = renderer.truth(0).lanes[1];
+    let mut pixels = frame.data().to_vec();
+    for y in 0..h {
+        let edge = truth.col_at_row(y as f64).round().max(0.0) as usize;
+        for v in &mut pixels[y * w + edge.min(w)..(y + 1) * w] {
+            *v = 200;
+        }
+    }
+    let edge_frame = GreyFrame::from_vec(w, h, pixels).unwrap();
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+    let report = tracker.track(&edge_frame).unwrap();
+    let roi_top = tracker.roi_rows().0 as f64;
+    let right = report.lanes[1];
+    let at = right.col_at_row(200.0).expect("the right lane on the edge");
+    assert!((at - truth.col_at_row(200.0)).abs() < 4.0, "at {at}");
+    let top = right.rows[0];
+    assert!(top < roi_top - 20.0, "rows from {top}, ROI from {roi_top}");
+}
+
+#[test]
 fn a_curving_lane_gets_a_far_segment_that_follows_it_better_than_the_near_parabola() {
     // The rendered curves: where a lane reports a far segment, it lies closer to the truth on
     // its rows than the near parabola extrapolated there (mean over the scene's first frames),

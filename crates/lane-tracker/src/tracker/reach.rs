@@ -19,12 +19,15 @@
 //! ```
 //!
 //! the mark's width shrinking linearly towards the horizon row `y_h` (where the two lanes meet,
-//! else the frame's top). The brightest such column moves `d` halfway to it (`|d| ≤ 2k`). The
-//! walk stops at `y_h` (without one — the lanes do not close in upwards — at the top of the
-//! second search's rows, `roi.fallback_top_row_fraction`), at the top of the rows the working
-//! frame holds, or after [`MAX_GAP_FRACTION`] of the
-//! height without a mark (a dash's gap is shorter); the lane's rows then start at the highest
-//! row where a mark was seen, if at least [`MIN_MARK_ROWS`] were.
+//! else the frame's top). A lane on a road's edge or a kerb has no such column: one side is
+//! brighter. What the lane is on is read first on the near parabola's last [`PROBE_ROWS`] rows
+//! (within ±3 px of it): where fewer than half hold a bright mark and at least half a step of
+//! one sign, `s · (I(c + 2) − I(c − 2)) ≥ MIN_STEP` (`s = ±1`, [`MIN_STEP`] grey levels), the
+//! walk looks for the strongest such step instead. The brightest (strongest) such column moves
+//! `d` halfway to it (`|d| ≤ 2k`). The walk stops at `y_h` (without one — the lanes do not close
+//! in upwards — where the marks end), at the top of the rows the working frame holds, or after
+//! [`MAX_GAP_FRACTION`] of the height without a mark (a dash's gap is shorter); the lane's rows
+//! then start at the highest row where a mark was seen, if at least [`MIN_MARK_ROWS`] were.
 //!
 //! The marks followed make the lane's **far segment** ([`super::report::FarSegment`]): a
 //! parabola joined to the near one at the top of its points `y_j` with the same column `x_j` and
@@ -52,6 +55,14 @@ use super::setup::{Rows, Setup};
 pub(crate) const MIN_CONTRAST: i16 = 12;
 /// Longest run of rows without a mark before the walk stops, as a fraction of the height.
 pub(crate) const MAX_GAP_FRACTION: f64 = 0.1;
+/// Least step across a road's edge or a kerb, grey levels.
+pub(crate) const MIN_STEP: i16 = 20;
+/// Half the span a step is read across, px.
+const STEP_HALF_PX: i64 = 2;
+/// Rows of the near parabola below the join read for what the lane is on.
+const PROBE_ROWS: usize = 8;
+/// Columns either side of the near parabola a probe row looks at, px.
+const PROBE_HALF_WIDTH_PX: i64 = 3;
 /// Fewest rows with a mark for a reach to count.
 pub(crate) const MIN_MARK_ROWS: usize = 3;
 /// The near parabola's curvature weighs in the far fit as this many marks this many rows
@@ -72,11 +83,9 @@ pub(super) fn reach_up(
     horizon_row: Option<f64>,
     setup: &Setup,
 ) {
-    let (w, h) = (image.width(), image.height());
-    // Without a horizon (the lanes do not close in upwards) no higher than the second search's
-    // rows, or the ROI's.
-    let unknown = setup.fallback_roi.unwrap_or(setup.roi).0 as f64;
-    let y_h = horizon_row.unwrap_or(unknown).max(0.0);
+    let h = image.height();
+    // Without a horizon (the lanes do not close in upwards) up to where the marks end.
+    let y_h = horizon_row.unwrap_or(0.0).max(0.0);
     let limit = (y_h.ceil() as usize).max(rows.0).max(1);
     let k = setup.cfg.track.window_half_width_px as i64;
     let max_width = f64::from(setup.cfg.gradient.stripe_max_width_px).max(4.0);
@@ -97,6 +106,7 @@ pub(super) fn reach_up(
         let [a1, a2, _] = filter.coeffs();
         let (y_j, x_j) = (start, filter.col_at_row(start));
         let m_j = 2.0 * a1 * y_j + a2;
+        let kind = MarkKind::of_near_field(image, filter_cols(filter, y_j), max_width, y_h, h);
         let mut far = FarFit::new(y_j, x_j, m_j, a1);
         let mut drift = 0.0f64;
         let (mut gap, mut top) = (0usize, None);
@@ -112,15 +122,7 @@ pub(super) fn reach_up(
                 break;
             }
             let centre = centre.round() as i64;
-            let mut best: Option<(i16, i64)> = None;
-            for c in (centre - k).max(m)..=(centre + k).min(w as i64 - 1 - m) {
-                let at = |x: i64| i16::from(line[x as usize]);
-                let step = at(c) - at(c - m).max(at(c + m));
-                if step >= MIN_CONTRAST && best.is_none_or(|(s, _)| step > s) {
-                    best = Some((step, c));
-                }
-            }
-            match best {
+            match kind.strongest(line, centre, k, m) {
                 Some((_, c)) => {
                     far.add(y as f64, c as f64);
                     let residual = c as f64 - far.col_at_row(y as f64);
@@ -139,6 +141,96 @@ pub(super) fn reach_up(
             });
         }
     }
+}
+
+/// The columns of the near parabola on the [`PROBE_ROWS`] rows below `y_j` (its last rows).
+fn filter_cols(filter: &super::lane::LaneFilter, y_j: f64) -> [(usize, f64); PROBE_ROWS] {
+    std::array::from_fn(|i| {
+        let y = y_j + 1.0 + i as f64;
+        (y as usize, filter.col_at_row(y))
+    })
+}
+
+/// What the lane is on, read on the near parabola's last rows: a bright mark (a ridge, the
+/// default) or the step of a road's edge or a kerb (one side brighter: `+1` the right).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum MarkKind {
+    Ridge,
+    Step(i16),
+}
+
+impl MarkKind {
+    /// A step of one sign on at least half of the probe rows where no ridge is: the lane is on
+    /// an edge; else on a mark.
+    fn of_near_field(
+        image: &GreyImage<'_>,
+        cols: [(usize, f64); PROBE_ROWS],
+        max_width: f64,
+        y_h: f64,
+        h: usize,
+    ) -> Self {
+        let w = image.width() as i64;
+        let (mut ridges, mut steps) = (0usize, [0usize; 2]);
+        for (y, x) in cols {
+            let Some(line) = image.row(y) else { continue };
+            if !x.is_finite() {
+                continue;
+            }
+            let depth = ((y as f64 - y_h) / (h as f64 - y_h)).clamp(0.0, 1.0);
+            let m = ((max_width * depth / 2.0).ceil() as i64 + 1).max(2);
+            let c = x.round() as i64;
+            if MarkKind::Ridge
+                .strongest(line, c, PROBE_HALF_WIDTH_PX, m)
+                .is_some()
+            {
+                ridges += 1;
+            } else {
+                for (i, sign) in [-1i16, 1].into_iter().enumerate() {
+                    let fits = (c - PROBE_HALF_WIDTH_PX..=c + PROBE_HALF_WIDTH_PX)
+                        .filter(|&c| c >= STEP_HALF_PX && c < w - STEP_HALF_PX)
+                        .any(|c| step_at(line, c, sign) >= MIN_STEP);
+                    steps[i] += usize::from(fits);
+                }
+            }
+        }
+        let half = PROBE_ROWS / 2;
+        match steps {
+            [l, r] if ridges < half && l >= half && l > r => MarkKind::Step(-1),
+            [l, r] if ridges < half && r >= half && r > l => MarkKind::Step(1),
+            _ => MarkKind::Ridge,
+        }
+    }
+
+    /// The strongest column of `line` within `centre ± k` of this kind, if any: a ridge at
+    /// least [`MIN_CONTRAST`] above the floor `m` px either side; a step of this sign at least
+    /// [`MIN_STEP`] across `±STEP_HALF_PX`.
+    fn strongest(self, line: &[u8], centre: i64, k: i64, m: i64) -> Option<(i16, i64)> {
+        let w = line.len() as i64;
+        let (margin, least) = match self {
+            MarkKind::Ridge => (m, MIN_CONTRAST),
+            MarkKind::Step(_) => (STEP_HALF_PX, MIN_STEP),
+        };
+        let mut best: Option<(i16, i64)> = None;
+        for c in (centre - k).max(margin)..=(centre + k).min(w - 1 - margin) {
+            let strength = match self {
+                MarkKind::Ridge => {
+                    let at = |x: i64| i16::from(line[x as usize]);
+                    at(c) - at(c - m).max(at(c + m))
+                }
+                MarkKind::Step(sign) => step_at(line, c, sign),
+            };
+            if strength >= least && best.is_none_or(|(s, _)| strength > s) {
+                best = Some((strength, c));
+            }
+        }
+        best
+    }
+}
+
+/// `sign · (I(c + STEP_HALF_PX) − I(c − STEP_HALF_PX))` (`c` at least `STEP_HALF_PX` inside).
+fn step_at(line: &[u8], c: i64, sign: i16) -> i16 {
+    let at = |x: i64| i16::from(line[x as usize]);
+    sign * (at(c + STEP_HALF_PX) - at(c - STEP_HALF_PX))
 }
 
 /// The far segment's least-squares fit (module docs): with `u = y − y_j`, the column
