@@ -38,21 +38,10 @@ fn synthetic_frame(w: usize, h: usize) -> GreyFrame {
     frame
 }
 
-/// `frame` with seeded Gaussian noise of σ = 8 grey levels (xorshift64* and Box–Muller).
+/// `frame` with seeded Gaussian noise of σ = 8 grey levels.
 fn noisy(frame: &GreyFrame) -> GreyFrame {
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    let mut uniform = || {
-        state ^= state >> 12;
-        state ^= state << 25;
-        state ^= state >> 27;
-        ((state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    };
     let mut out = frame.clone();
-    for v in out.data_mut() {
-        let (u, w) = (uniform(), uniform());
-        let n = (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * w).cos();
-        *v = (f64::from(*v) + 8.0 * n).round().clamp(0.0, 255.0) as u8;
-    }
+    lane_scenes::add_sensor_noise(&mut out, 8.0, 8);
     out
 }
 

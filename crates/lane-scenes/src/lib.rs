@@ -386,14 +386,7 @@ impl SceneRenderer {
                 *px = v.round().clamp(0.0, 255.0) as u8;
             }
         }
-        if spec.noise_sigma > 0.0
-            && let Ok(normal) = Normal::new(0.0, spec.noise_sigma)
-        {
-            for px in out.data_mut().iter_mut() {
-                let n: f64 = normal.sample(&mut self.rng);
-                *px = (f64::from(*px) + n).round().clamp(0.0, 255.0) as u8;
-            }
-        }
+        add_noise(out, spec.noise_sigma, &mut self.rng);
     }
 
     /// The sequence's ground truth for all its frames.
@@ -601,4 +594,22 @@ pub struct WriteError {
     /// What the writer said.
     #[source]
     pub source: std::io::Error,
+}
+
+/// `frame` plus independent Gaussian sensor noise of `sigma_grey` grey levels, rounded and
+/// clamped to 0..=255, drawn from ChaCha8 seeded with `seed` (what the `noise` scene adds to its
+/// frames; nothing for `sigma_grey ≤ 0`).
+pub fn add_sensor_noise(frame: &mut GreyFrame, sigma_grey: f64, seed: u64) {
+    add_noise(frame, sigma_grey, &mut ChaCha8Rng::seed_from_u64(seed));
+}
+
+fn add_noise(frame: &mut GreyFrame, sigma_grey: f64, rng: &mut ChaCha8Rng) {
+    if sigma_grey > 0.0
+        && let Ok(normal) = Normal::new(0.0, sigma_grey)
+    {
+        for px in frame.data_mut().iter_mut() {
+            let n: f64 = normal.sample(rng);
+            *px = (f64::from(*px) + n).round().clamp(0.0, 255.0) as u8;
+        }
+    }
 }
