@@ -29,7 +29,7 @@ fn frames_below_the_noise_limit_are_tracked_exactly_as_with_denoising_off() {
             assert!(
                 !noise.denoised,
                 "{} frame {i}: σ̂ {}",
-                spec.name, noise.noise_grey
+                spec.name, noise.sigma_grey
             );
             assert_eq!(a, b, "{} frame {i}", spec.name);
         }
@@ -63,10 +63,10 @@ fn a_noisy_camera_is_measured_smoothed_and_tracked_closer_to_the_truth() {
                     // (The `noise` scene has its own on top.)
                     let most = if spec.name == "noise" { 16.0 } else { 11.5 };
                     assert!(
-                        (8.5..=most).contains(&n.noise_grey),
+                        (8.5..=most).contains(&n.sigma_grey),
                         "{} frame {i}: σ̂ {}",
                         spec.name,
-                        n.noise_grey
+                        n.sigma_grey
                     );
                 }
                 for (lane, t) in report.lanes.iter().zip(truth.lanes) {

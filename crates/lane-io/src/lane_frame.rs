@@ -3,7 +3,7 @@
 //! JSON schema [`crate::mcap_sink::LANES_SCHEMA`] (`docs/json.md` documents its fields).
 
 use lane_tracker::camera::EgoLaneReport;
-use lane_tracker::{LaneReport, RoadReport};
+use lane_tracker::{FrameNoise, LaneReport, RoadReport};
 use serde::Serialize;
 
 use crate::capture_source::DeviceFrameInfo;
@@ -26,6 +26,9 @@ pub struct LaneFrame<'a> {
     /// The road region the frame was searched in: the road's bottom row, the rows searched and
     /// the horizon the ego lanes show (`lane_tracker::RoadReport`).
     pub road: RoadReport,
+    /// The frames' noise as last measured and whether they are smoothed before tracking
+    /// (`lane_tracker::FrameNoise`, `[denoise]`).
+    pub noise: FrameNoise,
     /// Wall time of `LaneTracker::track` on this frame, µs.
     pub track_us: f64,
     /// The ego lane in metres with σ (with a camera; `null` unless both lanes are held; absent
@@ -91,6 +94,10 @@ mod tests {
                 search_rows_px: [148.0, 240.0],
                 horizon_row_px: Some(96.5),
                 refused: None,
+            },
+            noise: FrameNoise {
+                sigma_grey: 1.7,
+                denoised: false,
             },
             track_us: 31.0,
             ego_lane: Some(None),

@@ -101,8 +101,14 @@ fn json_is_one_object_per_frame_with_the_documented_schema() {
         keys.sort_unstable();
         assert_eq!(
             keys,
-            ["frame", "lanes", "road", "schema", "t_s", "track_us"]
+            [
+                "frame", "lanes", "noise", "road", "schema", "t_s", "track_us"
+            ]
         );
+        // Rendered frames with σ = 2 noise: measured, below the default's limit, not smoothed.
+        let sigma = v["noise"]["sigma_grey"].as_f64().unwrap();
+        assert!(sigma > 0.5 && sigma < 4.0, "σ̂ {sigma}");
+        assert_eq!(v["noise"]["denoised"], false);
         let mut road: Vec<&str> = v["road"]
             .as_object()
             .unwrap()
@@ -632,4 +638,28 @@ fn each_cause_of_a_nested_error_is_printed_once() {
     for cause in [missing.as_str(), os.as_str()] {
         assert_eq!(e.matches(cause).count(), 1, "`{cause}` not once in {e}");
     }
+}
+
+#[test]
+fn a_reader_that_closes_the_pipe_ends_the_run_with_an_error_not_a_panic() {
+    // `nav-app --json | head -1`: the reader goes after one line.
+    let input = rendered("straight_solid");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nav-app"))
+        .args(["--input", &input, "--json"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    let mut first = [0u8; 64];
+    std::io::Read::read_exact(&mut stdout, &mut first).unwrap();
+    drop(stdout);
+    let o = child.wait_with_output().unwrap();
+    let err = stderr(&o);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        o.status.code().is_some(),
+        "ended by a signal: {:?}",
+        o.status
+    );
 }

@@ -41,6 +41,7 @@
 //!
 //! Decisions and figures: `docs/lanes/history/denoising.md`.
 
+use serde::Serialize;
 use vision_gradient::GreyImage;
 
 use super::setup::Rows;
@@ -50,11 +51,12 @@ pub(crate) const REMEASURE_EVERY_FRAMES: u32 = 30;
 /// `median |I ∗ N| = NOISE_MEDIAN_PER_SIGMA · σ` for independent Gaussian noise (`0.6745 · 6`).
 const NOISE_MEDIAN_PER_SIGMA: f64 = 0.6745 * 6.0;
 
-/// The last measurement of the frames' noise and what it does to them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The last measurement of the frames' noise and what it does to them (`nav-app --json`'s
+/// `noise`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct FrameNoise {
     /// Noise σ̂ of the rows searched, grey levels (0: not measured).
-    pub noise_grey: f64,
+    pub sigma_grey: f64,
     /// Whether the frames are smoothed before the stages read them (σ̂ above
     /// `denoise.above_noise_grey`).
     pub denoised: bool,
@@ -63,12 +65,13 @@ pub struct FrameNoise {
 impl FrameNoise {
     /// Nothing measured, nothing done.
     pub const NONE: FrameNoise = FrameNoise {
-        noise_grey: 0.0,
+        sigma_grey: 0.0,
         denoised: false,
     };
 }
 
-/// The stage: its limit, the histograms of a measurement, the stretch's centre and the buffers the smoothed frame is written to.
+/// The stage: its limit, the histograms of a measurement, the stretch's centre and the buffers
+/// the smoothed frame is written to.
 #[derive(Debug)]
 pub(super) struct Denoiser {
     /// `denoise.above_noise_grey` (0: never measured nor smoothed).
@@ -157,10 +160,10 @@ impl Denoiser {
             self.last = FrameNoise::NONE;
             return;
         }
-        let noise_grey = f64::from(median(&self.noise_hist, n)) / NOISE_MEDIAN_PER_SIGMA;
+        let sigma_grey = f64::from(median(&self.noise_hist, n)) / NOISE_MEDIAN_PER_SIGMA;
         self.last = FrameNoise {
-            noise_grey,
-            denoised: noise_grey > self.above_noise_grey,
+            sigma_grey,
+            denoised: sigma_grey > self.above_noise_grey,
         };
         self.median_grey = u8::try_from(median(&self.grey_hist, n)).unwrap_or(u8::MAX);
     }

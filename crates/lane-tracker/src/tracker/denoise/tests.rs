@@ -58,7 +58,7 @@ fn the_noise_estimate_reads_the_added_noise_and_ignores_ramps_and_marks() {
         let px = scene(sigma, 7);
         let mut stage = Denoiser::new(100.0, W, H);
         stage.measure_if_due(&image(&px), (0, H), true);
-        let n = stage.last().noise_grey;
+        let n = stage.last().sigma_grey;
         assert!((lo..=hi).contains(&n), "σ {sigma}: σ̂ {n}");
         assert!(!stage.last().denoised, "below the limit of 100");
     }

@@ -390,6 +390,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 t_s: meta.t_s,
                 lanes: &report.lanes,
                 road: report.road,
+                noise: t.frame_noise(),
                 track_us: dt.as_secs_f64() * 1e6,
                 ego_lane: ego,
                 lane_cov_px: (camera.is_some() || mcap_out.is_some()).then(|| {
@@ -566,9 +567,16 @@ pub fn main() -> ExitCode {
                 error,
             },
         };
-        match serde_json::to_string(&summary) {
-            Ok(line) => println!("{line}"),
-            Err(e) => eprintln!("nav-app: error: cannot write the JSON summary: {e}"),
+        // Written, not printed: a reader that closed the pipe (`| head -1`) is no panic; the
+        // summary then has nowhere to go and is dropped.
+        let written = serde_json::to_string(&summary)
+            .map_err(std::io::Error::other)
+            .and_then(|line| writeln!(std::io::stdout().lock(), "{line}"));
+        match written {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                eprintln!("nav-app: error: cannot write the JSON summary: {e}")
+            }
+            _ => {}
         }
     } else if let (Some(dev), Some(stats), Some(_)) = (&args.device, stats, &monitor) {
         eprintln!(
