@@ -21,6 +21,7 @@ use layouts::{input_layouts, parse_rotation, write_tum_files};
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app ins",
+    bin_name = "nav-app ins",
     about = "Replays an IMU log, with landmark sightings or unaided, through the INS/SD filter \
              (formats: ins_sim::logs; `nav-app ins sightings --help` writes sightings from a \
              reference trajectory)",
@@ -147,6 +148,7 @@ struct InsArgs {
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app ins sightings",
+    bin_name = "nav-app ins sightings",
     about = "Writes a pointed-sightings log from a reference trajectory and a landmark table \
              (ins_sim::logs::write_sightings): by default body directions when the reference has \
              an attitude, local-level (NED) ones otherwise, or the frame --frame asks for; \
@@ -381,10 +383,11 @@ fn unused_text(args: &InsArgs, s: &ReplaySummary) -> String {
 
 fn report(args: &InsArgs, out_path: &Path, s: &ReplaySummary) -> Result<()> {
     eprintln!(
-        "nav-app ins: {} IMU samples to t = {:.3} s from the start at t = {:.3} s, {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; {}; wrote {}",
+        "nav-app ins: {} IMU samples to t = {:.3} s from the start at t = {:.3} s (the first {:.3} s after it), {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; {}; wrote {}",
         s.imu_samples,
         s.end_t_s,
         s.start_t_s,
+        s.lead_in_s,
         s.gaps,
         s.longest_gap_s,
         s.epochs,
@@ -432,6 +435,7 @@ fn report(args: &InsArgs, out_path: &Path, s: &ReplaySummary) -> Result<()> {
             "epochs": s.epochs,
             "sightings_used": s.sightings_used,
             "sightings_rejected": s.sightings_rejected,
+            "lead_in_s": s.lead_in_s,
             "gaps": s.gaps,
             "longest_gap_s": s.longest_gap_s,
             "start_t_s": s.start_t_s,
