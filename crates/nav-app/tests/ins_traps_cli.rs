@@ -5,7 +5,7 @@
 
 mod ins_common;
 
-use ins_common::{nav_app, scratch, stderr, write_imu, write_reference};
+use ins_common::{nav_app, scratch, stderr, write_imu, write_reference, write_sightings};
 
 /// A reference whose first row (the default start) is 0.03 s before the first IMU sample was
 /// reported as "1 IMU gaps bridged (longest 0.030 s)".
@@ -86,4 +86,38 @@ fn usage_lines_name_the_whole_command() {
         assert!(o.status.success(), "{args:?}: {}", stderr(&o));
         assert!(out.contains(usage), "{args:?}: {out}");
     }
+}
+
+/// `--plot` draws the errors with the envelopes of the solution file it wrote (the envelopes'
+/// data is tested in `ins_plot::replay`): a PNG of the figure size.
+#[test]
+fn ins_plot_writes_the_error_figure() {
+    let dir = scratch("plot");
+    let p = |n: &str| dir.join(n).display().to_string();
+    write_imu(&dir.join("imu.csv"));
+    write_reference(&dir.join("truth.csv"), 0.0, 0.0);
+    let (s, lm) = write_sightings(&dir);
+    let o = nav_app(&[
+        "ins",
+        "--imu",
+        &p("imu.csv"),
+        "--truth",
+        &p("truth.csv"),
+        "--sightings",
+        &s,
+        "--landmarks",
+        &lm,
+        "--rate",
+        "10",
+        "--out",
+        &p("o.csv"),
+        "--plot",
+        &p("errors.png"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let png = std::fs::read(dir.join("errors.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    // Width and height, big-endian, in the IHDR chunk.
+    let be = |i: usize| u32::from_be_bytes([png[i], png[i + 1], png[i + 2], png[i + 3]]);
+    assert_eq!((be(16), be(20)), (1000, 760));
 }

@@ -139,7 +139,8 @@ struct InsArgs {
     /// With --truth: the error statistics as JSON.
     #[arg(long, value_name = "FILE", requires = "truth")]
     metrics_json: Option<PathBuf>,
-    /// With --truth: a PNG of the errors and their ±3σ envelopes.
+    /// With --truth: a PNG of the errors (at the reference's rows) and their ±3σ envelopes
+    /// (from the σ of each row of --out, so as many points as --rate writes).
     #[arg(long, value_name = "FILE", requires = "truth")]
     plot: Option<PathBuf>,
 }
@@ -453,7 +454,9 @@ fn report(args: &InsArgs, out_path: &Path, s: &ReplaySummary) -> Result<()> {
         let parts: Vec<_> = truth.components().rev().take(2).collect();
         let name: PathBuf = parts.iter().rev().collect();
         let title = format!("--filter {} against {}", args.filter, name.display());
-        let png = ins_plot::replay_figure(&m.series, &title)?;
+        // The envelopes from the σ of each solution row, as written.
+        let rows = logs::read_solution_sigma(out_path)?;
+        let png = ins_plot::replay_figure(&m.series, &rows, &title)?;
         std::fs::write(path, png).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
