@@ -485,23 +485,33 @@ fn print_metrics(truth: &Path, m: &ReplayMetrics) {
     if let Some(a) = &m.attitude_rad {
         line("attitude", "mrad", a, 1e3);
     }
-    let band = |b: Option<[f64; 2]>| {
-        b.map_or(String::new(), |[lo, hi]| {
-            format!(" (χ² 95 % band {lo:.3}–{hi:.3})")
-        })
-    };
     if let Some(n) = m.nees_per_dof {
+        let band = match (
+            m.nees_band_95,
+            m.nees_effective_times,
+            m.nees_autocorrelation_times,
+        ) {
+            (Some([lo, hi]), Some(n_eff), Some(tau)) => format!(
+                "; the times are correlated (autocorrelation time {tau:.1} times): as {n_eff:.1} independent ones, χ² 95 % band {lo:.3}–{hi:.3}{}",
+                m.nees_band_95_if_independent
+                    .map_or(String::new(), |[lo, hi]| format!(
+                        " ({lo:.3}–{hi:.3} if they were independent)"
+                    ))
+            ),
+            _ => String::new(),
+        };
         eprintln!(
-            "  NEES per dof {n:.3} over {} dof{}",
-            m.nees_dof,
-            band(m.nees_band_95)
+            "  NEES per dof {n:.3} over {} dof at {} times{band}",
+            m.nees_dof, m.nees_times
         );
     }
     if let Some(n) = m.nis_per_dof {
         eprintln!(
             "  NIS per dof {n:.3} over {} dof{}",
             m.nis_dof,
-            band(m.nis_band_95)
+            m.nis_band_95.map_or(String::new(), |[lo, hi]| format!(
+                " (χ² 95 % band {lo:.3}–{hi:.3}, the epochs taken as independent: a consistent filter's innovations are white)"
+            ))
         );
     }
 }
