@@ -186,7 +186,8 @@ def replay(
     allow_unaided: bool = False,
 ) -> dict:
     """Replay an IMU log as `nav-app ins` does; returns imu_samples, epochs, sightings_used,
-    sightings_rejected, gaps, longest_gap_s, end_t_s and, with truth, metrics (as --metrics-json).
+    sightings_rejected, lead_in_s (from the start to the first IMU sample, s: not a gap), gaps,
+    longest_gap_s, end_t_s and, with truth, metrics (as --metrics-json).
     Inputs that do not overlap in time, a filter that used no sighting (unless allow_unaided) and
     an alignment (align_s) away from rest raise NavError naming the files and their spans."""
 

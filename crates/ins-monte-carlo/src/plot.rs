@@ -7,8 +7,12 @@
 
 use std::error::Error;
 
-use ins_plot::{HEIGHT_PX as H, Series, WIDTH_PX as W, encode_png, panel, register_font};
+use ins_plot::{
+    HEIGHT_PX as H, Series, WIDTH_PX as W, encode_png, log_ticks, panel, register_font, segments,
+    style_mesh,
+};
 use plotters::coord::Shift;
+use plotters::coord::combinators::BindKeyPoints;
 use plotters::prelude::*;
 
 use super::McError;
@@ -158,19 +162,24 @@ where
     if !(lo.is_finite() && hi.is_finite() && lo > 0.0) {
         (lo, hi) = (0.1, 10.0);
     }
+    let (y0, y1) = (0.8 * lo, 1.25 * hi);
+    let (labelled, light) = log_ticks(y0, y1);
     let mut chart = ChartBuilder::on(area)
         .caption(caption, ("sans-serif", 20))
         .margin(12)
         .margin_right(36)
         .x_label_area_size(40)
         .y_label_area_size(80)
-        .build_cartesian_2d(0.0..t_end.max(1.0), (0.8 * lo..1.25 * hi).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc("time (s)")
-        .y_desc(y_desc)
-        .label_style(("sans-serif", 14))
-        .draw()?;
+        .build_cartesian_2d(
+            0.0..t_end.max(1.0),
+            (y0..y1)
+                .log_scale()
+                .with_key_points(labelled)
+                .with_light_points(light),
+        )?;
+    let mut mesh = chart.configure_mesh();
+    style_mesh(&mut mesh);
+    mesh.x_desc("time (s)").y_desc(y_desc).draw()?;
     for &(y, c) in bands {
         chart.draw_series(DashedLineSeries::new(
             [(0.0, y), (t_end, y)],
@@ -182,7 +191,7 @@ where
     for (name, colour, pts) in data {
         let c = *colour;
         chart
-            .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))?
+            .draw_series(segments(pts, c.stroke_width(2)))?
             .label(name.as_str())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
     }
@@ -248,7 +257,9 @@ where
         }
         log_panel(
             area,
-            &format!("{name} averaged over runs, n = {dof}; dashed: 95 % band"),
+            &format!(
+                "{name} averaged over runs, n = {dof}; dashed: 95 % band of a mean of independent runs"
+            ),
             name,
             t_end,
             &data,
@@ -413,6 +424,7 @@ where
     let y0 = ys.iter().copied().fold(f64::INFINITY, f64::min).max(1e-3) / 1.5;
     let y1 = ys.iter().copied().fold(0.0, f64::max).max(y0 * 10.0) * 1.5;
     let pad = if x1 > x0 { 0.05 * (x1 - x0) } else { 1.0 };
+    let (labelled, light) = log_ticks(y0, y1);
     let mut chart = ChartBuilder::on(&area)
         .caption(
             format!("Final 3-D position error vs {key} ({runs} runs: median, 10–90 % bars)"),
@@ -421,12 +433,17 @@ where
         .margin(20)
         .x_label_area_size(50)
         .y_label_area_size(70)
-        .build_cartesian_2d((x0 - pad)..(x1 + pad), (y0..y1).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc(key)
+        .build_cartesian_2d(
+            (x0 - pad)..(x1 + pad),
+            (y0..y1)
+                .log_scale()
+                .with_key_points(labelled)
+                .with_light_points(light),
+        )?;
+    let mut mesh = chart.configure_mesh();
+    style_mesh(&mut mesh);
+    mesh.x_desc(key)
         .y_desc("final 3-D position error (m)")
-        .label_style(("sans-serif", 16))
         .draw()?;
     let mut modes: Vec<Mode> = Vec::new();
     for p in pts {
@@ -438,8 +455,11 @@ where
         let c = mode_colour(mode);
         let mine: Vec<&SweepPoint> = pts.iter().filter(|p| p.mode == mode).collect();
         chart
-            .draw_series(LineSeries::new(
-                mine.iter().map(|p| (p.value, p.median_m.max(y0))),
+            .draw_series(segments(
+                &mine
+                    .iter()
+                    .map(|p| (p.value, p.median_m.max(y0)))
+                    .collect::<Vec<_>>(),
                 c.stroke_width(2),
             ))?
             .label(mode.to_string())
@@ -490,3 +510,7 @@ pub fn sweep_figure(
     .map_err(|e| plot_error("PNG sweep figure", e))?;
     Ok((svg, encode_png(rgb)?))
 }
+
+#[cfg(test)]
+#[path = "plot_tests.rs"]
+mod tests;

@@ -466,3 +466,35 @@ fn a_replay_reads_its_imu_log_once() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The time-averaged NEES is judged against the band for its correlated times (issue 54: the
+/// band for independent times — 0.969–1.031 per dof over 900 compared times — is far too
+/// narrow). The simulated KF of the paper's scenario replayed against its own truth (900 s,
+/// truth at 1 Hz): its errors are correlated over tens of seconds, so the 901 times count as
+/// 5–60 independent ones, and seed 3's mean NEES per dof (0.83) lies inside that band and
+/// outside the other. (Over seeds 1–6 the means are 0.60–0.98: the paper's tuning is
+/// conservative, and the band says so for seeds 5 and 6.)
+#[test]
+fn a_replays_mean_nees_is_judged_against_the_band_for_its_correlated_times() {
+    let sc = Scenario::paper_default();
+    let dir = temp_dir("nees-band");
+    logs::export_run(&sc, Mode::Kf, 3, &dir).unwrap();
+    let mut inp = inputs(&dir, Mode::Kf);
+    let truth = dir.join(names::TRUTH);
+    inp.reference = Some((truth.clone(), logs::read_reference(&truth).unwrap()));
+    let m = replay_to(&dir, inp).unwrap().metrics.unwrap();
+    assert_eq!(m.nees_times, 901);
+    let n_eff = m.nees_effective_times.unwrap();
+    let tau = m.nees_autocorrelation_times.unwrap();
+    assert!((5.0..60.0).contains(&n_eff), "{n_eff}");
+    assert!(
+        (n_eff * tau - 901.0).abs() < 1e-6 * 901.0,
+        "{n_eff} × {tau}"
+    );
+    let nees = m.nees_per_dof.unwrap();
+    let [lo, hi] = m.nees_band_95.unwrap();
+    let [ilo, ihi] = m.nees_band_95_if_independent.unwrap();
+    assert!((lo..=hi).contains(&nees), "{nees} outside {lo}–{hi}");
+    assert!(!(ilo..=ihi).contains(&nees), "{nees} inside {ilo}–{ihi}");
+    assert!(lo < ilo && hi > ihi);
+}

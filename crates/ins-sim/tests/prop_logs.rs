@@ -273,6 +273,19 @@ proptest! {
     }
 
     #[test]
+    fn mutated_solution_files_read_their_sigma_or_name_file_line_and_column(m in mutation()) {
+        let text = std::fs::read(exported().0.join(names::SOLUTION)).unwrap();
+        let bad = apply(&text, &m);
+        let dir = case_dir("solution");
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(names::SOLUTION);
+        std::fs::write(&path, &bad).unwrap();
+        if let Err(e) = logs::read_solution_sigma(&path) {
+            check_located(&e, std::slice::from_ref(&path))?;
+        }
+    }
+
+    #[test]
     fn initial_states_round_trip(
         t in -1e6f64..1e6, lat in -1.5f64..1.5, lon in -3.1f64..3.1, alt in -1e3f64..1e5,
         v in proptest::array::uniform3(-300f64..300.0), q in proptest::array::uniform4(-1f64..1.0),

@@ -503,6 +503,7 @@ pub fn replay<'py>(
     d.set_item("epochs", summary.epochs)?;
     d.set_item("sightings_used", summary.sightings_used)?;
     d.set_item("sightings_rejected", summary.sightings_rejected)?;
+    d.set_item("lead_in_s", summary.lead_in_s)?;
     d.set_item("gaps", summary.gaps)?;
     d.set_item("longest_gap_s", summary.longest_gap_s)?;
     d.set_item("end_t_s", summary.end_t_s)?;

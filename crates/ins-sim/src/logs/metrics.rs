@@ -8,6 +8,7 @@ use ins_errors::strapdown::NavState;
 use ins_sd_filter::{InsSdFilter, UpdateReport};
 use nalgebra::SMatrix;
 
+use super::chi2_band;
 use super::read::read_truth;
 use super::reference::{ReferenceRow, interpolate};
 use crate::SimError;
@@ -62,15 +63,26 @@ pub struct ReplayMetrics {
     pub nees_per_dof: Option<f64>,
     /// Degrees of freedom of one NEES (6 or 9).
     pub nees_dof: usize,
-    /// Two-sided 95 % χ² band of the mean NEES per dof if the compared times were independent
-    /// (they are not: consecutive errors are correlated, so this band is only a guide).
+    /// Compared times with a NEES.
+    pub nees_times: usize,
+    /// Integrated autocorrelation time of the NEES series, in compared times (module
+    /// [`super::chi2_band`]).
+    pub nees_autocorrelation_times: Option<f64>,
+    /// The number of independent times whose mean NEES would vary as much as this one:
+    /// `nees_times` / `nees_autocorrelation_times`, within [1, `nees_times`].
+    pub nees_effective_times: Option<f64>,
+    /// Two-sided 95 % band of the mean NEES per dof for `nees_effective_times` independent
+    /// times (χ²(ν)/ν, ν = `nees_effective_times` · `nees_dof`; module [`super::chi2_band`]):
+    /// consecutive errors are correlated, so the times are not independent.
     pub nees_band_95: Option<[f64; 2]>,
+    /// The band if the compared times were independent (too narrow: for comparison only).
+    pub nees_band_95_if_independent: Option<[f64; 2]>,
     /// Mean NIS per degree of freedom over the sighting epochs (Σ NIS / Σ 2·used).
     pub nis_per_dof: Option<f64>,
     /// Degrees of freedom summed over the epochs.
     pub nis_dof: u64,
-    /// Two-sided 95 % χ² band of the mean NIS per dof (epochs' innovations are independent for a
-    /// consistent filter).
+    /// Two-sided 95 % χ² band of the mean NIS per dof, the epochs taken as independent (a
+    /// consistent filter's innovations are white).
     pub nis_band_95: Option<[f64; 2]>,
     /// The compared times (for plots; not serialised).
     #[serde(skip)]
@@ -93,6 +105,8 @@ pub(super) struct MetricsAcc {
     epoch_count: [u64; 3],
     nees_sum: f64,
     nees_n: u64,
+    /// The NEES of each compared time (capacity: the reference's rows, one at most each).
+    nees: Vec<f64>,
     nis_sum: f64,
     nis_dof: u64,
     pub(super) out: ReplayMetrics,
@@ -119,6 +133,7 @@ impl MetricsAcc {
             epoch_count: [0; 3],
             nees_sum: 0.0,
             nees_n: 0,
+            nees: Vec::with_capacity(n),
             nis_sum: 0.0,
             nis_dof: 0,
             out: ReplayMetrics {
@@ -204,6 +219,8 @@ impl MetricsAcc {
             if let Some(n) = nees {
                 self.nees_sum += n;
                 self.nees_n += 1;
+                // At most one per reference row passed: within the capacity.
+                self.nees.push(n);
             }
         }
         self.out.nees_dof = 3 * blocks;
@@ -255,7 +272,13 @@ impl MetricsAcc {
         if self.nees_n > 0 {
             let dof = (self.nees_n * self.out.nees_dof as u64) as f64;
             self.out.nees_per_dof = Some(self.nees_sum / dof);
-            self.out.nees_band_95 = band(dof);
+            self.out.nees_times = self.nees.len();
+            self.out.nees_band_95_if_independent = band(dof);
+            if let Some(b) = chi2_band::nees_band(&self.nees, self.out.nees_dof as f64) {
+                self.out.nees_band_95 = Some(b.band);
+                self.out.nees_effective_times = Some(b.effective_times);
+                self.out.nees_autocorrelation_times = Some(b.autocorrelation_times);
+            }
         }
         if self.nis_dof > 0 {
             self.out.nis_per_dof = Some(self.nis_sum / self.nis_dof as f64);

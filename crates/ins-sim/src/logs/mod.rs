@@ -99,6 +99,7 @@ pub mod names {
 
 mod align;
 pub mod asl;
+pub mod chi2_band;
 mod csv;
 mod imu;
 pub mod local;

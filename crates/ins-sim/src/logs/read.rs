@@ -155,6 +155,45 @@ pub fn read_solution(path: &Path) -> Result<Vec<(f64, NavState)>, SimError> {
     Ok(out)
 }
 
+/// The filter's 1σ at one row of a solution file: position (N, E, D, m), velocity (N, E, D, m/s)
+/// and misalignment ψ (N, E, D, rad), in the file's column order (`sigma_n_m` … `sigma_psi_d_rad`);
+/// NaN where the row has none (a run without an estimator).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolutionSigma {
+    /// Time of the row, s.
+    pub t_s: f64,
+    /// The nine σ.
+    pub sigma: [f64; 9],
+}
+
+/// Column of `sigma_n_m`, the first σ, in a solution file.
+const SOLUTION_SIGMA_COLUMN: usize = 11;
+
+/// Reads the σ columns of a solution file written by [`super::replay`] or
+/// [`super::export_run`]: one [`SolutionSigma`] per row.
+///
+/// # Errors
+/// As [`read_truth`].
+pub fn read_solution_sigma(path: &Path) -> Result<Vec<SolutionSigma>, SimError> {
+    let mut r = CsvReader::open(path, SOLUTION_HEADER)?;
+    let names: Vec<&str> = SOLUTION_HEADER.split(',').collect();
+    let mut out = Vec::new();
+    while let Some(rec) = r.next()? {
+        let mut row = SolutionSigma {
+            t_s: r.f64(&rec, 0, names[0])?,
+            sigma: [f64::NAN; 9],
+        };
+        for (k, s) in row.sigma.iter_mut().enumerate() {
+            let i = SOLUTION_SIGMA_COLUMN + k;
+            if let Some(v) = r.opt_f64(&rec, i, names.get(i).copied().unwrap_or("sigma"))? {
+                *s = v;
+            }
+        }
+        out.push(row);
+    }
+    Ok(out)
+}
+
 /// Writes a landmark table file (the format [`read_landmarks`] reads).
 ///
 /// # Errors

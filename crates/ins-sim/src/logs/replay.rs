@@ -9,7 +9,9 @@
 //! a sighting is never applied late. A sample more than [`GAP_FACTOR`] nominal steps after the
 //! previous one is a **gap**: it is bridged by propagating its mean rates in nominal steps (the
 //! covariance grows with the model's Q over the gap), counted and reported, and refused only
-//! when longer than `max_gap_s`.
+//! when longer than `max_gap_s`. The first sample after the start is bridged the same way when
+//! it is that far from the start, but that is the **lead-in** ([`ReplaySummary::lead_in_s`],
+//! e.g. a reference whose first row, the default start, precedes the IMU log), not a gap.
 //!
 //! ## Inputs that cannot be right
 //!
@@ -108,7 +110,11 @@ pub struct ReplaySummary {
     /// True when the sightings were offsets (format 1): meaningful only to the filter that
     /// pointed the device.
     pub offset_sightings: bool,
-    /// IMU gaps bridged.
+    /// Time from the start to the first IMU sample propagated, s (bridged in nominal steps
+    /// when longer than [`GAP_FACTOR`] of them, but not an IMU gap: e.g. a reference whose
+    /// first row, the default start, precedes the IMU log).
+    pub lead_in_s: f64,
+    /// IMU gaps bridged (between two IMU samples).
     pub gaps: u64,
     /// The longest gap, s.
     pub longest_gap_s: f64,
@@ -476,8 +482,12 @@ pub fn replay(
                 ),
             ));
         }
+        // Bridged in nominal steps when longer than GAP_FACTOR of them; counted as a gap only
+        // between two samples: the first sample's distance from the start is the lead-in.
         let gap = dt > GAP_FACTOR * step;
-        if gap {
+        if run.summary.imu_samples == 0 {
+            run.summary.lead_in_s = dt;
+        } else if gap {
             run.summary.gaps += 1;
             run.summary.longest_gap_s = run.summary.longest_gap_s.max(dt);
         }

@@ -21,6 +21,7 @@ use layouts::{input_layouts, parse_rotation, write_tum_files};
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app ins",
+    bin_name = "nav-app ins",
     about = "Replays an IMU log, with landmark sightings or unaided, through the INS/SD filter \
              (formats: ins_sim::logs; `nav-app ins sightings --help` writes sightings from a \
              reference trajectory)",
@@ -138,7 +139,8 @@ struct InsArgs {
     /// With --truth: the error statistics as JSON.
     #[arg(long, value_name = "FILE", requires = "truth")]
     metrics_json: Option<PathBuf>,
-    /// With --truth: a PNG of the errors and their ±3σ envelopes.
+    /// With --truth: a PNG of the errors (at the reference's rows) and their ±3σ envelopes
+    /// (from the σ of each row of --out, so as many points as --rate writes).
     #[arg(long, value_name = "FILE", requires = "truth")]
     plot: Option<PathBuf>,
 }
@@ -147,6 +149,7 @@ struct InsArgs {
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app ins sightings",
+    bin_name = "nav-app ins sightings",
     about = "Writes a pointed-sightings log from a reference trajectory and a landmark table \
              (ins_sim::logs::write_sightings): by default body directions when the reference has \
              an attitude, local-level (NED) ones otherwise, or the frame --frame asks for; \
@@ -381,10 +384,11 @@ fn unused_text(args: &InsArgs, s: &ReplaySummary) -> String {
 
 fn report(args: &InsArgs, out_path: &Path, s: &ReplaySummary) -> Result<()> {
     eprintln!(
-        "nav-app ins: {} IMU samples to t = {:.3} s from the start at t = {:.3} s, {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; {}; wrote {}",
+        "nav-app ins: {} IMU samples to t = {:.3} s from the start at t = {:.3} s (the first {:.3} s after it), {} IMU gaps bridged (longest {:.3} s), {} sighting epochs, {} sightings used, {} rejected by the gate; {}; wrote {}",
         s.imu_samples,
         s.end_t_s,
         s.start_t_s,
+        s.lead_in_s,
         s.gaps,
         s.longest_gap_s,
         s.epochs,
@@ -432,6 +436,7 @@ fn report(args: &InsArgs, out_path: &Path, s: &ReplaySummary) -> Result<()> {
             "epochs": s.epochs,
             "sightings_used": s.sightings_used,
             "sightings_rejected": s.sightings_rejected,
+            "lead_in_s": s.lead_in_s,
             "gaps": s.gaps,
             "longest_gap_s": s.longest_gap_s,
             "start_t_s": s.start_t_s,
@@ -449,7 +454,9 @@ fn report(args: &InsArgs, out_path: &Path, s: &ReplaySummary) -> Result<()> {
         let parts: Vec<_> = truth.components().rev().take(2).collect();
         let name: PathBuf = parts.iter().rev().collect();
         let title = format!("--filter {} against {}", args.filter, name.display());
-        let png = ins_plot::replay_figure(&m.series, &title)?;
+        // The envelopes from the σ of each solution row, as written.
+        let rows = logs::read_solution_sigma(out_path)?;
+        let png = ins_plot::replay_figure(&m.series, &rows, &title)?;
         std::fs::write(path, png).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
@@ -478,23 +485,33 @@ fn print_metrics(truth: &Path, m: &ReplayMetrics) {
     if let Some(a) = &m.attitude_rad {
         line("attitude", "mrad", a, 1e3);
     }
-    let band = |b: Option<[f64; 2]>| {
-        b.map_or(String::new(), |[lo, hi]| {
-            format!(" (χ² 95 % band {lo:.3}–{hi:.3})")
-        })
-    };
     if let Some(n) = m.nees_per_dof {
+        let band = match (
+            m.nees_band_95,
+            m.nees_effective_times,
+            m.nees_autocorrelation_times,
+        ) {
+            (Some([lo, hi]), Some(n_eff), Some(tau)) => format!(
+                "; the times are correlated (autocorrelation time {tau:.1} times): as {n_eff:.1} independent ones, χ² 95 % band {lo:.3}–{hi:.3}{}",
+                m.nees_band_95_if_independent
+                    .map_or(String::new(), |[lo, hi]| format!(
+                        " ({lo:.3}–{hi:.3} if they were independent)"
+                    ))
+            ),
+            _ => String::new(),
+        };
         eprintln!(
-            "  NEES per dof {n:.3} over {} dof{}",
-            m.nees_dof,
-            band(m.nees_band_95)
+            "  NEES per dof {n:.3} over {} dof at {} times{band}",
+            m.nees_dof, m.nees_times
         );
     }
     if let Some(n) = m.nis_per_dof {
         eprintln!(
             "  NIS per dof {n:.3} over {} dof{}",
             m.nis_dof,
-            band(m.nis_band_95)
+            m.nis_band_95.map_or(String::new(), |[lo, hi]| format!(
+                " (χ² 95 % band {lo:.3}–{hi:.3}, the epochs taken as independent: a consistent filter's innovations are white)"
+            ))
         );
     }
 }

@@ -30,6 +30,7 @@ output that could not be written — each named); 2 bad command line.";
 #[derive(Parser, Debug)]
 #[command(
     name = "nav-app monte-carlo",
+    bin_name = "nav-app monte-carlo",
     about = "The INS/SD paper's Monte Carlo (stand-alone INS, KF, AKF): summaries, CSV, Figs. 1–8",
     after_help = AFTER_HELP,
     args_conflicts_with_subcommands = true,
