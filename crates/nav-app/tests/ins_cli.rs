@@ -49,6 +49,10 @@ fn ins_refuses_a_reference_on_another_clock_exit_1_naming_each_file_and_its_span
         !dir.join("m.json").exists(),
         "no metrics JSON for a refused run"
     );
+    assert!(
+        !dir.join("o.csv").exists(),
+        "no partial solution left by a refused run"
+    );
 }
 
 /// `--filter kf` with sightings on another clock: exit 1 unless `--allow-unaided`; allowed,

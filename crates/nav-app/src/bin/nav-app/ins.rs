@@ -343,7 +343,18 @@ fn run_ins(args: &InsArgs) -> Result<()> {
     let file = std::fs::File::create(out_path)
         .with_context(|| format!("creating {}", out_path.display()))?;
     let mut out = BufWriter::new(file);
-    let summary = logs::replay(inputs, &mut out, out_path)?;
+    let summary = match logs::replay(inputs, &mut out, out_path) {
+        Ok(summary) => summary,
+        Err(e) => {
+            // A refused or failed run leaves no solution behind that could pass for one (the
+            // rows before the refusal); a device or a symlink such as /dev/stdout is left alone.
+            drop(out);
+            if std::fs::symlink_metadata(out_path).is_ok_and(|m| m.is_file()) {
+                let _ = std::fs::remove_file(out_path);
+            }
+            return Err(e.into());
+        }
+    };
     if mode != Mode::Standalone && summary.end_t_s < feedback_t_s {
         eprintln!(
             "nav-app ins: warning: the IMU log ends at t = {:.3} s, before feedback starts at t = {:.3} s (filter.feedback_from_s after the start): the filter ran open loop throughout, its estimates never corrected the INS; lower feedback_from_s in a filter file (--print-config prints the settings in force)",
