@@ -473,7 +473,7 @@ impl Default for FrameConfig {
 #[serde(default, deny_unknown_fields)]
 pub struct DenoiseConfig {
     /// Noise σ̂ (the robust Laplacian estimate), grey levels, above which the frame is smoothed
-    /// by a 3 × 3 binomial (and stretched by 4/3) before the stages read it; 0 = never (the
+    /// by a 3 × 3 binomial before the stages read it; 0 = never (the
     /// default when absent).
     pub above_noise_grey: f64,
 }

@@ -21,17 +21,13 @@
 //! On the labelled stills σ̂ is 0.5–2.5 grey levels for 90 % of the frames (some textured indoor
 //! floors read up to 5.5); with σ = 8 added it reads 8.2–8.9.
 //!
-//! **The remedy.** Above `denoise.above_noise_grey` the working frame is smoothed by the 3 × 3 binomial
-//! `[1 2 1]ᵀ[1 2 1]/16`, which keeps `Σw² = (6/16)² = 0.14` of independent noise's variance
-//! (σ × 0.375), and its grey levels stretched about their median `m` by `g = 4/3`,
-//!
-//! ```text
-//! I' = clamp(m + g · (B ∗ I − m), 0, 255),
-//! ```
-//!
-//! because the smoothing leaves a step edge `3/4` of its Sobel magnitude (the smoothed central
-//! difference `[−1 −2 0 2 1]/4` sums to 3/4 either side): a mark's edges then pass the same
-//! thresholds as before, the noise at σ × 0.5.
+//! **The remedy.** Above `denoise.above_noise_grey` the working frame is smoothed by the 3 × 3
+//! binomial `B = [1 2 1]ᵀ[1 2 1]/16`, which keeps `Σw² = (6/16)² = 0.14` of independent noise's
+//! variance (σ × 0.375) and 3/4 of a step edge's Sobel magnitude (the smoothed central difference
+//! `[−1 −2 0 2 1]/4` sums to 3/4 either side). Giving the step its magnitude back by stretching
+//! the grey levels by 4/3 was measured and not kept: it pulled a dashed lane onto a road edge
+//! beside it in its gaps (the rendered `noise` scene) and gained nothing overall on the real
+//! stills (`docs/lanes/history/denoising.md`).
 //!
 //! **When.** Measured on every frame that starts with no lane estimate (a new scene: the frame
 //! the road's bottom is placed on) and every [`REMEASURE_EVERY_FRAMES`] frames while lanes are
@@ -70,8 +66,8 @@ impl FrameNoise {
     };
 }
 
-/// The stage: its limit, the histograms of a measurement, the stretch's centre and the buffers
-/// the smoothed frame is written to.
+/// The stage: its limit, the histogram of a measurement and the buffers the smoothed frame is
+/// written to.
 #[derive(Debug)]
 pub(super) struct Denoiser {
     /// `denoise.above_noise_grey` (0: never measured nor smoothed).
@@ -79,9 +75,6 @@ pub(super) struct Denoiser {
     last: FrameNoise,
     frames_since_measured: u32,
     noise_hist: Vec<u32>,
-    grey_hist: Vec<u32>,
-    /// The median grey of the last measurement: the centre of the stretch.
-    median_grey: u8,
     /// The vertical binomial sums of the rows written, `width` a row.
     sums: Vec<u16>,
     /// The smoothed frame, `width` a row.
@@ -102,8 +95,6 @@ impl Denoiser {
             last: FrameNoise::NONE,
             frames_since_measured: 0,
             noise_hist: vec![0; 256],
-            grey_hist: vec![0; 256],
-            median_grey: 128,
             sums: vec![0; n],
             pixels: vec![0; n],
         }
@@ -134,10 +125,9 @@ impl Denoiser {
     }
 
     /// σ̂ and the median grey of every other pixel of every other row of `roi` (those with a
-    /// pixel on each side), whether to smooth, and the stretch's look-up table.
+    /// pixel on each side), and whether to smooth.
     fn measure(&mut self, image: &GreyImage<'_>, roi: Rows) {
         self.noise_hist.fill(0);
-        self.grey_hist.fill(0);
         let (w, h) = (image.width(), image.height());
         let mut n = 0usize;
         for y in (roi.0.max(1)..roi.1.min(h.saturating_sub(1))).step_by(2) {
@@ -152,7 +142,6 @@ impl Denoiser {
                 let sides = p(up, x) + p(mid, x - 1) + p(mid, x + 1) + p(down, x);
                 let laplacian = corners - 2 * sides + 4 * p(mid, x);
                 self.noise_hist[laplacian.unsigned_abs().min(255) as usize] += 1;
-                self.grey_hist[usize::from(mid[x])] += 1;
                 n += 1;
             }
         }
@@ -165,11 +154,10 @@ impl Denoiser {
             sigma_grey,
             denoised: sigma_grey > self.above_noise_grey,
         };
-        self.median_grey = u8::try_from(median(&self.grey_hist, n)).unwrap_or(u8::MAX);
     }
 
     /// The frame the stages read when the last measurement smooths: `image`'s rows `rows`
-    /// smoothed and stretched into a buffer lent out of the stage (the other rows are stale;
+    /// smoothed into a buffer lent out of the stage (the other rows are stale;
     /// give it back with [`Self::put_back`]); `None`: `image` as it is.
     pub(super) fn smoothed(&mut self, image: &GreyImage<'_>, rows: Rows) -> Option<Vec<u8>> {
         let (w, h) = (image.width(), image.height());
@@ -178,7 +166,7 @@ impl Denoiser {
         }
         let mut out = std::mem::take(&mut self.pixels);
         let rows = (rows.0.min(h), rows.1.min(h));
-        smooth_and_stretch(image, rows, self.median_grey, &mut self.sums, &mut out);
+        smooth(image, rows, &mut self.sums, &mut out);
         Some(out)
     }
 
@@ -188,28 +176,16 @@ impl Denoiser {
     }
 }
 
-/// `out` = `image` smoothed by `B = [1 2 1]ᵀ[1 2 1]/16` over the rows `[top, end)` and stretched
-/// by 4/3 about `median_grey`: with `S = 16·(B ∗ I)` the integer sum of the mask (clamped to the
-/// frame: its border rows and columns repeat their neighbour),
-///
-/// ```text
-/// m + (4/3)·(S/16 − m) = (S − 4m)/12,   rounded half up and clamped to 0..=255,
-/// ```
-///
-/// all in integers (the inner columns vectorise). `sums` and `out` hold `width × height`.
-fn smooth_and_stretch(
-    image: &GreyImage<'_>,
-    (top, end): Rows,
-    median_grey: u8,
-    sums: &mut [u16],
-    out: &mut [u8],
-) {
+/// `out` = `image` smoothed by `B = [1 2 1]ᵀ[1 2 1]/16` over the rows `[top, end)`: with `S` the
+/// integer sum of the mask (clamped to the frame: its border rows and columns repeat their
+/// neighbour), `(S + 8)/16`, rounded half up, in integers (the inner columns vectorise). `sums`
+/// and `out` hold `width × height`.
+fn smooth(image: &GreyImage<'_>, (top, end): Rows, sums: &mut [u16], out: &mut [u8]) {
     let (w, h) = (image.width(), image.height());
     if w == 0 || h == 0 {
         return;
     }
-    let offset = 6 - 4 * i32::from(median_grey);
-    let stretch = |s: i32| ((s + offset).max(0) / 12).min(255) as u8;
+    let round = |s: i32| ((s + 8) / 16).min(255) as u8;
     for y in top..end {
         let (Some(up), Some(mid), Some(down)) = (
             image.row(y.saturating_sub(1)),
@@ -225,18 +201,18 @@ fn smooth_and_stretch(
         let o = &mut out[y * w..(y + 1) * w];
         let sum3 = |l: u16, c: u16, r: u16| i32::from(l) + 2 * i32::from(c) + i32::from(r);
         if w == 1 {
-            o[0] = stretch(4 * i32::from(col[0]));
+            o[0] = round(4 * i32::from(col[0]));
             continue;
         }
-        o[0] = stretch(sum3(col[0], col[0], col[1]));
-        o[w - 1] = stretch(sum3(col[w - 2], col[w - 1], col[w - 1]));
+        o[0] = round(sum3(col[0], col[0], col[1]));
+        o[w - 1] = round(sum3(col[w - 2], col[w - 1], col[w - 1]));
         for (((v, &l), &c), &r) in o[1..w - 1]
             .iter_mut()
             .zip(&col[..w - 2])
             .zip(&col[1..w - 1])
             .zip(&col[2..])
         {
-            *v = stretch(sum3(l, c, r));
+            *v = round(sum3(l, c, r));
         }
     }
 }
