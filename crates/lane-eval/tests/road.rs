@@ -89,18 +89,23 @@ fn a_bonnet_in_view_ends_the_road_and_the_lanes_are_found_above_it() {
     );
 }
 
+/// The rendered `straight_solid` scene's first 320×240 frame, its renderer, and a default tracker.
+fn straight_first_frame() -> (GreyFrame, SceneRenderer, LaneTracker) {
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let mut renderer = SceneRenderer::new(scene("straight_solid"), 320, 240);
+    let mut frame = GreyFrame::default();
+    renderer.render(0, &mut frame);
+    let tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
+    (frame, renderer, tracker)
+}
+
 #[test]
 fn a_lanes_rows_reach_up_as_far_as_its_mark_is_seen() {
     // The rendered straight scene: its marks run from the bottom towards the horizon, so each
     // lane's rows reach well above the ROI's top (module `lane_tracker::tracker::reach`). With
     // the marks painted out above a row, the rows stop there (within the walk's gap).
-    let spec = scene("straight_solid");
-    let cfg = TrackerConfig::default_preset().unwrap();
-    let (w, h) = (320usize, 240usize);
-    let mut renderer = SceneRenderer::new(spec, w, h);
-    let mut frame = GreyFrame::default();
-    renderer.render(0, &mut frame);
-    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
+    let (frame, _, mut tracker) = straight_first_frame();
+    let (w, h) = (frame.width(), frame.height());
     let report = tracker.track(&frame).unwrap();
     let roi_top = tracker.roi_rows().0 as f64;
     for lane in report.lanes {
@@ -135,12 +140,8 @@ fn a_lane_on_a_roads_edge_is_followed_up_along_its_step() {
     // edge, a kerb: one step, no bright mark on a darker floor): the right lane is followed up
     // along the step as far as the mark ran (module `lane_tracker::tracker::reach`, the mark's
     // kind read on the near parabola's last rows), not left at the ROI's top.
-    let spec = scene("straight_solid");
-    let cfg = TrackerConfig::default_preset().unwrap();
-    let (w, h) = (320usize, 240usize);
-    let mut renderer = SceneRenderer::new(spec, w, h);
-    let mut frame = GreyFrame::default();
-    renderer.render(0, &mut frame);
+    let (frame, renderer, mut tracker) = straight_first_frame();
+    let (w, h) = (frame.width(), frame.height());
     let truth = renderer.truth(0).lanes[1];
     let mut pixels = frame.data().to_vec();
     for y in 0..h {
@@ -150,7 +151,6 @@ fn a_lane_on_a_roads_edge_is_followed_up_along_its_step() {
         }
     }
     let edge_frame = GreyFrame::from_vec(w, h, pixels).unwrap();
-    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, w, h).unwrap();
     let report = tracker.track(&edge_frame).unwrap();
     let roi_top = tracker.roi_rows().0 as f64;
     let right = report.lanes[1];
