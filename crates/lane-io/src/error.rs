@@ -279,6 +279,15 @@ pub enum LaneIoError {
         #[source]
         source: image::ImageError,
     },
+    /// A Foxglove message of the lane channels could not be encoded as JSON.
+    #[error("topic {topic}: cannot encode the message as JSON")]
+    Encode {
+        /// The channel's topic.
+        topic: &'static str,
+        /// The encoder's error.
+        #[source]
+        source: serde_json::Error,
+    },
     /// The tracker, its configuration or the camera model refused (crate `lane-tracker`; a
     /// configuration text out of range names its file, line and column).
     #[error(transparent)]

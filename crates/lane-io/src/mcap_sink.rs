@@ -5,6 +5,10 @@
 //! `nav-app --json` prints for the frame, [`LaneFrame`], with its JSON schema [`LANES_SCHEMA`]). Opening the
 //! file in Foxglove's Image panel on `/camera/image` with `/camera/lanes` as annotations shows
 //! the camera with the lanes on it; the Plot panel plots `/lanes.lanes[0].coeffs[2]` and the rest.
+//!
+//! The messages are encoded once ([`LaneEncoder`]; `/lanes` is the `--json` line itself) and the
+//! same bytes go to the file ([`LaneMcapSink::write_encoded`]) and to a live Foxglove connection
+//! (`nav-app --foxglove`), whose channels are [`lane_channels`].
 
 use grey_frame::GreyFrame;
 use lane_tracker::TrackReport;
@@ -66,68 +70,53 @@ const NO_FILL: Color = Color {
 /// Vertices per lane polyline.
 const POLYLINE_POINTS: usize = 24;
 
-/// An open `--mcap-out` file.
-#[derive(Debug)]
-pub struct LaneMcapSink {
-    writer: JsonMcapWriter,
-    image: JsonChannel,
-    annotations: JsonChannel,
-    lanes: JsonChannel,
+/// The lane channels, in the order image, annotations, lanes: (topic, schema name, JSON schema).
+pub fn lane_channels() -> [(&'static str, &'static str, String); 3] {
+    [
+        (IMAGE_TOPIC, RAW_IMAGE, raw_image_schema()),
+        (
+            ANNOTATIONS_TOPIC,
+            IMAGE_ANNOTATIONS,
+            image_annotations_schema(),
+        ),
+        (LANES_TOPIC, LANES_SCHEMA_NAME, LANES_SCHEMA.to_owned()),
+    ]
+}
+
+/// A frame's time in nanoseconds, as the channels carry it: `round(max(t_s, 0)·1e9)`.
+pub fn frame_t_ns(t_s: f64) -> u64 {
+    (t_s.max(0.0) * 1e9).round() as u64
+}
+
+/// Encodes the `/camera/image` and `/camera/lanes` messages as JSON into buffers it keeps, so that
+/// one encoding serves the file and the live connection alike.
+#[derive(Debug, Default)]
+pub struct LaneEncoder {
     base64: String,
     ann: ImageAnnotations,
+    image: Vec<u8>,
+    annotations: Vec<u8>,
 }
 
-fn bag(source: ros_bag::BagError) -> LaneIoError {
-    LaneIoError::Bag { source }
+fn encode(
+    topic: &'static str,
+    out: &mut Vec<u8>,
+    message: &impl serde::Serialize,
+) -> Result<(), LaneIoError> {
+    out.clear();
+    serde_json::to_writer(&mut *out, message)
+        .map_err(|source| LaneIoError::Encode { topic, source })
 }
 
-impl LaneMcapSink {
-    /// Creates the file and its three channels.
+impl LaneEncoder {
+    /// Encodes the frame as `foxglove.RawImage` (mono8, base64) at `t_ns`: [`Self::image_json`].
     ///
     /// # Errors
-    /// [`LaneIoError::Bag`] when the file cannot be created.
-    pub fn create(path: &std::path::Path) -> Result<Self, LaneIoError> {
-        let mut writer = JsonMcapWriter::create(&path.display().to_string()).map_err(bag)?;
-        let image = writer
-            .channel(IMAGE_TOPIC, RAW_IMAGE, &raw_image_schema())
-            .map_err(bag)?;
-        let annotations = writer
-            .channel(
-                ANNOTATIONS_TOPIC,
-                IMAGE_ANNOTATIONS,
-                &image_annotations_schema(),
-            )
-            .map_err(bag)?;
-        let lanes = writer
-            .channel(LANES_TOPIC, LANES_SCHEMA_NAME, LANES_SCHEMA)
-            .map_err(bag)?;
-        Ok(Self {
-            writer,
-            image,
-            annotations,
-            lanes,
-            base64: String::new(),
-            ann: ImageAnnotations::default(),
-        })
-    }
-
-    /// Writes one frame: the image, the lanes drawn on it, and `lanes_message` (the `--json`
-    /// object) at time `t_s` (negative times are written at 0).
-    ///
-    /// # Errors
-    /// [`LaneIoError::Bag`] when writing fails.
-    pub fn write(
-        &mut self,
-        t_s: f64,
-        frame: &GreyFrame,
-        report: &TrackReport,
-        lanes_message: &LaneFrame<'_>,
-    ) -> Result<(), LaneIoError> {
-        let t_ns = (t_s.max(0.0) * 1e9).round() as u64;
-        let timestamp = Time::from_ns(t_ns);
+    /// [`LaneIoError::Encode`].
+    pub fn encode_image(&mut self, t_ns: u64, frame: &GreyFrame) -> Result<(), LaneIoError> {
         base64_into(frame.data(), &mut self.base64);
         let image = RawImage {
-            timestamp,
+            timestamp: Time::from_ns(t_ns),
             frame_id: "camera",
             width: frame.width() as u32,
             height: frame.height() as u32,
@@ -135,7 +124,33 @@ impl LaneMcapSink {
             step: frame.width() as u32,
             data: &self.base64,
         };
-        self.writer.write(self.image, t_ns, &image).map_err(bag)?;
+        encode(IMAGE_TOPIC, &mut self.image, &image)
+    }
+
+    /// The last image encoded, JSON.
+    pub fn image_json(&self) -> &[u8] {
+        &self.image
+    }
+
+    /// The last annotations encoded, JSON.
+    pub fn annotations_json(&self) -> &[u8] {
+        &self.annotations
+    }
+
+    /// Encodes the lanes of `report` as polylines on the `width_px`×`height_px` frame, with the
+    /// road's bottom and horizon lines (`foxglove.ImageAnnotations`) at `t_ns`:
+    /// [`Self::annotations_json`].
+    ///
+    /// # Errors
+    /// [`LaneIoError::Encode`].
+    pub fn encode_annotations(
+        &mut self,
+        t_ns: u64,
+        width_px: usize,
+        height_px: usize,
+        report: &TrackReport,
+    ) -> Result<(), LaneIoError> {
+        let timestamp = Time::from_ns(t_ns);
         self.ann.points.clear();
         for (lane, colour) in report.lanes.iter().zip(COLOURS) {
             let Some(_) = lane.coeffs else { continue };
@@ -161,13 +176,13 @@ impl LaneMcapSink {
                 thickness: 3.0,
             });
         }
-        let width = frame.width() as f64;
+        let width = width_px as f64;
         let road = report.road;
         let lines = [
             (
                 road.bottom_row_px,
                 ROAD_BOTTOM_COLOUR,
-                road.bottom_row_px < frame.height() as f64,
+                road.bottom_row_px < height_px as f64,
             ),
             (
                 road.horizon_row_px.unwrap_or(0.0),
@@ -188,11 +203,93 @@ impl LaneMcapSink {
                 });
             }
         }
+        encode(ANNOTATIONS_TOPIC, &mut self.annotations, &self.ann)
+    }
+}
+
+/// An open `--mcap-out` file.
+#[derive(Debug)]
+pub struct LaneMcapSink {
+    writer: JsonMcapWriter,
+    channels: [JsonChannel; 3],
+    encoder: LaneEncoder,
+    lanes: Vec<u8>,
+}
+
+fn bag(source: ros_bag::BagError) -> LaneIoError {
+    LaneIoError::Bag { source }
+}
+
+impl LaneMcapSink {
+    /// Creates the file and its three channels ([`lane_channels`]).
+    ///
+    /// # Errors
+    /// [`LaneIoError::Bag`] when the file cannot be created.
+    pub fn create(path: &std::path::Path) -> Result<Self, LaneIoError> {
+        let mut writer = JsonMcapWriter::create(&path.display().to_string()).map_err(bag)?;
+        let mut channels = Vec::with_capacity(3);
+        for (topic, name, schema) in lane_channels() {
+            channels.push(writer.channel(topic, name, &schema).map_err(bag)?);
+        }
+        let channels = [channels[0], channels[1], channels[2]];
+        Ok(Self {
+            writer,
+            channels,
+            encoder: LaneEncoder::default(),
+            lanes: Vec::new(),
+        })
+    }
+
+    /// Writes one frame: the image, the lanes drawn on it, and `lanes_message` (the `--json`
+    /// object) at time `t_s` (negative times are written at 0).
+    ///
+    /// # Errors
+    /// [`LaneIoError::Bag`] when writing fails, [`LaneIoError::Encode`].
+    pub fn write(
+        &mut self,
+        t_s: f64,
+        frame: &GreyFrame,
+        report: &TrackReport,
+        lanes_message: &LaneFrame<'_>,
+    ) -> Result<(), LaneIoError> {
+        let t_ns = frame_t_ns(t_s);
+        encode(LANES_TOPIC, &mut self.lanes, lanes_message)?;
+        self.encoder.encode_image(t_ns, frame)?;
+        self.encoder
+            .encode_annotations(t_ns, frame.width(), frame.height(), report)?;
+        let [image, annotations, lanes] = self.channels;
+        for (channel, json) in [
+            (image, self.encoder.image_json()),
+            (annotations, self.encoder.annotations_json()),
+            (lanes, &self.lanes[..]),
+        ] {
+            self.writer
+                .write_json_bytes(channel, t_ns, json)
+                .map_err(bag)?;
+        }
+        Ok(())
+    }
+
+    /// Writes one frame's messages already encoded: `image` and `annotations` from a
+    /// [`LaneEncoder`], `lanes` the [`LaneFrame`] as JSON (the `--json` line without its newline).
+    ///
+    /// # Errors
+    /// [`LaneIoError::Bag`].
+    pub fn write_encoded(
+        &mut self,
+        t_ns: u64,
+        image: &[u8],
+        annotations: &[u8],
+        lanes: &[u8],
+    ) -> Result<(), LaneIoError> {
+        self.write_json(0, t_ns, image)?;
+        self.write_json(1, t_ns, annotations)?;
+        self.write_json(2, t_ns, lanes)
+    }
+
+    fn write_json(&mut self, k: usize, t_ns: u64, json: &[u8]) -> Result<(), LaneIoError> {
         self.writer
-            .write(self.annotations, t_ns, &self.ann)
-            .map_err(bag)?;
-        self.writer
-            .write(self.lanes, t_ns, lanes_message)
+            .write_json_bytes(self.channels[k], t_ns, json)
             .map_err(bag)
     }
 

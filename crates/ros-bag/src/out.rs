@@ -107,6 +107,23 @@ impl JsonMcapWriter {
             topic: self.topics[channel.1].clone(),
             source,
         })?;
+        let data = std::mem::take(&mut self.scratch);
+        let r = self.write_json_bytes(channel, t_ns, &data);
+        self.scratch = data;
+        r
+    }
+
+    /// Writes `json`, a message already serialized as JSON (the same bytes another sink, such as a
+    /// live server, receives), on `channel` at `t_ns` (log and publish time).
+    ///
+    /// # Errors
+    /// [`BagError::Mcap`].
+    pub fn write_json_bytes(
+        &mut self,
+        channel: JsonChannel,
+        t_ns: u64,
+        json: &[u8],
+    ) -> Result<(), BagError> {
         self.sequence += 1;
         let header = mcap::records::MessageHeader {
             channel_id: channel.0,
@@ -114,10 +131,9 @@ impl JsonMcapWriter {
             log_time: t_ns,
             publish_time: t_ns,
         };
-        let data = std::mem::take(&mut self.scratch);
-        let r = self.writer.write_to_known_channel(&header, &data);
-        self.scratch = data;
-        r.map_err(self.mcap_err())
+        self.writer
+            .write_to_known_channel(&header, json)
+            .map_err(self.mcap_err())
     }
 
     /// Writes the summary and closes the file.

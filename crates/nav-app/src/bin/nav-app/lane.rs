@@ -26,6 +26,10 @@ use lane_tracker::camera::CameraModel;
 use lane_tracker::{Estimator, LaneReport, LaneState, Side};
 use serde::Serialize;
 
+use crate::live::{self, Live, LiveArgs, Pacer};
+use foxglove_live::LiveStats;
+use lane_io::mcap_sink::{LaneEncoder, frame_t_ns, lane_channels};
+
 /// The default input: a scene the project renders itself (`lane_scenes`, deterministic), a
 /// curved road with dashed marks, 320×240.
 const SAMPLE_SCENE: &str = "curve_left_dashed";
@@ -116,6 +120,8 @@ struct Args {
     /// /camera/lanes) and the lane estimate with its covariance (JSON, /lanes).
     #[arg(long, value_name = "FILE")]
     mcap_out: Option<PathBuf>,
+    #[command(flatten)]
+    live: LiveArgs,
     #[command(flatten)]
     dev: DeviceArgs,
 }
@@ -224,6 +230,9 @@ struct SummaryBody<'a> {
     tracked_frames: u64,
     lost_frames: u64,
     skipped_bytes: u64,
+    /// With `--foxglove`: the live server's clients and messages sent and dropped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    foxglove: Option<LiveStats>,
     exit: &'a str,
     exit_code: u8,
     error: Option<String>,
@@ -238,6 +247,8 @@ struct RunStats {
     lost_frames: u64,
     /// Bytes of a stream skipped while resynchronising (and of short last frames).
     skipped_bytes: u64,
+    /// Ctrl-C ended the run.
+    interrupted: bool,
 }
 
 /// Exit code of a run that finished but lost frames of its input to damage.
@@ -276,8 +287,21 @@ fn lane_text(r: &LaneReport) -> String {
 
 /// Run the tracker, counting frames in `stats`. With `--device` the capture monitor is left in
 /// `monitor` (also when the run fails) for the summary.
-fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) -> Result<()> {
+/// With `--foxglove` the live server is left in `live` (also when the run fails), for the summary.
+fn run(
+    args: &Args,
+    monitor: &mut Option<CaptureMonitor>,
+    live: &mut Option<Live>,
+    stats: &mut RunStats,
+) -> Result<()> {
     let cfg = lane_io::config::load_tracker_config(&args.config)?;
+    if args.live.realtime && args.device.is_some() {
+        bail!("--realtime paces a recorded input; a --device delivers frames at its own pace");
+    }
+    if let Some(addr) = &args.live.foxglove {
+        *live = Some(Live::start(addr, &lane_channels())?);
+    }
+    let live = live.as_ref();
     let camera: Option<CameraModel> = match &args.camera {
         Some(c) => Some(lane_io::config::load_camera_config(c)?.model()?),
         None => None,
@@ -322,6 +346,22 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         Some(p) => Some(lane_io::mcap_sink::LaneMcapSink::create(p)?),
         None => None,
     };
+    if let Some(l) = live
+        && !quiet
+    {
+        eprintln!("nav-app: serving Foxglove on ws://{}", l.addr());
+    }
+    if let Some(l) = live
+        && args.live.wait_client
+    {
+        if !quiet {
+            eprintln!("nav-app: waiting for a client to subscribe (--wait-client)");
+        }
+        l.wait_client();
+    }
+    let mut pacer = args.live.realtime.then(Pacer::default);
+    let mut encoder = LaneEncoder::default();
+    let mut lanes_json = Vec::new();
     let mut rgb = Vec::new();
     let mut lanes = FrameLoop::new(cfg, estimator);
     let stdout = std::io::stdout();
@@ -334,6 +374,10 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
     let bar = progress_bar(!quiet && args.device.is_none());
     let mut shown_lost = 0u64;
     while args.max_frames.is_none_or(|m| stats.frames < m) {
+        if live::interrupted() {
+            stats.interrupted = true;
+            break;
+        }
         let Tracked {
             meta,
             frame,
@@ -368,6 +412,9 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
         {
             cam.check_frame_size(frame.width(), frame.height())?;
         }
+        if let Some(p) = pacer.as_mut() {
+            p.wait(meta.t_s);
+        }
         last_index = meta.index;
         track_time += dt;
         stats.frames += 1;
@@ -383,7 +430,8 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 eprintln!("nav-app: frame {index}: input signal {what}");
             }
         }
-        if args.json || mcap_out.is_some() {
+        let wants = live.map_or([false; 3], |l| [l.wants(0), l.wants(1), l.wants(2)]);
+        if args.json || mcap_out.is_some() || wants.contains(&true) {
             let frame_json = LaneFrame {
                 schema: JSON_SCHEMA,
                 frame: index,
@@ -393,20 +441,51 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
                 noise: t.frame_noise(),
                 track_us: dt.as_secs_f64() * 1e6,
                 ego_lane: ego,
-                lane_cov_px: (camera.is_some() || mcap_out.is_some()).then(|| {
-                    [Side::Left, Side::Right]
-                        .map(|s| t.lane_covariance_px(s).map(|p| p.transpose().into()))
-                }),
+                lane_cov_px: (camera.is_some() || mcap_out.is_some() || live.is_some()).then(
+                    || {
+                        [Side::Left, Side::Right]
+                            .map(|s| t.lane_covariance_px(s).map(|p| p.transpose().into()))
+                    },
+                ),
                 capture,
             };
+            // Encoded once: the --json line, the MCAP file's and the live /lanes message are
+            // the same bytes.
+            lanes_json.clear();
+            serde_json::to_writer(&mut lanes_json, &frame_json)
+                .context("cannot encode the frame as JSON")?;
             if args.json {
-                serde_json::to_writer(&mut out, &frame_json)
-                    .context("cannot write JSON to stdout")?;
-                out.write_all(b"\n")
+                out.write_all(&lanes_json)
+                    .and_then(|()| out.write_all(b"\n"))
                     .context("cannot write JSON to stdout")?;
             }
+            let t_ns = frame_t_ns(meta.t_s);
+            if mcap_out.is_some() || wants[0] {
+                encoder.encode_image(t_ns, frame)?;
+            }
+            if mcap_out.is_some() || wants[1] {
+                encoder.encode_annotations(t_ns, frame.width(), frame.height(), &report)?;
+            }
             if let Some(sink) = mcap_out.as_mut() {
-                sink.write(meta.t_s, frame, &report, &frame_json)?;
+                sink.write_encoded(
+                    t_ns,
+                    encoder.image_json(),
+                    encoder.annotations_json(),
+                    &lanes_json,
+                )?;
+            }
+            if let Some(l) = live {
+                l.time(t_ns);
+                let messages = [
+                    encoder.image_json(),
+                    encoder.annotations_json(),
+                    &lanes_json,
+                ];
+                for (k, json) in messages.into_iter().enumerate() {
+                    if wants[k] {
+                        l.publish(k, t_ns, json);
+                    }
+                }
             }
         }
         if let Some(sink) = overlay.as_mut() {
@@ -475,7 +554,7 @@ fn run(args: &Args, monitor: &mut Option<CaptureMonitor>, stats: &mut RunStats) 
     } else if lost > 0 {
         eprintln!("nav-app: {lost} frames lost ({skipped} bytes skipped)");
     }
-    if frames == 0 {
+    if frames == 0 && !stats.interrupted {
         bail!("no frame could be read");
     }
     Ok(())
@@ -521,10 +600,14 @@ pub fn main() -> ExitCode {
     let args = Args::parse();
     let mut monitor = None;
     let mut run_stats = RunStats::default();
-    let result = run(&args, &mut monitor, &mut run_stats);
+    let mut live = None;
+    live::install_sigint();
+    let result = run(&args, &mut monitor, &mut live, &mut run_stats);
+    let foxglove = live.map(Live::shutdown);
     let lost = run_stats.lost_frames > 0;
     let ok_code = if lost { EXIT_FRAMES_LOST } else { 0 };
     let (code, exit, error) = match &result {
+        Ok(()) if run_stats.interrupted => (ok_code, "interrupted", None),
         Ok(()) if args.max_frames.is_some_and(|m| run_stats.frames >= m) => {
             (ok_code, "max-frames", None)
         }
@@ -536,6 +619,14 @@ pub fn main() -> ExitCode {
     };
     if let Some(e) = &error {
         eprintln!("nav-app: error: {e}");
+    }
+    if let Some(f) = foxglove
+        && !args.json
+    {
+        eprintln!(
+            "nav-app: Foxglove: {} clients, {} messages sent, {} dropped",
+            f.clients, f.sent, f.dropped
+        );
     }
     let stats = args.device.as_ref().map(|_| {
         monitor
@@ -562,6 +653,7 @@ pub fn main() -> ExitCode {
                 tracked_frames: run_stats.frames,
                 lost_frames: run_stats.lost_frames,
                 skipped_bytes: run_stats.skipped_bytes,
+                foxglove,
                 exit,
                 exit_code: code,
                 error,

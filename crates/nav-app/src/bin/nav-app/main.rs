@@ -94,6 +94,7 @@ use std::process::ExitCode;
 mod bench;
 mod ins;
 mod lane;
+mod live;
 mod monte_carlo;
 
 /// `e` and its causes on one line, `e: cause: cause's cause…`, following

@@ -1,0 +1,137 @@
+//! Watching a run live: `--foxglove [ADDR]` serves the run's channels over Foxglove's WebSocket
+//! protocol (crate `foxglove-live`), `--wait-client` holds the first frame until a client has
+//! subscribed, `--realtime` paces a recorded input at its own timestamps; and Ctrl-C (SIGINT),
+//! which ends a run cleanly: the loops stop at the next frame or epoch, the files are finished and
+//! the summary printed.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use foxglove_live::{ChannelId, LiveConfig, LiveServer, LiveStats};
+
+/// The address `--foxglove` without a value listens on: loopback only.
+pub(crate) const DEFAULT_ADDR: &str = "127.0.0.1:8765";
+
+/// The options shared by the lane tracker and `nav-app ins`.
+#[derive(clap::Args, Debug, Clone)]
+pub(crate) struct LiveArgs {
+    /// Serve the run live to Foxglove (the app's "Open connection" → Foxglove WebSocket →
+    /// ws://ADDR) with the same channels as --mcap-out [ADDR default: 127.0.0.1:8765, loopback
+    /// only; give e.g. 0.0.0.0:8765 to serve a robot's network].
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = DEFAULT_ADDR)]
+    pub foxglove: Option<String>,
+    /// With --foxglove: start only once a client has subscribed to a channel.
+    #[arg(long, requires = "foxglove")]
+    pub wait_client: bool,
+    /// Pace a recorded input (file, bag, video, log) at its own timestamps instead of as fast as
+    /// possible.
+    #[arg(long)]
+    pub realtime: bool,
+}
+
+/// A live server and its channels.
+pub(crate) struct Live {
+    server: LiveServer,
+    channels: Vec<ChannelId>,
+}
+
+impl Live {
+    /// Listens on `addr` and adds `channels` (topic, schema name, JSON schema), in this order.
+    pub fn start(addr: &str, channels: &[(&str, &str, String)]) -> Result<Self> {
+        let server =
+            LiveServer::bind(addr, "nav-app", LiveConfig::default()).context("--foxglove")?;
+        let channels = channels
+            .iter()
+            .map(|(topic, name, schema)| server.add_channel(topic, name, schema))
+            .collect::<Result<Vec<_>, _>>()
+            .context("--foxglove")?;
+        Ok(Self { server, channels })
+    }
+
+    /// The address served (with the port picked when 0 was given).
+    pub fn addr(&self) -> std::net::SocketAddr {
+        self.server.local_addr()
+    }
+
+    /// Whether a client subscribed channel `k`.
+    pub fn wants(&self, k: usize) -> bool {
+        self.server.wants(self.channels[k])
+    }
+
+    /// Sends `json` on channel `k` at `t_ns` to the clients that subscribed it.
+    pub fn publish(&self, k: usize, t_ns: u64, json: &[u8]) {
+        self.server.publish(self.channels[k], t_ns, json);
+    }
+
+    /// Moves the clients' clocks to `t_ns`.
+    pub fn time(&self, t_ns: u64) {
+        self.server.time(t_ns);
+    }
+
+    /// `--wait-client`: waits until a client subscribed; false when Ctrl-C came first.
+    pub fn wait_client(&self) -> bool {
+        eprintln!(
+            "nav-app: waiting for a Foxglove client on ws://{} (--wait-client)",
+            self.addr()
+        );
+        while !interrupted() {
+            if self.server.wait_subscribed(Duration::from_millis(100)) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Lets the clients receive what is queued (2 s at most), closes and returns the counters.
+    pub fn shutdown(self) -> LiveStats {
+        self.server.shutdown()
+    }
+}
+
+/// `--realtime`: sleeps until the wall clock is as far from the first frame as `t_s` is from the
+/// first frame's time (in slices, so that Ctrl-C is seen).
+#[derive(Debug, Default)]
+pub(crate) struct Pacer {
+    start: Option<(Instant, f64)>,
+}
+
+impl Pacer {
+    /// Waits for the time of a frame or epoch stamped `t_s`.
+    pub fn wait(&mut self, t_s: f64) {
+        let (started, t0_s) = *self.start.get_or_insert((Instant::now(), t_s));
+        let due = started + Duration::from_secs_f64((t_s - t0_s).clamp(0.0, 1e9));
+        loop {
+            let now = Instant::now();
+            if now >= due || interrupted() {
+                return;
+            }
+            std::thread::sleep((due - now).min(Duration::from_millis(50)));
+        }
+    }
+}
+
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_sigint(_: libc::c_int) {
+    INTERRUPTED.store(true, Ordering::SeqCst);
+}
+
+/// Makes the first Ctrl-C (SIGINT) set a flag that the frame and epoch loops poll instead of
+/// killing the process; a second Ctrl-C kills it (`SA_RESETHAND`).
+pub(crate) fn install_sigint() {
+    // SAFETY: `sigaction` is given a zeroed, then filled, `struct sigaction` that lives across
+    // the call; the handler only stores to an atomic, which is async-signal-safe.
+    unsafe {
+        let mut action: libc::sigaction = std::mem::zeroed();
+        action.sa_sigaction = on_sigint as extern "C" fn(libc::c_int) as libc::sighandler_t;
+        action.sa_flags = libc::SA_RESETHAND;
+        libc::sigemptyset(&mut action.sa_mask);
+        libc::sigaction(libc::SIGINT, &action, std::ptr::null_mut());
+    }
+}
+
+/// Whether Ctrl-C was pressed.
+pub(crate) fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
+}
