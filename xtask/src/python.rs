@@ -2,7 +2,7 @@
 //! environment `target/py-venv` and run its pytest suite against the `nav-app` binary.
 //!
 //! Everything it needs comes from PyPI into the venv on first use (maturin, pytest, numpy, and
-//! the independent peers of the interop tests: mcap, jsonschema, pillow, evo): a
+//! the independent peers of the interop tests: mcap, jsonschema, pillow, evo, websockets): a
 //! fresh machine needs only `python3` with its `venv` module (Debian `python3-venv`, installed with
 //! apt-get when missing and running as root or under CI with passwordless sudo).
 
@@ -27,6 +27,9 @@ const REQUIREMENTS: &[&str] = &[
     "pillow>=9",
     // The field's usual trajectory evaluator: `evo_ape` reads nav-app's --tum-out (test_evo.py).
     "evo>=1.28",
+    // An independent client of Foxglove's WebSocket protocol for nav-app --foxglove
+    // (test_foxglove_live.py).
+    "websockets>=13",
 ];
 
 /// Arguments of `cargo xtask python`.

@@ -265,13 +265,30 @@ struct Link<'a> {
     frame: Vec<u8>,
 }
 
+/// What became of a message written.
+enum Written {
+    /// Handed to the socket.
+    Yes,
+    /// Kept in tungstenite's buffer (or dropped and counted when that is full): the socket did
+    /// not take it within the write timeout.
+    Backlogged,
+    /// The connection is gone.
+    Gone,
+}
+
 fn would_block(e: &tungstenite::Error) -> bool {
     matches!(e, tungstenite::Error::Io(io) if matches!(io.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut))
 }
 
 impl Link<'_> {
     /// Runs until the client leaves (false) or the server stops (true: close the connection).
+    ///
+    /// A socket that did not take a write within the write timeout is *backlogged*: nothing more
+    /// is written to it until a flush gets through, so its messages wait in the queue (where the
+    /// byte budget drops and counts them) and each turn of the loop blocks at most one write
+    /// timeout, so that requests and the shutdown are still seen.
     fn run(&mut self, ws: &mut WebSocket<TcpStream>) -> bool {
+        let mut backlogged = false;
         loop {
             if !self.read_requests(ws) {
                 return false;
@@ -281,6 +298,13 @@ impl Link<'_> {
                 let deadline = (*lock(&self.shared.drain_deadline)).unwrap_or_else(Instant::now);
                 if Instant::now() >= deadline {
                     return true;
+                }
+            }
+            if backlogged {
+                match ws.flush() {
+                    Ok(()) => backlogged = false,
+                    Err(e) if would_block(&e) => continue,
+                    Err(_) => return false,
                 }
             }
             let mut written = 0;
@@ -293,24 +317,31 @@ impl Link<'_> {
                     break;
                 };
                 written += 1;
-                if !self.write(ws, item) {
-                    return false;
+                match self.write(ws, item) {
+                    Written::Yes => {}
+                    Written::Backlogged => {
+                        backlogged = true;
+                        break;
+                    }
+                    Written::Gone => return false,
                 }
             }
-            match ws.flush() {
-                Ok(()) => {
-                    if stopping && written == 0 {
-                        return true;
+            if !backlogged {
+                match ws.flush() {
+                    Ok(()) => {
+                        if stopping && written == 0 {
+                            return true;
+                        }
                     }
+                    Err(e) if would_block(&e) => backlogged = true,
+                    Err(_) => return false,
                 }
-                Err(e) if would_block(&e) => {}
-                Err(_) => return false,
             }
         }
     }
 
-    /// Writes one message; false when the connection is gone.
-    fn write(&mut self, ws: &mut WebSocket<TcpStream>, item: Outgoing) -> bool {
+    /// Writes one message.
+    fn write(&mut self, ws: &mut WebSocket<TcpStream>, item: Outgoing) -> Written {
         let (message, data) = match item {
             Outgoing::Data {
                 subscription_id,
@@ -326,17 +357,19 @@ impl Link<'_> {
             }
             Outgoing::Text(text) => (Message::text(&*text), false),
         };
-        let counter = match ws.write(message) {
-            Ok(()) => &self.shared.sent,
+        let (counter, written) = match ws.write(message) {
+            Ok(()) => (&self.shared.sent, Written::Yes),
             // Buffered: tungstenite writes it out on the next write or flush.
-            Err(e) if would_block(&e) => &self.shared.sent,
-            Err(tungstenite::Error::WriteBufferFull(_)) => &self.shared.dropped,
-            Err(_) => return false,
+            Err(e) if would_block(&e) => (&self.shared.sent, Written::Backlogged),
+            Err(tungstenite::Error::WriteBufferFull(_)) => {
+                (&self.shared.dropped, Written::Backlogged)
+            }
+            Err(_) => return Written::Gone,
         };
         if data {
             counter.fetch_add(1, Ordering::Relaxed);
         }
-        true
+        written
     }
 
     /// Reads and answers every request waiting on the socket, without blocking; false when the
