@@ -70,7 +70,7 @@ fn ensure_venv(root: &Path) -> Result<PathBuf> {
         root,
         "py-venv",
         REQUIREMENTS,
-        "import numpy, pytest, mcap, mcap_ros2, jsonschema, PIL, evo",
+        "import numpy, pytest, mcap, mcap_ros2, jsonschema, PIL, evo, websockets",
         Some("bin/maturin"),
     )
 }
