@@ -1,0 +1,152 @@
+//! `nav-app --foxglove` end to end with a tungstenite client on loopback: with `--mcap-out` the
+//! live messages are the file's, byte for byte and at the same times; `--wait-client` holds the
+//! run until the subscription; `--realtime` needs a recorded input.
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::collections::BTreeMap;
+use std::net::{TcpListener, TcpStream};
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use tungstenite::client::IntoClientRequest;
+use tungstenite::{Message, WebSocket};
+
+fn free_port() -> u16 {
+    TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
+}
+
+/// A `foxglove.websocket.v1` client, retried while nav-app starts listening.
+fn connect(port: u16) -> WebSocket<TcpStream> {
+    let end = Instant::now() + Duration::from_secs(60);
+    let stream = loop {
+        match TcpStream::connect(("127.0.0.1", port)) {
+            Ok(s) => break s,
+            Err(e) if Instant::now() > end => panic!("nav-app did not listen on {port}: {e}"),
+            Err(_) => std::thread::sleep(Duration::from_millis(20)),
+        }
+    };
+    stream
+        .set_read_timeout(Some(Duration::from_secs(60)))
+        .unwrap();
+    let mut request = format!("ws://127.0.0.1:{port}/")
+        .into_client_request()
+        .unwrap();
+    request.headers_mut().insert(
+        "Sec-WebSocket-Protocol",
+        "foxglove.websocket.v1".parse().unwrap(),
+    );
+    tungstenite::client(request, stream).unwrap().0
+}
+
+type ByTopic = BTreeMap<String, Vec<(u64, Vec<u8>)>>;
+
+#[test]
+fn live_messages_are_the_mcap_files_byte_for_byte() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("foxglove-cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mcap_path = dir.join("run.mcap");
+    let port = free_port();
+    let child = Command::new(env!("CARGO_BIN_EXE_nav-app"))
+        .args(["--json", "--mcap-out"])
+        .arg(&mcap_path)
+        .args(["--foxglove", &format!("127.0.0.1:{port}"), "--wait-client"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut ws = connect(port);
+    let mut topics = BTreeMap::new();
+    while topics.len() < 3 {
+        if let Message::Text(t) = ws.read().unwrap() {
+            let v: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
+            if v["op"] == "advertise" {
+                for c in v["channels"].as_array().unwrap() {
+                    topics.insert(
+                        c["id"].as_u64().unwrap(),
+                        c["topic"].as_str().unwrap().to_owned(),
+                    );
+                }
+            }
+        }
+    }
+    let subscriptions: Vec<_> = topics
+        .keys()
+        .map(|&id| serde_json::json!({"id": id * 10, "channelId": id}))
+        .collect();
+    ws.send(Message::text(
+        serde_json::json!({"op": "subscribe", "subscriptions": subscriptions}).to_string(),
+    ))
+    .unwrap();
+    let mut live = ByTopic::new();
+    loop {
+        match ws.read() {
+            Ok(Message::Binary(b)) if b[0] == 1 => {
+                let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
+                let t_ns = u64::from_le_bytes(b[5..13].try_into().unwrap());
+                let topic = topics[&(u64::from(sub) / 10)].clone();
+                live.entry(topic)
+                    .or_default()
+                    .push((t_ns, b[13..].to_vec()));
+            }
+            Ok(_) => {}
+            Err(_) => break,
+        }
+    }
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = stdout.lines().collect();
+    let summary: serde_json::Value = serde_json::from_str(lines[lines.len() - 1]).unwrap();
+    let frames = summary["summary"]["tracked_frames"].as_u64().unwrap() as usize;
+    assert!(frames > 10);
+    assert_eq!(
+        summary["summary"]["foxglove"],
+        serde_json::json!({"clients": 1, "sent": 3 * frames, "dropped": 0})
+    );
+
+    let bytes = std::fs::read(&mcap_path).unwrap();
+    let mut file = ByTopic::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        file.entry(m.channel.topic.clone())
+            .or_default()
+            .push((m.log_time, m.data.into_owned()));
+    }
+    assert_eq!(
+        live.keys().collect::<Vec<_>>(),
+        ["/camera/image", "/camera/lanes", "/lanes"]
+    );
+    for (topic, messages) in &live {
+        assert_eq!(messages.len(), frames, "{topic}");
+        assert!(messages == &file[topic], "{topic}: live and file differ");
+    }
+    // And /lanes is the --json line.
+    for ((_, payload), line) in live["/lanes"].iter().zip(&lines) {
+        assert_eq!(std::str::from_utf8(payload).unwrap(), *line);
+    }
+}
+
+#[test]
+fn realtime_with_a_device_and_wait_client_without_foxglove_are_refused() {
+    let out = Command::new(env!("CARGO_BIN_EXE_nav-app"))
+        .args(["--wait-client"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--foxglove"));
+    let out = Command::new(env!("CARGO_BIN_EXE_nav-app"))
+        .args(["--device", "/dev/null", "--realtime", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--realtime"));
+}
