@@ -143,6 +143,15 @@ pub enum SimError {
         #[from]
         source: ros_bag::BagError,
     },
+    /// A replay's message (`--mcap-out`, `--foxglove`) could not be encoded as JSON.
+    #[error("topic {topic}: cannot encode the message as JSON")]
+    Encode {
+        /// The channel's topic.
+        topic: &'static str,
+        /// The encoder's error.
+        #[source]
+        source: serde_json::Error,
+    },
     /// A replay needs the reference trajectory at a time it does not cover.
     #[error("reference trajectory at t = {t_s} s: {what}")]
     ReferenceSpan {

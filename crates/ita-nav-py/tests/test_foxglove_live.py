@@ -9,6 +9,7 @@ Loopback only; each test picks a free port.
 
 import base64
 import json
+import math
 import os
 import pathlib
 import signal
@@ -288,3 +289,53 @@ def test_realtime_paces_the_frames_at_their_own_times():
     assert r.returncode == 0, r.stderr
     t = [json.loads(l)["t_s"] for l in r.stdout.splitlines()[:-1]]
     assert len(t) == frames and wall_s >= t[-1] - t[0]
+
+
+def test_ins_solution_rows_reach_the_client_equal_to_the_csv(tmp_path):
+    d = DATA / "ins" / "rtkexp_drive0708"
+    imu, truth = data_file(d / "imu.csv"), data_file(d / "truth.csv")
+    lm, s, sol = tmp_path / "lm.toml", tmp_path / "s.csv", tmp_path / "sol.csv"
+    subprocess.run([exe(), "ins", "sightings", "--reference", str(truth), "--landmarks", str(lm),
+                    "--make-landmarks", "60", "--landmark-range-m", "30", "200", "--max-range-m", "500",
+                    "--seed", "7", "--out", str(s)], check=True, capture_output=True)
+    port = free_port()
+    proc = subprocess.Popen([exe(), "ins", "--imu", str(imu), "--truth", str(truth), "--sightings", str(s),
+                             "--landmarks", str(lm), "--filter", "kf", "--align-s", "30", "--out", str(sol),
+                             "--foxglove", f"127.0.0.1:{port}", "--wait-client"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    topics = ("/ins/solution", "/ins/fix", "/ins/epochs", "/ins/errors")
+    try:
+        with ws_connect(port) as ws:
+            op, sub_topics = subscribe_op(channels_of(ws, topics), topics)
+            reader = Reader(ws, sub_topics)
+            ws.send(op)
+            reader.start()
+            out, err = proc.communicate(timeout=600)
+            reader.join(timeout=120)
+            assert not reader.is_alive(), "the server did not close the connection"
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, err.decode()
+    assert b"0 dropped" in err, err.decode()
+    header, *rows = sol.read_text().splitlines()
+    cols = header.split(",")
+    csv = [dict(zip(cols, r.split(","))) for r in rows]
+    got = [json.loads(p) for _, p in reader.got["/ins/solution"]]
+    assert len(got) == len(csv) > 1000
+    for g, c in zip(got, csv):
+        assert g["t_s"] == float(c["t_s"])
+        assert g["alt_m"] == float(c["alt_m"])
+        assert g["vel_ned_mps"] == [float(c[k]) for k in ("vel_n_mps", "vel_e_mps", "vel_d_mps")]
+        assert abs(math.radians(g["lat_deg"]) - float(c["lat_rad"])) < 1e-15
+        assert abs(math.radians(g["lon_deg"]) - float(c["lon_rad"])) < 1e-15
+        if c["sigma_n_m"]:
+            assert g["sigma_pos_ned_m"] == [float(c[k]) for k in ("sigma_n_m", "sigma_e_m", "sigma_d_m")]
+            assert g["sigma_vel_ned_mps"] == [float(c[k]) for k in ("sigma_vn_mps", "sigma_ve_mps", "sigma_vd_mps")]
+    fixes = [json.loads(p) for _, p in reader.got["/ins/fix"]]
+    assert len(fixes) == len(got)
+    assert all(f["latitude"] == g["lat_deg"] and f["longitude"] == g["lon_deg"] for f, g in zip(fixes, got))
+    assert fixes[-1]["position_covariance_type"] == 2
+    epochs = sum(1 for c in csv if c["used"])
+    assert len(reader.got["/ins/epochs"]) == epochs > 100
+    assert len(reader.got["/ins/errors"]) > 100

@@ -191,6 +191,40 @@ pub mod foxglove {
         )
     }
 
+    /// Schema name of [`LocationFix`].
+    pub const LOCATION_FIX: &str = "foxglove.LocationFix";
+
+    /// JSON schema of [`LocationFix`] (Foxglove's, the fields used here).
+    pub fn location_fix_schema() -> String {
+        format!(
+            r#"{{"title":"foxglove.LocationFix","description":"A navigation satellite fix for any Global Navigation Satellite System","type":"object","properties":{{"timestamp":{TIME},"frame_id":{{"type":"string"}},"latitude":{{"type":"number","description":"degrees"}},"longitude":{{"type":"number","description":"degrees"}},"altitude":{{"type":"number","description":"metres above the WGS 84 ellipsoid"}},"position_covariance":{{"type":"array","items":{{"type":"number"}},"minItems":9,"maxItems":9,"description":"m^2, east-north-up, row-major"}},"position_covariance_type":{{"type":"integer","description":"0 UNKNOWN, 1 APPROXIMATED, 2 DIAGONAL_KNOWN, 3 KNOWN"}}}},"required":["timestamp","frame_id","latitude","longitude","altitude","position_covariance","position_covariance_type"]}}"#
+        )
+    }
+
+    /// `position_covariance_type` of a [`LocationFix`] whose covariance diagonal is known.
+    pub const COVARIANCE_DIAGONAL_KNOWN: u8 = 2;
+    /// `position_covariance_type` of a [`LocationFix`] without a covariance.
+    pub const COVARIANCE_UNKNOWN: u8 = 0;
+
+    /// `foxglove.LocationFix`: a position on the WGS 84 ellipsoid (Foxglove's Map panel).
+    #[derive(Clone, Debug, Serialize)]
+    pub struct LocationFix<'a> {
+        /// Time.
+        pub timestamp: Time,
+        /// Frame.
+        pub frame_id: &'a str,
+        /// Latitude, degrees.
+        pub latitude: f64,
+        /// Longitude, degrees.
+        pub longitude: f64,
+        /// Height above the ellipsoid, m.
+        pub altitude: f64,
+        /// Position covariance, m², east-north-up axes, row-major.
+        pub position_covariance: [f64; 9],
+        /// [`COVARIANCE_DIAGONAL_KNOWN`] or [`COVARIANCE_UNKNOWN`].
+        pub position_covariance_type: u8,
+    }
+
     /// A time stamp.
     #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
     pub struct Time {

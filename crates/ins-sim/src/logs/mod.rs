@@ -120,7 +120,10 @@ pub use asl::{
 };
 pub use imu::{ImuLog, imu_nominal_step_s, is_bag};
 pub use local::{LocalAxes, LocalFrame, write_tum};
-pub use mcap_out::InsMcapSink;
+pub use mcap_out::{
+    EPOCHS_CHANNEL, ERRORS_CHANNEL, FIX_CHANNEL, InsMcapSink, ReplayTap, SOLUTION_CHANNEL,
+    ins_channels,
+};
 pub use metrics::*;
 pub use read::*;
 pub use reference::*;

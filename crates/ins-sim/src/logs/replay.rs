@@ -256,7 +256,7 @@ impl SightingStream {
 }
 
 /// Mutable state of one replay besides the filter.
-struct Run<'a, W: Write> {
+struct Run<'a, 't, W: Write> {
     rate: SolutionRate,
     out: &'a mut W,
     out_path: &'a Path,
@@ -266,10 +266,10 @@ struct Run<'a, W: Write> {
     next_output_s: f64,
     tol: f64,
     t0_s: f64,
-    mcap: Option<super::InsMcapSink>,
+    sink: super::mcap_out::InsSink<'t>,
 }
 
-impl<W: Write> Run<'_, W> {
+impl<W: Write> Run<'_, '_, W> {
     /// After the filter reached a new time: applies the epochs due, writes the row, compares.
     fn after(&mut self, filter: &mut InsSdFilter) -> Result<(), SimError> {
         let now = filter.time_s();
@@ -325,15 +325,13 @@ impl<W: Write> Run<'_, W> {
         if write {
             write_solution(self.out, now, filter, report.as_ref())
                 .map_err(io_err(self.out_path))?;
-            if let Some(sink) = self.mcap.as_mut() {
-                sink.solution(filter, report.as_ref())?;
-            }
+            self.sink.solution(filter, report.as_ref())?;
         }
         if let Some(m) = self.metrics.as_mut() {
             let before = m.out.series.len();
             m.observe(filter);
-            if let (Some(sink), Some(e)) = (self.mcap.as_mut(), m.out.series.get(before)) {
-                sink.errors(e)?;
+            if let Some(e) = m.out.series.get(before) {
+                self.sink.errors(e)?;
             }
         }
         Ok(())
@@ -359,6 +357,21 @@ pub fn replay(
     inputs: ReplayInputs,
     out: &mut impl Write,
     out_path: &Path,
+) -> Result<ReplaySummary, SimError> {
+    replay_with_tap(inputs, out, out_path, None)
+}
+
+/// [`replay`], handing every message of the `--mcap-out` channels ([`super::ins_channels`]) to
+/// `tap` as well (a live viewer), which also paces the replay and can end it early (then the
+/// replay ends as if its IMU log ended there).
+///
+/// # Errors
+/// As [`replay`].
+pub fn replay_with_tap(
+    inputs: ReplayInputs,
+    out: &mut impl Write,
+    out_path: &Path,
+    tap: Option<&mut dyn super::ReplayTap>,
 ) -> Result<ReplaySummary, SimError> {
     let ReplayInputs {
         mut imu,
@@ -431,15 +444,24 @@ pub fn replay(
         metrics: reference.map(MetricsAcc::new),
         next_output_s: init.t_s,
         t0_s: init.t_s,
-        mcap: match &mcap_out {
-            Some(p) => Some(super::InsMcapSink::create(p)?),
-            None => None,
-        },
+        sink: super::mcap_out::InsSink::new(
+            match &mcap_out {
+                Some(p) => Some(super::InsMcapSink::create(p)?),
+                None => None,
+            },
+            tap,
+        ),
         tol: config.timestamp_tolerance_s.max(1e-9),
     };
     run.after(&mut filter)?;
     while let Some(rec) = imu.next()? {
         let t = rec.t_s;
+        if let Some(tap) = run.sink.tap() {
+            if tap.stop() {
+                break;
+            }
+            tap.pace(t);
+        }
         imu_rows += 1;
         imu_last_s = t;
         if t <= init.t_s {
@@ -545,10 +567,8 @@ pub fn replay(
         reference_path.as_deref(),
         allow_unaided,
     )?;
-    if let Some(sink) = run.mcap.take() {
-        sink.finish()?;
-    }
     let mut summary = run.summary;
+    run.sink.finish()?;
     summary.metrics = run.metrics.map(MetricsAcc::finish);
     summary.alignment = alignment;
     summary.initial = Some(initial);
@@ -585,7 +605,7 @@ fn input_spans(
 /// After the IMU's last sample: counts the sightings and reference rows not used, records the
 /// spans, and refuses inputs that do not overlap (module documentation).
 fn check_overlap<W: Write>(
-    run: &mut Run<'_, W>,
+    run: &mut Run<'_, '_, W>,
     imu: (&Path, Option<f64>, f64, u64),
     reference_path: Option<&Path>,
     allow_unaided: bool,

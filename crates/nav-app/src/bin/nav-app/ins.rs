@@ -118,9 +118,11 @@ struct InsArgs {
     print_config: bool,
     /// Also write the solution with its σ, each epoch's NIS and (with --truth) the errors as
     /// JSON channels of an MCAP file, plottable in Foxglove (/ins/solution, /ins/epochs,
-    /// /ins/errors).
+    /// /ins/errors, and the position as foxglove.LocationFix on /ins/fix for the Map panel).
     #[arg(long, value_name = "FILE")]
     mcap_out: Option<PathBuf>,
+    #[command(flatten)]
+    live: crate::live::LiveArgs,
     /// Reference trajectory: print and write the errors against it. CSV (radians or degrees,
     /// attitude optional), a TUM trajectory (`t x y z qx qy qz qw`, blank-separated, body →
     /// local quaternion) or an EuRoC/ASL folder's ground truth
@@ -343,7 +345,36 @@ fn run_ins(args: &InsArgs) -> Result<()> {
     let file = std::fs::File::create(out_path)
         .with_context(|| format!("creating {}", out_path.display()))?;
     let mut out = BufWriter::new(file);
-    let summary = match logs::replay(inputs, &mut out, out_path) {
+    let live = match &args.live.foxglove {
+        Some(addr) => Some(crate::live::Live::start(addr, &logs::ins_channels())?),
+        None => None,
+    };
+    if live.is_some() || args.live.realtime {
+        crate::live::install_sigint();
+    }
+    if let Some(l) = &live {
+        eprintln!("nav-app ins: serving Foxglove on ws://{}", l.addr());
+        if args.live.wait_client {
+            eprintln!("nav-app ins: waiting for a client to subscribe (--wait-client)");
+            l.wait_client();
+        }
+    }
+    let mut tap = crate::live::InsTap {
+        live: live.as_ref(),
+        pacer: args.live.realtime.then(crate::live::Pacer::default),
+    };
+    let replayed = logs::replay_with_tap(inputs, &mut out, out_path, Some(&mut tap));
+    if let Some(l) = live {
+        let f = l.shutdown();
+        eprintln!(
+            "nav-app ins: Foxglove: {} clients, {} messages sent, {} dropped",
+            f.clients, f.sent, f.dropped
+        );
+    }
+    if crate::live::interrupted() {
+        eprintln!("nav-app ins: interrupted (Ctrl-C): the replay ended there");
+    }
+    let summary = match replayed {
         Ok(summary) => summary,
         Err(e) => {
             // A refused or failed run leaves no solution behind that could pass for one (the

@@ -135,3 +135,35 @@ pub(crate) fn install_sigint() {
 pub(crate) fn interrupted() -> bool {
     INTERRUPTED.load(Ordering::SeqCst)
 }
+
+/// `nav-app ins`'s view of a replay: its messages to the live server, its pace (`--realtime`)
+/// and Ctrl-C.
+pub(crate) struct InsTap<'a> {
+    pub live: Option<&'a Live>,
+    pub pacer: Option<Pacer>,
+}
+
+impl ins_sim::logs::ReplayTap for InsTap<'_> {
+    fn wants(&self, channel: usize) -> bool {
+        self.live.is_some_and(|l| l.wants(channel))
+    }
+
+    fn message(&mut self, channel: usize, t_ns: u64, json: &[u8]) {
+        if let Some(l) = self.live {
+            if channel == ins_sim::logs::SOLUTION_CHANNEL {
+                l.time(t_ns);
+            }
+            l.publish(channel, t_ns, json);
+        }
+    }
+
+    fn pace(&mut self, t_s: f64) {
+        if let Some(p) = self.pacer.as_mut() {
+            p.wait(t_s);
+        }
+    }
+
+    fn stop(&self) -> bool {
+        interrupted()
+    }
+}
