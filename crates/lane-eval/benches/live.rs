@@ -1,0 +1,207 @@
+//! The tracker thread's cost per frame of `nav-app --json` over the real udacity clip (221
+//! frames, 320×240, `lane_bench::data::UDACITY_CLIP`) with and without the live Foxglove server
+//! (issue 55: "within 5 % of without, with no client and with one").
+//!
+//! Each iteration tracks every frame of the clip (decoded into memory once) with a fresh tracker
+//! and does per frame what `nav-app`'s frame loop does on its thread: the `--json` object
+//! serialized once (`lane_io::lane_frame::LaneFrame`), and with the server the `wants` checks,
+//! the *Time* message and, for what a client subscribed, the image and annotations encoded
+//! (`lane_io::mcap_sink::LaneEncoder`) and published. Criterion's time is per frame
+//! (`iter_custom`, the iteration's total over the clip's frames). Cases:
+//! - `no_server`: `nav-app --json`;
+//! - `server_no_client`: `nav-app --json --foxglove`, nobody connected;
+//! - `server_one_client`: the same with one local tungstenite client subscribed to the three
+//!   channels and reading on its own thread (its reading, and the server's client thread, run
+//!   beside the tracker on the same machine).
+//!
+//! `cargo bench -p lane-eval --bench live -- --warm-up-time 2 --measurement-time 10`
+//!
+//! Without the clip under the data root (`lane_bench::data`), it says so and measures nothing.
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::hint::black_box;
+use std::net::TcpStream;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use foxglove_live::{ChannelId, LiveConfig, LiveServer};
+use lane_io::FrameSource;
+use lane_io::lane_frame::LaneFrame;
+use lane_io::mcap_sink::{LaneEncoder, frame_t_ns, lane_channels};
+use lane_io::y4m::Y4mSource;
+use lane_tracker::{Estimator, GreyFrame, LaneTracker, Side, TrackerConfig};
+use tungstenite::Message;
+use tungstenite::client::IntoClientRequest;
+
+/// The clip's frames, or `None` (said on stderr) when it is missing.
+fn udacity_clip() -> Option<Vec<GreyFrame>> {
+    let path = match lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP) {
+        Ok(path) => path,
+        Err(e) => {
+            eprintln!("SKIPPED: the live bench needs the real udacity clip: {e}");
+            return None;
+        }
+    };
+    let file = std::fs::File::open(&path).expect("the clip opens");
+    let mut src = Y4mSource::new(std::io::BufReader::new(file), path.display().to_string())
+        .expect("a y4m stream");
+    let mut frames = Vec::new();
+    let mut frame = GreyFrame::default();
+    while src.next_frame(&mut frame).expect("a frame").is_some() {
+        frames.push(frame.clone());
+    }
+    Some(frames)
+}
+
+/// The server and its three channels (image, annotations, lanes).
+struct Live {
+    server: LiveServer,
+    channels: [ChannelId; 3],
+}
+
+/// One pass over the clip as nav-app's frame loop does it; returns the time spent.
+fn pass(
+    cfg: &TrackerConfig,
+    frames: &[GreyFrame],
+    live: Option<&Live>,
+    encoder: &mut LaneEncoder,
+    json: &mut Vec<u8>,
+) -> Duration {
+    let (w, h) = (frames[0].width(), frames[0].height());
+    let mut tracker = LaneTracker::new(cfg, Estimator::Kif, w, h).unwrap();
+    let start = Instant::now();
+    for (k, frame) in frames.iter().enumerate() {
+        let t0 = Instant::now();
+        let report = tracker.track(black_box(frame)).unwrap();
+        let dt = t0.elapsed();
+        let t_s = k as f64 / 25.0;
+        let message = LaneFrame {
+            schema: 1,
+            frame: k as u64,
+            t_s,
+            lanes: &report.lanes,
+            road: report.road,
+            noise: tracker.frame_noise(),
+            track_us: dt.as_secs_f64() * 1e6,
+            ego_lane: None,
+            lane_cov_px: live.is_some().then(|| {
+                [Side::Left, Side::Right]
+                    .map(|s| tracker.lane_covariance_px(s).map(|p| p.transpose().into()))
+            }),
+            capture: None,
+        };
+        json.clear();
+        serde_json::to_writer(&mut *json, &message).unwrap();
+        black_box(&json);
+        if let Some(l) = live {
+            let wants = l.channels.map(|c| l.server.wants(c));
+            let t_ns = frame_t_ns(t_s);
+            l.server.time(t_ns);
+            if wants[0] {
+                encoder.encode_image(t_ns, frame).unwrap();
+                l.server.publish(l.channels[0], t_ns, encoder.image_json());
+            }
+            if wants[1] {
+                encoder.encode_annotations(t_ns, w, h, &report).unwrap();
+                l.server
+                    .publish(l.channels[1], t_ns, encoder.annotations_json());
+            }
+            if wants[2] {
+                l.server.publish(l.channels[2], t_ns, json);
+            }
+        }
+    }
+    start.elapsed()
+}
+
+/// A client subscribed to the three channels, reading until `stop`.
+fn reading_client(server: &LiveServer, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<u64> {
+    let addr = server.local_addr();
+    let stream = TcpStream::connect(addr).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_millis(100)))
+        .unwrap();
+    let mut request = format!("ws://{addr}/").into_client_request().unwrap();
+    request.headers_mut().insert(
+        "Sec-WebSocket-Protocol",
+        "foxglove.websocket.v1".parse().unwrap(),
+    );
+    let mut ws = tungstenite::client(request, stream).unwrap().0;
+    ws.send(Message::text(
+        r#"{"op":"subscribe","subscriptions":[{"id":1,"channelId":1},{"id":2,"channelId":2},{"id":3,"channelId":3}]}"#,
+    ))
+    .unwrap();
+    std::thread::spawn(move || {
+        let mut bytes = 0u64;
+        while !stop.load(Ordering::Relaxed) {
+            match ws.read() {
+                Ok(Message::Binary(b)) => bytes += b.len() as u64,
+                Ok(_) => {}
+                Err(tungstenite::Error::Io(e))
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                    ) => {}
+                Err(_) => break,
+            }
+        }
+        bytes
+    })
+}
+
+fn live(c: &mut Criterion) {
+    let Some(frames) = udacity_clip() else {
+        return;
+    };
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let n = u32::try_from(frames.len()).unwrap();
+    let mut encoder = LaneEncoder::default();
+    let mut json = Vec::new();
+    let mut group = c.benchmark_group("live");
+    group.sample_size(20);
+    let start_server = || {
+        let server = LiveServer::bind("127.0.0.1:0", "bench", LiveConfig::default()).unwrap();
+        let channels = lane_channels()
+            .map(|(topic, name, schema)| server.add_channel(topic, name, &schema).unwrap());
+        Live { server, channels }
+    };
+    for case in ["no_server", "server_no_client", "server_one_client"] {
+        let server = (case != "no_server").then(start_server);
+        let stop = Arc::new(AtomicBool::new(false));
+        let client = (case == "server_one_client").then(|| {
+            let l = server.as_ref().unwrap();
+            let handle = reading_client(&l.server, Arc::clone(&stop));
+            let end = Instant::now() + Duration::from_secs(10);
+            while !l.channels.iter().all(|&ch| l.server.wants(ch)) {
+                assert!(Instant::now() < end, "the client did not subscribe");
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            handle
+        });
+        group.bench_function(BenchmarkId::new(case, "udacity_320x240_per_frame"), |b| {
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                for _ in 0..iters {
+                    total += pass(&cfg, &frames, server.as_ref(), &mut encoder, &mut json);
+                }
+                // Criterion divides by `iters`: the time it reports is per frame.
+                total / n
+            });
+        });
+        if let Some(l) = server {
+            let stats = l.server.shutdown();
+            stop.store(true, Ordering::Relaxed);
+            let read = client.map(|h| h.join().unwrap());
+            println!(
+                "live/{case}: server sent {} messages, dropped {}; the client read {:?} bytes",
+                stats.sent, stats.dropped, read
+            );
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, live);
+criterion_main!(benches);
