@@ -7,7 +7,10 @@
 //! `lane-tracker` and `lane-io` build cleanly alone; the INS simulation, crate `ins-sim` (used by
 //! the Python package), builds and depends on neither `rayon` nor `plotters` (they belong to
 //! `ins-monte-carlo`); the INS figures, crate `ins-plot` (the replay's error figure), do not
-//! depend on the Monte Carlo. Each check reads `cargo tree -p CRATE -e normal`.
+//! depend on the Monte Carlo; the live Foxglove server (`foxglove-live`, shared) depends on no
+//! lane or INS crate and on no async runtime, TLS or native code, and only the binary serves
+//! live (`lane-io` and `ins-sim`, the libraries the Python package uses, do not depend on it).
+//! Each check reads `cargo tree -p CRATE -e normal`.
 
 use std::process::Command;
 
@@ -50,6 +53,25 @@ const NOT_IN_INS_SIM: &[&str] = &["rayon", "plotters"];
 /// Crates the INS figures (`ins-plot`: the replay's error figure, `nav-app ins --plot`) must not
 /// depend on: the Monte Carlo and its pool.
 const NOT_IN_INS_PLOT: &[&str] = &["ins-monte-carlo", "rayon"];
+
+/// Crates the live Foxglove server (`foxglove-live`) must not depend on: either half, an async
+/// runtime, TLS or native code (it builds on a fresh machine with the toolchain alone).
+const NOT_IN_FOXGLOVE_LIVE: &[&str] = &[
+    "lane-tracker",
+    "lane-io",
+    "ins-sd-filter",
+    "ins-sim",
+    "tokio",
+    "rustls",
+    "native-tls",
+    "openssl-sys",
+    "ring",
+    "aws-lc-sys",
+];
+
+/// Crates the libraries (`lane-io`, `ins-sim`) must not depend on: the live server belongs to
+/// the binary, which composes it.
+const LIVE_SERVER: &[&str] = &["foxglove-live", "tungstenite"];
 
 /// The crates `cargo tree -p PACKAGE -e normal ARGS…` lists (one name per line, no prefix).
 fn normal_deps(cargo: &str, package: &str, args: &[&str]) -> Result<Vec<String>> {
@@ -166,6 +188,10 @@ pub fn run() -> Result<()> {
         &["--no-default-features"],
         &["lane-eval"],
     )?;
+    // The live server: shared, no half, no runtime or TLS; the libraries do not serve.
+    check_deps(&cargo, "foxglove-live", &[], NOT_IN_FOXGLOVE_LIVE)?;
+    check_deps(&cargo, "lane-io", &["--no-default-features"], LIVE_SERVER)?;
+    check_deps(&cargo, "ins-sim", &[], LIVE_SERVER)?;
     clippy_alone(&cargo, "lane-tracker", &[])?;
     clippy_alone(&cargo, "lane-io", &["--no-default-features"])?;
     // The INS half: the simulation without the Monte Carlo's rayon and plotters; the replay's

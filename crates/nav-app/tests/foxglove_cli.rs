@@ -150,3 +150,56 @@ fn realtime_with_a_device_and_wait_client_without_foxglove_are_refused() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--realtime"));
 }
+
+/// Every topic `docs/foxglove-layout.json` shows is one nav-app serves (lanes or INS), and every
+/// served channel but the annotations' own image is shown or drawn.
+#[test]
+fn the_layout_file_shows_only_served_topics() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/foxglove-layout.json"),
+    )
+    .unwrap();
+    let layout: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let served: Vec<&str> = lane_io::mcap_sink::lane_channels()
+        .iter()
+        .map(|c| c.0)
+        .chain(ins_sim::logs::ins_channels().iter().map(|c| c.0))
+        .collect();
+    let mut shown = Vec::new();
+    collect_topics(&layout["configById"], &mut shown);
+    assert!(!shown.is_empty());
+    for topic in &shown {
+        assert!(served.contains(&topic.as_str()), "{topic} is not served");
+    }
+    for topic in served {
+        assert!(
+            shown.iter().any(|s| s == topic),
+            "{topic} is not in the layout"
+        );
+    }
+}
+
+/// The topic of `s` (`/a/b` of `/a/b.field[0]`) into `out`, when it names one.
+fn add_topic(s: &str, out: &mut Vec<String>) {
+    if s.starts_with('/') {
+        let topic = s.split('.').next().unwrap().to_owned();
+        if !out.contains(&topic) {
+            out.push(topic);
+        }
+    }
+}
+
+/// The topics of the strings (and keys) under `v`.
+fn collect_topics(v: &serde_json::Value, out: &mut Vec<String>) {
+    match v {
+        serde_json::Value::String(s) => add_topic(s, out),
+        serde_json::Value::Array(a) => a.iter().for_each(|x| collect_topics(x, out)),
+        serde_json::Value::Object(o) => {
+            for (k, x) in o {
+                add_topic(k, out);
+                collect_topics(x, out);
+            }
+        }
+        _ => {}
+    }
+}
