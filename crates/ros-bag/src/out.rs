@@ -146,6 +146,44 @@ impl JsonMcapWriter {
     }
 }
 
+/// Appends `bytes` as standard base64 (RFC 4648, with padding) to `out`, 3 bytes to 4 characters
+/// at a time: the same text as [`base64_into`], for a caller that writes JSON bytes itself.
+pub fn base64_append(bytes: &[u8], out: &mut Vec<u8>) {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    out.reserve(bytes.len().div_ceil(3) * 4);
+    let mut chunks = bytes.chunks_exact(3);
+    for c in &mut chunks {
+        let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
+        out.extend_from_slice(&[
+            A[(n >> 18) as usize & 63],
+            A[(n >> 12) as usize & 63],
+            A[(n >> 6) as usize & 63],
+            A[n as usize & 63],
+        ]);
+    }
+    match *chunks.remainder() {
+        [a] => {
+            let n = u32::from(a) << 16;
+            out.extend_from_slice(&[
+                A[(n >> 18) as usize & 63],
+                A[(n >> 12) as usize & 63],
+                b'=',
+                b'=',
+            ]);
+        }
+        [a, b] => {
+            let n = (u32::from(a) << 16) | (u32::from(b) << 8);
+            out.extend_from_slice(&[
+                A[(n >> 18) as usize & 63],
+                A[(n >> 12) as usize & 63],
+                A[(n >> 6) as usize & 63],
+                b'=',
+            ]);
+        }
+        _ => {}
+    }
+}
+
 /// Standard base64 (RFC 4648, with padding), how JSON carries Foxglove's `bytes` fields.
 pub fn base64_into(bytes: &[u8], out: &mut String) {
     const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -318,4 +356,34 @@ pub mod foxglove {
 
     /// Foxglove's `PointsAnnotation` type for a polyline.
     pub const LINE_STRIP: u8 = 3;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_append_writes_the_rfc_4648_text_of_base64_into() {
+        // RFC 4648 section 10's vectors.
+        for (raw, text) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            let mut out = b"x".to_vec();
+            base64_append(raw.as_bytes(), &mut out);
+            assert_eq!(out, format!("x{text}").as_bytes());
+        }
+        let bytes: Vec<u8> = (0..1000u32).map(|k| (k * 7919 % 256) as u8).collect();
+        for len in [998, 999, 1000] {
+            let (mut a, mut b) = (String::new(), Vec::new());
+            base64_into(&bytes[..len], &mut a);
+            base64_append(&bytes[..len], &mut b);
+            assert_eq!(a.as_bytes(), &b[..]);
+        }
+    }
 }
