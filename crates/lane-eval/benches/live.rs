@@ -7,7 +7,9 @@
 //! serialized once (`lane_io::lane_frame::LaneFrame`), and with the server the `wants` checks,
 //! the *Time* message and, for what a client subscribed, the image and annotations encoded
 //! (`lane_io::mcap_sink::LaneEncoder`) and published. Criterion's time is per frame
-//! (`iter_custom`, the iteration's total over the clip's frames). Cases:
+//! (`iter_custom`, the iteration's total over the clip's frames); after each case the mean time
+//! of `LaneTracker::track` alone over every frame measured is printed too (what `nav-app` reports
+//! as "tracking … µs/frame", the tracker's speed without the output work). Cases:
 //! - `no_server`: `nav-app --json`;
 //! - `server_no_client`: `nav-app --json --foxglove`, nobody connected;
 //! - `server_one_client`: the same with one local tungstenite client subscribed to the three
@@ -61,13 +63,15 @@ struct Live {
     channels: [ChannelId; 3],
 }
 
-/// One pass over the clip as nav-app's frame loop does it; returns the time spent.
+/// One pass over the clip as nav-app's frame loop does it; returns the time spent, and adds the
+/// time spent in `LaneTracker::track` to `track_time`.
 fn pass(
     cfg: &TrackerConfig,
     frames: &[GreyFrame],
     live: Option<&Live>,
     encoder: &mut LaneEncoder,
     json: &mut Vec<u8>,
+    track_time: &mut Duration,
 ) -> Duration {
     let (w, h) = (frames[0].width(), frames[0].height());
     let mut tracker = LaneTracker::new(cfg, Estimator::Kif, w, h).unwrap();
@@ -76,6 +80,7 @@ fn pass(
         let t0 = Instant::now();
         let report = tracker.track(black_box(frame)).unwrap();
         let dt = t0.elapsed();
+        *track_time += dt;
         let t_s = k as f64 / 25.0;
         let message = LaneFrame {
             schema: 1,
@@ -180,16 +185,29 @@ fn live(c: &mut Criterion) {
             }
             handle
         });
+        let (mut track_time, mut tracked) = (Duration::ZERO, 0u64);
         group.bench_function(BenchmarkId::new(case, "udacity_320x240_per_frame"), |b| {
             b.iter_custom(|iters| {
                 let mut total = Duration::ZERO;
                 for _ in 0..iters {
-                    total += pass(&cfg, &frames, server.as_ref(), &mut encoder, &mut json);
+                    total += pass(
+                        &cfg,
+                        &frames,
+                        server.as_ref(),
+                        &mut encoder,
+                        &mut json,
+                        &mut track_time,
+                    );
+                    tracked += u64::from(n);
                 }
                 // Criterion divides by `iters`: the time it reports is per frame.
                 total / n
             });
         });
+        println!(
+            "live/{case}: LaneTracker::track alone {:.1} µs per frame (mean over {tracked} frames)",
+            track_time.as_secs_f64() * 1e6 / tracked.max(1) as f64
+        );
         if let Some(l) = server {
             let stats = l.server.shutdown();
             stop.store(true, Ordering::Relaxed);
