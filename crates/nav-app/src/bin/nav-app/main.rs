@@ -11,6 +11,7 @@
 //!         [--estimator kif|wrls] [--json] [--overlay DIR|FILE.y4m] [--max-frames N] [--loop]
 //!         [--dir-fps HZ] [--topic TOPIC] [--mcap-out FILE]
 //!         [--camera robot|highway|FILE.toml [--birdseye DIR]]
+//!         [--foxglove [ADDR] [--wait-client]] [--realtime]
 //!         [--input-name NAME | --input-index N] [--std ntsc|pal|…] [--size WxH] [--max-timeouts N]
 //! ```
 //! With neither `--input` nor `--device` it runs on a rendered sample (the project's own
@@ -71,6 +72,12 @@
 //! the run goes on. The last stderr line says `N frames tracked, L frames lost (B bytes
 //! skipped)`. With `--json` the last stdout line is always (every input, also after an error)
 //! the summary line (`docs/json.md`).
+//!
+//! ## Live (`--foxglove`, `live.rs`)
+//! `--foxglove [ADDR]` serves the channels of `--mcap-out` live over Foxglove's WebSocket
+//! protocol (crate `foxglove_live`; default `127.0.0.1:8765`), for the lanes and for `nav-app ins`;
+//! `--wait-client` waits for a subscription, `--realtime` paces a recorded input at its own
+//! timestamps, and Ctrl-C (SIGINT) ends a run cleanly (`"exit": "interrupted"`).
 //!
 //! ## Lanes in metres (`--camera`)
 //! With a camera file (read by `lane_io::config::load_camera_config`, the model in
