@@ -200,8 +200,13 @@ def test_every_frames_lanes_reach_a_websocket_v1_client_equal_to_the_json_lines(
         # The same bytes as the --json line, frame by frame, stamped with the frame's own time.
         assert [p.decode() for _, p in lanes] == lines
         assert [t for t, _ in lanes] == [round(max(json.loads(l)["t_s"], 0) * 1e9) for l in lines]
-        images = reader.got["/camera/image"]
-        assert len(images) == len(lines) and len(reader.got["/camera/lanes"]) == len(lines)
+        # The images and annotations are encoded off the tracker's thread: when the encoder is
+        # behind (a file tracked as fast as it goes) a frame's are dropped and counted, never the
+        # lanes. Every message is accounted for.
+        images, annotations = reader.got["/camera/image"], reader.got["/camera/lanes"]
+        assert len(images) > 0 and len(images) == len(annotations)
+        stamps = [t for t, _ in lanes]
+        assert [t for t, _ in images] == [t for t in stamps if t in {t for t, _ in images}]
         img = json.loads(images[0][1])
         assert (img["width"], img["height"], img["encoding"]) == (320, 240, "mono8")
         assert len(base64.b64decode(img["data"])) == 320 * 240
@@ -210,7 +215,10 @@ def test_every_frames_lanes_reach_a_websocket_v1_client_equal_to_the_json_lines(
         assert set(fox) == {"clients", "sent", "dropped"}
     # The stalled client changes neither the first client's lanes nor the frame count.
     assert [without_time(l) for l in first[0]] == [without_time(l) for l in second[0]]
-    assert first[1]["foxglove"] == {"clients": 1, "sent": 3 * len(first[0]), "dropped": 0}
+    fox = first[1]["foxglove"]
+    received = sum(len(v) for v in first[2].got.values())
+    assert fox["clients"] == 1 and fox["sent"] == received
+    assert fox["sent"] + fox["dropped"] == 3 * len(first[0])
     assert second[1]["foxglove"]["clients"] == 2
 
 

@@ -5,8 +5,9 @@
 //! Each iteration tracks every frame of the clip (decoded into memory once) with a fresh tracker
 //! and does per frame what `nav-app`'s frame loop does on its thread: the `--json` object
 //! serialized once (`lane_io::lane_frame::LaneFrame`), and with the server the `wants` checks,
-//! the *Time* message and, for what a client subscribed, the image and annotations encoded
-//! (`lane_io::mcap_sink::LaneEncoder`) and published. Criterion's time is per frame
+//! the *Time* message, `/lanes` published and, for what a client subscribed, the frame handed to
+//! the encoder thread (`lane_io::encode_thread`, which encodes and publishes the image and
+//! annotations beside the tracker). Criterion's time is per frame
 //! (`iter_custom`, the iteration's total over the clip's frames); after each case the mean time
 //! of `LaneTracker::track` alone over every frame measured is printed too (what `nav-app` reports
 //! as "tracking … µs/frame", the tracker's speed without the output work). Cases:
@@ -30,8 +31,9 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use foxglove_live::{ChannelId, LiveConfig, LiveServer};
 use lane_io::FrameSource;
+use lane_io::encode_thread::EncodeThread;
 use lane_io::lane_frame::LaneFrame;
-use lane_io::mcap_sink::{LaneEncoder, frame_t_ns, lane_channels};
+use lane_io::mcap_sink::{frame_t_ns, lane_channels};
 use lane_io::y4m::Y4mSource;
 use lane_tracker::{Estimator, GreyFrame, LaneTracker, Side, TrackerConfig};
 use tungstenite::Message;
@@ -57,10 +59,11 @@ fn udacity_clip() -> Option<Vec<GreyFrame>> {
     Some(frames)
 }
 
-/// The server and its three channels (image, annotations, lanes).
+/// The server, its three channels (image, annotations, lanes) and the encoder thread.
 struct Live {
-    server: LiveServer,
+    server: Arc<LiveServer>,
     channels: [ChannelId; 3],
+    encode: EncodeThread,
 }
 
 /// One pass over the clip as nav-app's frame loop does it; returns the time spent, and adds the
@@ -68,8 +71,7 @@ struct Live {
 fn pass(
     cfg: &TrackerConfig,
     frames: &[GreyFrame],
-    live: Option<&Live>,
-    encoder: &mut LaneEncoder,
+    mut live: Option<&mut Live>,
     json: &mut Vec<u8>,
     track_time: &mut Duration,
 ) -> Duration {
@@ -100,21 +102,15 @@ fn pass(
         json.clear();
         serde_json::to_writer(&mut *json, &message).unwrap();
         black_box(&json);
-        if let Some(l) = live {
+        if let Some(l) = live.as_deref_mut() {
             let wants = l.channels.map(|c| l.server.wants(c));
             let t_ns = frame_t_ns(t_s);
             l.server.time(t_ns);
-            if wants[0] {
-                encoder.encode_image(t_ns, frame).unwrap();
-                l.server.publish(l.channels[0], t_ns, encoder.image_json());
-            }
-            if wants[1] {
-                encoder.encode_annotations(t_ns, w, h, &report).unwrap();
-                l.server
-                    .publish(l.channels[1], t_ns, encoder.annotations_json());
-            }
             if wants[2] {
                 l.server.publish(l.channels[2], t_ns, json);
+            }
+            if wants[0] || wants[1] {
+                l.encode.offer(t_ns, frame, &report, [wants[0], wants[1]]);
             }
         }
     }
@@ -162,7 +158,6 @@ fn live(c: &mut Criterion) {
     };
     let cfg = TrackerConfig::default_preset().unwrap();
     let n = u32::try_from(frames.len()).unwrap();
-    let mut encoder = LaneEncoder::default();
     let mut json = Vec::new();
     let mut group = c.benchmark_group("live");
     group.sample_size(20);
@@ -170,10 +165,20 @@ fn live(c: &mut Criterion) {
         let server = LiveServer::bind("127.0.0.1:0", "bench", LiveConfig::default()).unwrap();
         let channels = lane_channels()
             .map(|(topic, name, schema)| server.add_channel(topic, name, &schema).unwrap());
-        Live { server, channels }
+        let server = Arc::new(server);
+        let publisher = Arc::clone(&server);
+        let encode = EncodeThread::start(move |k, t_ns, json: &[u8]| {
+            publisher.publish(channels[k], t_ns, json);
+        })
+        .unwrap();
+        Live {
+            server,
+            channels,
+            encode,
+        }
     };
     for case in ["no_server", "server_no_client", "server_one_client"] {
-        let server = (case != "no_server").then(start_server);
+        let mut server = (case != "no_server").then(start_server);
         let stop = Arc::new(AtomicBool::new(false));
         let client = (case == "server_one_client").then(|| {
             let l = server.as_ref().unwrap();
@@ -190,14 +195,7 @@ fn live(c: &mut Criterion) {
             b.iter_custom(|iters| {
                 let mut total = Duration::ZERO;
                 for _ in 0..iters {
-                    total += pass(
-                        &cfg,
-                        &frames,
-                        server.as_ref(),
-                        &mut encoder,
-                        &mut json,
-                        &mut track_time,
-                    );
+                    total += pass(&cfg, &frames, server.as_mut(), &mut json, &mut track_time);
                     tracked += u64::from(n);
                 }
                 // Criterion divides by `iters`: the time it reports is per frame.
@@ -209,11 +207,13 @@ fn live(c: &mut Criterion) {
             track_time.as_secs_f64() * 1e6 / tracked.max(1) as f64
         );
         if let Some(l) = server {
-            let stats = l.server.shutdown();
+            let busy = l.encode.finish();
+            let stats = Arc::try_unwrap(l.server).ok().unwrap().shutdown();
             stop.store(true, Ordering::Relaxed);
             let read = client.map(|h| h.join().unwrap());
             println!(
-                "live/{case}: server sent {} messages, dropped {}; the client read {:?} bytes",
+                "live/{case}: server sent {} messages, dropped {}; {busy} messages left out by the \
+                 busy encoder; the client read {:?} bytes",
                 stats.sent, stats.dropped, read
             );
         }

@@ -24,6 +24,7 @@
 pub mod birdseye;
 pub mod capture_source;
 pub mod config;
+pub mod encode_thread;
 mod error;
 mod frame;
 pub mod frame_loop;

@@ -301,7 +301,7 @@ fn run(
     if let Some(addr) = &args.live.foxglove {
         *live = Some(Live::start(addr, &lane_channels())?);
     }
-    let live = live.as_ref();
+    let mut live = live.as_mut();
     let camera: Option<CameraModel> = match &args.camera {
         Some(c) => Some(lane_io::config::load_camera_config(c)?.model()?),
         None => None,
@@ -346,12 +346,12 @@ fn run(
         Some(p) => Some(lane_io::mcap_sink::LaneMcapSink::create(p)?),
         None => None,
     };
-    if let Some(l) = live
+    if let Some(l) = live.as_deref()
         && !quiet
     {
         eprintln!("nav-app: serving Foxglove on ws://{}", l.addr());
     }
-    if let Some(l) = live
+    if let Some(l) = live.as_deref()
         && args.live.wait_client
     {
         if !quiet {
@@ -430,7 +430,9 @@ fn run(
                 eprintln!("nav-app: frame {index}: input signal {what}");
             }
         }
-        let wants = live.map_or([false; 3], |l| [l.wants(0), l.wants(1), l.wants(2)]);
+        let wants = live
+            .as_deref()
+            .map_or([false; 3], |l| [l.wants(0), l.wants(1), l.wants(2)]);
         if args.json || mcap_out.is_some() || wants.contains(&true) {
             let frame_json = LaneFrame {
                 schema: JSON_SCHEMA,
@@ -460,13 +462,9 @@ fn run(
                     .context("cannot write JSON to stdout")?;
             }
             let t_ns = frame_t_ns(meta.t_s);
-            if mcap_out.is_some() || wants[0] {
-                encoder.encode_image(t_ns, frame)?;
-            }
-            if mcap_out.is_some() || wants[1] {
-                encoder.encode_annotations(t_ns, frame.width(), frame.height(), &report)?;
-            }
             if let Some(sink) = mcap_out.as_mut() {
+                encoder.encode_image(t_ns, frame)?;
+                encoder.encode_annotations(t_ns, frame.width(), frame.height(), &report)?;
                 sink.write_encoded(
                     t_ns,
                     encoder.image_json(),
@@ -474,18 +472,11 @@ fn run(
                     &lanes_json,
                 )?;
             }
-            if let Some(l) = live {
-                l.time(t_ns);
-                let messages = [
-                    encoder.image_json(),
-                    encoder.annotations_json(),
-                    &lanes_json,
-                ];
-                for (k, json) in messages.into_iter().enumerate() {
-                    if wants[k] {
-                        l.publish(k, t_ns, json);
-                    }
-                }
+            if let Some(l) = live.as_deref_mut() {
+                let encoded = mcap_out
+                    .is_some()
+                    .then(|| [encoder.image_json(), encoder.annotations_json()]);
+                l.lane_frame(t_ns, frame, &report, &lanes_json, encoded, wants)?;
             }
         }
         if let Some(sink) = overlay.as_mut() {

@@ -4,11 +4,15 @@
 //! which ends a run cleanly: the loops stop at the next frame or epoch, the files are finished and
 //! the summary printed.
 
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use foxglove_live::{ChannelId, LiveConfig, LiveServer, LiveStats};
+use lane_io::GreyFrame;
+use lane_io::encode_thread::EncodeThread;
+use lane_tracker::TrackReport;
 
 /// The address `--foxglove` without a value listens on: loopback only.
 pub(crate) const DEFAULT_ADDR: &str = "127.0.0.1:8765";
@@ -30,10 +34,11 @@ pub(crate) struct LiveArgs {
     pub realtime: bool,
 }
 
-/// A live server and its channels.
+/// A live server and its channels (and, for the lanes, the thread that encodes the images).
 pub(crate) struct Live {
-    server: LiveServer,
+    server: Arc<LiveServer>,
     channels: Vec<ChannelId>,
+    encode: Option<EncodeThread>,
 }
 
 impl Live {
@@ -46,7 +51,11 @@ impl Live {
             .map(|(topic, name, schema)| server.add_channel(topic, name, schema))
             .collect::<Result<Vec<_>, _>>()
             .context("--foxglove")?;
-        Ok(Self { server, channels })
+        Ok(Self {
+            server: Arc::new(server),
+            channels,
+            encode: None,
+        })
     }
 
     /// The address served (with the port picked when 0 was given).
@@ -83,9 +92,56 @@ impl Live {
         false
     }
 
-    /// Lets the clients receive what is queued (2 s at most), closes and returns the counters.
-    pub fn shutdown(self) -> LiveStats {
-        self.server.shutdown()
+    /// One tracked frame of the lane channels (image, annotations, lanes) at `t_ns`, for the
+    /// channels in `wants`: `lanes_json` (the `--json` line) at once; the image and annotations
+    /// either `encoded` already (the `--mcap-out` bytes) or by the encoder thread, so that the
+    /// tracker's thread only copies the frame.
+    pub fn lane_frame(
+        &mut self,
+        t_ns: u64,
+        frame: &GreyFrame,
+        report: &TrackReport,
+        lanes_json: &[u8],
+        encoded: Option<[&[u8]; 2]>,
+        wants: [bool; 3],
+    ) -> Result<()> {
+        self.time(t_ns);
+        if wants[2] {
+            self.publish(2, t_ns, lanes_json);
+        }
+        if let Some(messages) = encoded {
+            for (k, json) in messages.into_iter().enumerate() {
+                if wants[k] {
+                    self.publish(k, t_ns, json);
+                }
+            }
+        } else if wants[0] || wants[1] {
+            let encode = match &mut self.encode {
+                Some(e) => e,
+                None => {
+                    let server = Arc::clone(&self.server);
+                    let channels = [self.channels[0], self.channels[1]];
+                    let thread = EncodeThread::start(move |k, t_ns, json: &[u8]| {
+                        server.publish(channels[k], t_ns, json);
+                    })?;
+                    self.encode.insert(thread)
+                }
+            };
+            encode.offer(t_ns, frame, report, [wants[0], wants[1]]);
+        }
+        Ok(())
+    }
+
+    /// Lets the encoder finish, the clients receive what is queued (2 s at most), closes and
+    /// returns the counters (messages the encoder was too busy for counted as dropped).
+    pub fn shutdown(mut self) -> LiveStats {
+        let busy = self.encode.take().map_or(0, EncodeThread::finish);
+        let mut stats = match Arc::try_unwrap(self.server) {
+            Ok(server) => server.shutdown(),
+            Err(shared) => shared.stats(),
+        };
+        stats.dropped += busy;
+        stats
     }
 }
 

@@ -1,0 +1,210 @@
+//! The lane channels' image and annotations encoded off the tracker's thread (`nav-app
+//! --foxglove` without `--mcap-out`): the tracker's thread copies the grey frame into a buffer of
+//! a small pool and hands it over with the frame's `Copy` [`TrackReport`]; this thread encodes
+//! them with [`LaneEncoder`] (the bytes the MCAP file would get) and gives them to a publish
+//! callback (the live server). No allocation per frame once the pool is full; when every buffer
+//! is busy (the encoder cannot keep up) the frame is not sent and counted.
+
+use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
+use std::thread::JoinHandle;
+
+use grey_frame::GreyFrame;
+use lane_tracker::TrackReport;
+
+use crate::LaneIoError;
+use crate::mcap_sink::LaneEncoder;
+
+/// Frames that may wait for, or be in, the encoder at once.
+const POOL_FRAMES: usize = 4;
+
+/// Index of the image channel for the publish callback (as in [`crate::mcap_sink::lane_channels`]).
+pub const IMAGE: usize = 0;
+/// Index of the annotations channel for the publish callback.
+pub const ANNOTATIONS: usize = 1;
+
+struct Job {
+    t_ns: u64,
+    frame: GreyFrame,
+    report: TrackReport,
+    /// Image, annotations.
+    wants: [bool; 2],
+}
+
+/// The encoder thread and its buffer pool.
+pub struct EncodeThread {
+    jobs: Option<SyncSender<Job>>,
+    free: Receiver<GreyFrame>,
+    made: usize,
+    dropped: u64,
+    handle: Option<JoinHandle<()>>,
+}
+
+impl std::fmt::Debug for EncodeThread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EncodeThread")
+            .field("dropped", &self.dropped)
+            .finish()
+    }
+}
+
+impl EncodeThread {
+    /// Starts the thread; `publish(channel, t_ns, json)` receives each encoded message
+    /// (`channel` [`IMAGE`] or [`ANNOTATIONS`]).
+    ///
+    /// # Errors
+    /// [`LaneIoError::Io`] when the thread cannot be started.
+    pub fn start(
+        mut publish: impl FnMut(usize, u64, &[u8]) + Send + 'static,
+    ) -> Result<Self, LaneIoError> {
+        let (jobs, job_rx) = sync_channel::<Job>(POOL_FRAMES);
+        let (free_tx, free) = sync_channel::<GreyFrame>(POOL_FRAMES);
+        let handle = std::thread::Builder::new()
+            .name("lane-encode".into())
+            .spawn(move || {
+                let mut encoder = LaneEncoder::default();
+                for job in job_rx {
+                    let (w, h) = (job.frame.width(), job.frame.height());
+                    if job.wants[0] && encoder.encode_image(job.t_ns, &job.frame).is_ok() {
+                        publish(IMAGE, job.t_ns, encoder.image_json());
+                    }
+                    if job.wants[1]
+                        && encoder
+                            .encode_annotations(job.t_ns, w, h, &job.report)
+                            .is_ok()
+                    {
+                        publish(ANNOTATIONS, job.t_ns, encoder.annotations_json());
+                    }
+                    let _ = free_tx.try_send(job.frame);
+                }
+            })
+            .map_err(|source| LaneIoError::Io {
+                path: "the lane encoder thread".to_owned(),
+                source,
+            })?;
+        Ok(Self {
+            jobs: Some(jobs),
+            free,
+            made: 0,
+            dropped: 0,
+            handle: Some(handle),
+        })
+    }
+
+    /// Hands `frame` and `report` at `t_ns` to the thread for the channels `wants` (image,
+    /// annotations); false when every buffer is busy (the messages are counted as dropped).
+    pub fn offer(
+        &mut self,
+        t_ns: u64,
+        frame: &GreyFrame,
+        report: &TrackReport,
+        wants: [bool; 2],
+    ) -> bool {
+        let buffer = match self.free.try_recv() {
+            Ok(b) => Some(b),
+            Err(TryRecvError::Empty | TryRecvError::Disconnected) if self.made < POOL_FRAMES => {
+                self.made += 1;
+                Some(GreyFrame::default())
+            }
+            Err(_) => None,
+        };
+        let messages = wants.iter().filter(|&&w| w).count() as u64;
+        let Some(mut buffer) = buffer else {
+            self.dropped += messages;
+            return false;
+        };
+        if buffer.reshape(frame.width(), frame.height()).is_err() {
+            self.dropped += messages;
+            return false;
+        }
+        buffer.data_mut().copy_from_slice(frame.data());
+        let job = Job {
+            t_ns,
+            frame: buffer,
+            report: *report,
+            wants,
+        };
+        // Never full: the pool holds no more frames than the channel does.
+        let sent = self.jobs.as_ref().is_some_and(|j| j.try_send(job).is_ok());
+        if !sent {
+            self.dropped += messages;
+        }
+        sent
+    }
+
+    /// Messages not encoded because the encoder was busy.
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    /// Lets the thread encode what it was handed, and joins it; returns [`Self::dropped`].
+    pub fn finish(mut self) -> u64 {
+        self.join();
+        self.dropped
+    }
+
+    fn join(&mut self) {
+        self.jobs = None;
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+impl Drop for EncodeThread {
+    fn drop(&mut self) {
+        self.join();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::{Arc, Mutex};
+
+    #[test]
+    fn every_frame_offered_is_encoded_as_the_encoder_does_it_on_the_callers_thread() {
+        let got = Arc::new(Mutex::new(Vec::new()));
+        let sink = Arc::clone(&got);
+        let mut thread = EncodeThread::start(move |channel, t_ns, json: &[u8]| {
+            sink.lock().unwrap().push((channel, t_ns, json.to_vec()));
+        })
+        .unwrap();
+        let lane = |side| lane_tracker::LaneReport {
+            side,
+            state: lane_tracker::LaneState::Tracking,
+            coeffs: Some([0.01, -0.5, 4.0]),
+            rows: [1.0, 5.0],
+            points: 9,
+            initialised: false,
+            far: None,
+        };
+        let report = TrackReport {
+            lanes: [
+                lane(lane_tracker::Side::Left),
+                lane(lane_tracker::Side::Right),
+            ],
+            full_gradient: false,
+            road: lane_tracker::RoadReport {
+                bottom_row_px: 6.0,
+                search_rows_px: [1.0, 6.0],
+                horizon_row_px: Some(0.5),
+                refused: None,
+            },
+        };
+        let mut expected = Vec::new();
+        let mut encoder = LaneEncoder::default();
+        for k in 0..20u64 {
+            let data: Vec<u8> = (0..48).map(|i| (i as u64 * 3 + k) as u8).collect();
+            let frame = GreyFrame::from_vec(8, 6, data).unwrap();
+            while !thread.offer(k, &frame, &report, [true, true]) {
+                std::thread::yield_now();
+            }
+            encoder.encode_image(k, &frame).unwrap();
+            expected.push((IMAGE, k, encoder.image_json().to_vec()));
+            encoder.encode_annotations(k, 8, 6, &report).unwrap();
+            expected.push((ANNOTATIONS, k, encoder.annotations_json().to_vec()));
+        }
+        thread.finish();
+        assert_eq!(*got.lock().unwrap(), expected);
+    }
+}
