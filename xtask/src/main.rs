@@ -14,12 +14,12 @@ mod fixtures;
 mod halves;
 mod ins_real;
 mod monte_carlo;
+mod packages;
 mod paths;
 mod python;
 mod readme;
 mod regress;
 mod resample_lanes;
-mod vivid;
 
 #[derive(Parser)]
 #[command(
@@ -45,8 +45,13 @@ enum Cmd {
     /// Install the system packages a full build and the tests need (Debian `libclang-dev` for
     /// V4L2 capture, `ffmpeg` for video inputs).
     Setup,
-    /// Boot Debian's kernel under qemu with the vivid V4L2 driver and run the capture cases.
-    Vivid(vivid::VividArgs),
+    /// Boot Debian's kernel under qemu with the vivid V4L2 driver and run the capture cases:
+    /// installs the host packages, then runs `cargo run -p vivid-vm -- ARGS` (`--help` there).
+    Vivid {
+        /// Passed to `vivid-vm` as they are (`--case NAME`, `--guest-bin PATH`, `--verbose`…).
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
     /// Render the synthetic lane sequences with ground truth into fixtures/synthetic/.
     Fixtures(fixtures::FixturesArgs),
     /// Run the lane tracker over every fixture and compare with the recorded expectations.
@@ -86,8 +91,8 @@ enum Cmd {
 fn main() -> Result<()> {
     match Cli::parse().cmd {
         Cmd::Test => test(),
-        Cmd::Setup => vivid::ensure_test_packages(),
-        Cmd::Vivid(args) => vivid::run(args),
+        Cmd::Setup => packages::ensure_test_packages(),
+        Cmd::Vivid { args } => vivid(&args),
         Cmd::Fixtures(args) => fixtures::run(args),
         Cmd::Regress(args) => regress::run(args),
         Cmd::EvalLanes(args) => eval_lanes::run(args),
@@ -193,7 +198,7 @@ const STEPS: &[Step] = &[
 /// every step, printing each one's wall time as it ends, and closes with a table of the steps'
 /// wall times (`timing_table`) and one `xtask: N passed, M failed` line.
 fn test() -> Result<()> {
-    vivid::ensure_test_packages()
+    packages::ensure_test_packages()
         .context("the workspace build and tests need libclang-dev and ffmpeg (Debian)")?;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let this = std::env::current_exe().context("cannot locate the xtask binary")?;
@@ -240,6 +245,22 @@ fn test() -> Result<()> {
     println!("xtask: {passed} passed, {} failed", failed.len());
     if !failed.is_empty() {
         bail!("failed steps: {}", failed.join(", "));
+    }
+    Ok(())
+}
+
+/// `cargo xtask vivid ARGS`: the VM test's host packages, then the `vivid-vm` tool with `ARGS`.
+fn vivid(args: &[String]) -> Result<()> {
+    packages::ensure_vivid_packages()?;
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    let status = Command::new(cargo)
+        .current_dir(paths::workspace_root())
+        .args(["run", "--quiet", "-p", "vivid-vm", "--"])
+        .args(args)
+        .status()
+        .context("cannot run cargo run -p vivid-vm")?;
+    if !status.success() {
+        bail!("the vivid VM test failed ({status})");
     }
     Ok(())
 }

@@ -95,7 +95,7 @@ pub fn ensure_venv_with(
             .context("python3 is needed (cannot start python3)")?;
         if !made.success() {
             // Debian splits the venv module out (python3-venv).
-            crate::vivid::ensure_host_packages(&["python3-venv"])?;
+            crate::packages::ensure_host_packages(&["python3-venv"])?;
             let _ = std::fs::remove_dir_all(&venv);
             run_checked(
                 Command::new("python3").args(["-m", "venv"]).arg(&venv),

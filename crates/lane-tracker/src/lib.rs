@@ -274,22 +274,12 @@
 //!   windows measure; on tracked frames the kerb is read again on every eighth row and the
 //!   shift follows it, or is dropped after `track.lost_after_frames` frames without a kerb.
 //!
-//! Measured on the labelled real sets (`cargo xtask eval-lanes`, `../shared/data/lanes`: 377
-//! stills in four sets, two road, two indoor; tuned on the development part only), TuSimple
-//! accuracy / FP went from 39.3 % / 56.3 % (the paper's initialisation) to 70.2 % / 33.2 % on the
-//! development part (Aly detection 51.1 → 74.8 %), and from 41.8 % / 51.1 % to 69.9 % / 41.3 % on
-//! the held-out part (the candidate coverage and the width term: 57.9 → 60.4 % dev, 57.3 → 61.7 %
-//! hold-out; the orientation vote and gate, edges to 85° and the ego lane under the image's
-//! middle column: 60.4 → 63.3 % dev, 61.7 → 63.1 % hold-out; the second search: 63.3 → 65.3 %
-//! dev, 63.1 → 66.9 % hold-out; the double line's middle and the kerb's foot: 65.3 → 67.7 % dev,
-//! 66.9 → 68.2 % hold-out; the second search's fits asked for a quarter of the ROI's rows, not of
-//! the taller rows': 67.7 → 68.5 % dev, 68.2 → 69.3 % hold-out; the unpaired pixels' cap in the
-//! row coverage: 68.5 → 68.8 % dev, 69.3 → 69.6 % hold-out; vertical marks (edges to 90°, a
-//! vertical line not reported alone, stripes to 16 px): 68.8 → 69.5 % dev, 69.6 → 70.0 %
-//! hold-out; periodic stripes: 69.5 → 70.2 % dev, 70.0 → 69.9 % hold-out);
-//! `init.ego_pair.min_support_frac = 0.1` keeps a dashed ego mark beside a solid one (the real udacity clip: both lanes on 220 of 221 stills initialised alone, 163 with
-//! 0.2). The presets (`indoor`, `outdoor`, used by the rendered regression sequences) keep the
-//! paper's initialisation.
+//! `init.ego_pair.min_support_frac = 0.1` keeps a dashed ego mark beside a solid one (the real
+//! udacity clip: both lanes on 220 of 221 stills initialised alone, 163 with 0.2). The presets
+//! (`indoor`, `outdoor`, used by the rendered regression sequences) keep the paper's
+//! initialisation. What each of these mechanisms earns on the labelled real sets, switched off
+//! in turn and leave-one-set-out, is `docs/results/ablation.md` (`cargo xtask ablation`); the
+//! decisions and figures behind each, `docs/lanes/history/`.
 //!
 //! ## Lanes in metres
 //! [`camera`]: a camera configuration (pinhole intrinsics + mounting, or a measured ground-plane
@@ -301,22 +291,12 @@
 //!
 //! ## Working resolution (an addition beyond the paper; `frame.working_width_px`, default 320)
 //! The paper's frames are 320×240, and so are the pixel fields of the default and the presets.
-//! A frame of another width than the working width is resampled to exactly that width, by
-//! `s = width / working_width_px` input pixels per working pixel, any real (the area average
-//! down, linear interpolation up to 2×; a 1280×720 frame is tracked at 320×180, a 512×288 one
-//! too), and every report — coefficients, covariance, rows, windows, points, candidates — is
-//! mapped back to the input's pixels by the exact affine map of the coefficients (module
-//! `tracker::working`, derivation there; counts such as a report's points stay counts of the
-//! working frame). At the default, frames 320 px wide are tracked as they are, bit for bit as
-//! before, and whole factors (640, 1280 px) by the box average as before. Measured on the
-//! labelled stills enlarged to 640×360 and 1280×720 (`cargo xtask resample-lanes --factor 2` /
-//! `4`, then `cargo xtask eval-lanes --data target/lanes-2x`): held out 79.0 % and 79.5 %
-//! (TuSimple) against 78.8 % at 320×180, where the same pixel settings used at the input's
-//! size reach 66.0 % and 43.9 %; and the work per frame stays that of a 320-px frame plus the
-//! resampling. `working_width_px = 0` tracks every frame at its own size (the paper).
-//! [`LaneTracker::working_scale`] gives `s` and [`LaneTracker::working_frame`] the last
-//! frame's working pixels, for diagnostics that must read the frame as the stages do
-//! (`lane_bench::labelled::census_lanes`).
+//! A frame of another width is resampled to exactly the working width, by any real factor, and
+//! every report is mapped back to the input's pixels by the exact affine map of the coefficients
+//! (module `tracker::working`, the derivation and figures there); `working_width_px = 0` tracks
+//! every frame at its own size (the paper). [`LaneTracker::working_scale`] gives the factor and
+//! [`LaneTracker::working_frame`] the last frame's working pixels, for diagnostics that must read
+//! the frame as the stages do (`lane_bench::labelled::census_lanes`).
 //!
 //! ## Units of the configuration
 //! See [`TrackerConfig`] and `configs/outdoor.toml` / `configs/indoor.toml`: every field

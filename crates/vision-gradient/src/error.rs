@@ -55,6 +55,17 @@ pub enum GradientError {
         /// `width * height` of the image.
         expected: usize,
     },
+    /// A buffer given to a kernel writing into caller-owned buffers ([`crate::resample_rows`],
+    /// [`crate::downscale_box`], [`crate::smooth_binomial`]) cannot hold what the call asks for.
+    #[error("buffer `{buffer}` has {len} entries, the call needs {required}")]
+    BufferTooSmall {
+        /// Which buffer, by its parameter's name.
+        buffer: &'static str,
+        /// Its length, entries.
+        len: usize,
+        /// Entries needed.
+        required: usize,
+    },
     /// The class-image output buffer does not have `width * height` bytes.
     #[error("class image buffer has {len} bytes, expected width*height = {expected}")]
     ClassImageSizeMismatch {

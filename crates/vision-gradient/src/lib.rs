@@ -104,6 +104,17 @@
 //! module's docs give the rule and its known gap). It also runs on the detector's output and
 //! allocates nothing.
 //!
+//! ## Resampling by any factor ([`resample_rows`], [`downscale_box`])
+//! The tracker works on a frame of a fixed working width whatever the camera's: the input is
+//! resampled by `s` input pixels per working pixel, any real `s` (area average down, linear
+//! interpolation up), the taps of each axis computed once ([`AxisTaps`]) and the pixels written
+//! into caller-owned buffers whose sizes are checked. The maths is in module `resample`.
+//!
+//! ## Noise ([`noise_sigma_grey`], [`smooth_binomial`])
+//! Immerkær's noise estimate σ̂ of a frame's rows, and the 3 × 3 binomial smoothing the tracker
+//! applies to frames far noisier than its grey-level settings assume; the maths is in module
+//! `noise`.
+//!
 //! ## Defaults
 //! [`GradientParams::default`]: band 15°..80°, fixed threshold 120 (a 45° step of 20 grey
 //! levels). On the Udacity 320×240 frames (`shared/data/udacity`) this keeps both marks of the
@@ -153,17 +164,21 @@ mod edges;
 mod error;
 mod image;
 mod kernel;
+mod noise;
 mod normal;
 mod params;
 mod periodic;
+mod resample;
 mod ridge;
 
 pub use edges::{EdgeBuffer, EdgeClass, EdgePixel, EdgeStats};
 pub use error::GradientError;
 pub use image::{GreyImage, MAX_SIDE_PX};
+pub use noise::{NOISE_MEDIAN_PER_SIGMA, noise_sigma_grey, smooth_binomial};
 pub use normal::gradient_normal_deg;
 pub use params::{GradientParams, Threshold};
 pub use periodic::{PeriodicStripeParams, drop_periodic_stripes};
+pub use resample::{AxisSpan, AxisTaps, downscale_box, resample_rows};
 pub use ridge::{keep_bright_stripes, split_stripes};
 
 use kernel::{Band, CheckedRegion, HIST_BINS, Sink};

@@ -9,23 +9,17 @@
 //! on the rows searched and, where it is far above what the settings assume, gives the stages a
 //! working frame with less.
 //!
-//! **The estimate.** The mask `N = [1 −2 1; −2 4 −2; 1 −2 1]` cancels every linear ramp of grey,
-//! so on a smooth scene `I ∗ N` is mostly the noise; for independent noise of σ it has
-//! σ·‖N‖₂ = 6σ, and its absolute value's median is `0.6745 · 6σ` (Immerkær's estimator, with the
-//! median instead of the mean so that the scene's edges, a minority of the pixels, do not count):
-//!
-//! ```text
-//! σ̂ = median |I ∗ N| / (6 · 0.6745)   over every other pixel of every other ROI row.
-//! ```
+//! **The estimate** is Immerkær's: σ̂ = median |I ∗ N| / (6 · 0.6745), `N` the 3 × 3 mask that
+//! cancels every linear ramp of grey, over every other pixel of every other ROI row
+//! (`vision_gradient::noise_sigma_grey`, where the maths is).
 //!
 //! On the labelled stills σ̂ is 0.5–2.5 grey levels for 80 % of the frames of every set (medians
 //! 0.7–2.2); 19 of `seame`'s 90 textured floors read above 4 (up to 7.4); with σ = 8 added it
 //! reads 8.2–8.9.
 //!
 //! **The remedy.** Above `denoise.above_noise_grey` the working frame is smoothed by the 3 × 3
-//! binomial `B = [1 2 1]ᵀ[1 2 1]/16`, which keeps `Σw² = (6/16)² = 0.14` of independent noise's
-//! variance (σ × 0.375) and 3/4 of a step edge's Sobel magnitude (the smoothed central difference
-//! `[−1 −2 0 2 1]/4` sums to 3/4 either side). Giving the step its magnitude back by stretching
+//! binomial (`vision_gradient::smooth_binomial`), which keeps σ × 0.375 of independent noise and
+//! 3/4 of a step edge's Sobel magnitude. Giving the step its magnitude back by stretching
 //! the grey levels by 4/3 was measured and not kept: it pulled a dashed lane onto a road edge
 //! beside it in its gaps (the rendered `noise` scene) and gained nothing overall on the real
 //! stills (`docs/lanes/history/denoising.md`).
@@ -39,14 +33,12 @@
 //! Decisions and figures: `docs/lanes/history/denoising.md`.
 
 use serde::Serialize;
-use vision_gradient::GreyImage;
+use vision_gradient::{GreyImage, noise_sigma_grey, smooth_binomial};
 
 use super::setup::Rows;
 
 /// Frames between two measurements while a lane is tracked.
 pub(crate) const REMEASURE_EVERY_FRAMES: u32 = 30;
-/// `median |I ∗ N| = NOISE_MEDIAN_PER_SIGMA · σ` for independent Gaussian noise (`0.6745 · 6`).
-const NOISE_MEDIAN_PER_SIGMA: f64 = 0.6745 * 6.0;
 
 /// The last measurement of the frames' noise and what it does to them (`nav-app --json`'s
 /// `noise`).
@@ -75,7 +67,7 @@ pub(super) struct Denoiser {
     above_noise_grey: f64,
     last: FrameNoise,
     frames_since_measured: u32,
-    noise_hist: Vec<u32>,
+    noise_hist: [u32; 256],
     /// The vertical binomial sums of the rows written, `width` a row.
     sums: Vec<u16>,
     /// The smoothed frame, `width` a row.
@@ -95,7 +87,7 @@ impl Denoiser {
             above_noise_grey,
             last: FrameNoise::NONE,
             frames_since_measured: 0,
-            noise_hist: vec![0; 256],
+            noise_hist: [0; 256],
             sums: vec![0; n],
             pixels: vec![0; n],
         }
@@ -125,35 +117,14 @@ impl Denoiser {
         }
     }
 
-    /// σ̂ and the median grey of every other pixel of every other row of `roi` (those with a
-    /// pixel on each side), and whether to smooth.
+    /// σ̂ of `roi` (module docs), and whether to smooth.
     fn measure(&mut self, image: &GreyImage<'_>, roi: Rows) {
-        self.noise_hist.fill(0);
-        let (w, h) = (image.width(), image.height());
-        let mut n = 0usize;
-        for y in (roi.0.max(1)..roi.1.min(h.saturating_sub(1))).step_by(2) {
-            let (Some(up), Some(mid), Some(down)) =
-                (image.row(y - 1), image.row(y), image.row(y + 1))
-            else {
-                continue;
-            };
-            for x in (1..w.saturating_sub(1)).step_by(2) {
-                let p = |r: &[u8], c: usize| i32::from(r[c]);
-                let corners = p(up, x - 1) + p(up, x + 1) + p(down, x - 1) + p(down, x + 1);
-                let sides = p(up, x) + p(mid, x - 1) + p(mid, x + 1) + p(down, x);
-                let laplacian = corners - 2 * sides + 4 * p(mid, x);
-                self.noise_hist[laplacian.unsigned_abs().min(255) as usize] += 1;
-                n += 1;
-            }
-        }
-        if n == 0 {
-            self.last = FrameNoise::NONE;
-            return;
-        }
-        let sigma_grey = f64::from(median(&self.noise_hist, n)) / NOISE_MEDIAN_PER_SIGMA;
-        self.last = FrameNoise {
-            sigma_grey,
-            denoised: sigma_grey > self.above_noise_grey,
+        self.last = match noise_sigma_grey(image, roi, &mut self.noise_hist) {
+            Some(sigma_grey) => FrameNoise {
+                sigma_grey,
+                denoised: sigma_grey > self.above_noise_grey,
+            },
+            None => FrameNoise::NONE,
         };
     }
 
@@ -167,7 +138,11 @@ impl Denoiser {
         }
         let mut out = std::mem::take(&mut self.pixels);
         let rows = (rows.0.min(h), rows.1.min(h));
-        smooth(image, rows, &mut self.sums, &mut out);
+        // The buffers hold `w × h` (checked above), all any rows need.
+        if smooth_binomial(image, rows, &mut self.sums, &mut out).is_err() {
+            self.pixels = out;
+            return None;
+        }
         Some(out)
     }
 
@@ -175,60 +150,6 @@ impl Denoiser {
     pub(super) fn put_back(&mut self, pixels: Vec<u8>) {
         self.pixels = pixels;
     }
-}
-
-/// `out` = `image` smoothed by `B = [1 2 1]ᵀ[1 2 1]/16` over the rows `[top, end)`: with `S` the
-/// integer sum of the mask (clamped to the frame: its border rows and columns repeat their
-/// neighbour), `(S + 8)/16`, rounded half up, in integers (the inner columns vectorise). `sums`
-/// and `out` hold `width × height`.
-fn smooth(image: &GreyImage<'_>, (top, end): Rows, sums: &mut [u16], out: &mut [u8]) {
-    let (w, h) = (image.width(), image.height());
-    if w == 0 || h == 0 {
-        return;
-    }
-    let round = |s: i32| ((s + 8) / 16).min(255) as u8;
-    for y in top..end {
-        let (Some(up), Some(mid), Some(down)) = (
-            image.row(y.saturating_sub(1)),
-            image.row(y),
-            image.row((y + 1).min(h - 1)),
-        ) else {
-            continue;
-        };
-        let col = &mut sums[y * w..(y + 1) * w];
-        for (((s, &a), &b), &c) in col.iter_mut().zip(up).zip(mid).zip(down) {
-            *s = u16::from(a) + 2 * u16::from(b) + u16::from(c);
-        }
-        let o = &mut out[y * w..(y + 1) * w];
-        let sum3 = |l: u16, c: u16, r: u16| i32::from(l) + 2 * i32::from(c) + i32::from(r);
-        if w == 1 {
-            o[0] = round(4 * i32::from(col[0]));
-            continue;
-        }
-        o[0] = round(sum3(col[0], col[0], col[1]));
-        o[w - 1] = round(sum3(col[w - 2], col[w - 1], col[w - 1]));
-        for (((v, &l), &c), &r) in o[1..w - 1]
-            .iter_mut()
-            .zip(&col[..w - 2])
-            .zip(&col[1..w - 1])
-            .zip(&col[2..])
-        {
-            *v = round(sum3(l, c, r));
-        }
-    }
-}
-
-/// The smallest value with at least half of the `n` counted values at or below it.
-fn median(hist: &[u32], n: usize) -> u32 {
-    let k = n.div_ceil(2).max(1);
-    let mut acc = 0usize;
-    for (v, &count) in hist.iter().enumerate() {
-        acc += count as usize;
-        if acc >= k {
-            return v as u32;
-        }
-    }
-    hist.len().saturating_sub(1) as u32
 }
 
 #[cfg(test)]

@@ -36,7 +36,6 @@ mod lane;
 mod points;
 mod reach;
 mod report;
-mod resample;
 mod revalidation;
 mod road;
 mod setup;
@@ -364,7 +363,7 @@ impl LaneTracker {
         let input = GreyImage::new(data, width, height, stride_px)?;
         let new_scene = !self.lanes.iter().any(|l| l.has_estimate());
         if new_scene && self.setup.cfg.roi.road_bottom == RoadBottom::Found {
-            self.place_road(&input);
+            self.place_road(&input)?;
         }
         let (lanes, full_gradient) = self.track_view(&input, new_scene)?;
         let view = self.frame.view;
@@ -388,7 +387,7 @@ impl LaneTracker {
         Ok(if self.frame.resamples() {
             // The working frame (module `working`), in a buffer lent out of the stage for the
             // frame and put back whatever happens.
-            let pixels = self.frame.resample(input);
+            let pixels = self.frame.resample(input)?;
             let (w, h) = (self.setup.width, self.setup.height);
             let tracked = GreyImage::new(&pixels, w, h, w)
                 .map_err(TrackerError::from)
@@ -428,14 +427,14 @@ impl LaneTracker {
     /// The working rows for this frame (`roi.road_bottom = "found"`, module `road`): the road's
     /// bottom found on the square view, and the rows above it stretched over the working
     /// height; the square view's when the road reaches the frame's bottom.
-    fn place_road(&mut self, input: &GreyImage<'_>) {
+    fn place_road(&mut self, input: &GreyImage<'_>) -> Result<(), TrackerError> {
         let square = self.frame.square_view();
         self.frame.set_rows(square.rows);
         let h = self.setup.height;
         let bottom = if square.is_identity() {
             self.road.find(input, (0, input.height()))
         } else {
-            let pixels = self.frame.resample(input);
+            let pixels = self.frame.resample(input)?;
             let w = self.setup.width;
             let rows = self.frame.resampled_rows();
             let found = GreyImage::new(&pixels, w, h, w)
@@ -450,6 +449,7 @@ impl LaneTracker {
                 start_px: 0.0,
             });
         }
+        Ok(())
     }
 
     /// [`LaneTracker::track_pixels`] on the working frame: the pipeline. `true` when the whole

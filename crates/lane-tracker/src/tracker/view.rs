@@ -51,6 +51,15 @@ pub(crate) struct AxisMap {
 }
 
 impl AxisMap {
+    /// This axis as the resampling kernel takes it (`vision_gradient::AxisSpan`, the same
+    /// convention: its `centre_px` is [`Self::to_input_px`]).
+    pub(crate) fn span(self) -> vision_gradient::AxisSpan {
+        vision_gradient::AxisSpan {
+            scale: self.scale,
+            start_px: self.start_px,
+        }
+    }
+
     /// `o = start + (s − 1)/2`, px: the input coordinate of working pixel 0's centre.
     pub(crate) fn offset_px(self) -> f64 {
         self.start_px + (self.scale - 1.0) / 2.0

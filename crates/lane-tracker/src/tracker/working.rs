@@ -16,7 +16,7 @@
 //! ```
 //!
 //! the area average of that interval in both axes (down), or linear interpolation at its
-//! centre (up, at most 2×) — module `resample`; a whole `s` is the box average over `s × s`
+//! centre (up, at most 2×) — `vision_gradient::resample_rows`; a whole `s` is the box average over `s × s`
 //! blocks, computed as such. Rounding `s` to a whole number instead (as before) tracked a
 //! 512-px frame at 256 px, where the pixel settings are 25 % too wide: 11 points lost on
 //! TuSimple stills given at 512 × 288 against the same stills resized to 320 first.
@@ -44,11 +44,10 @@
 //!
 //! Decisions and figures: `docs/lanes/history/working-resolution.md`.
 
-use vision_gradient::{ColSpan, GreyImage};
+use vision_gradient::{AxisTaps, ColSpan, GradientError, GreyImage, downscale_box, resample_rows};
 
 use super::lane::Lanes;
 use super::report::{InitCandidate, LaneReport, MAX_CANDIDATE_LINES};
-use super::resample::{AxisTaps, downscale_box, resample_rows};
 use super::setup::Rows;
 use super::view::{AxisMap, WorkingView};
 
@@ -108,7 +107,7 @@ pub(super) struct WorkingFrame {
     pixels: Vec<u8>,
     /// The box average's column sums (a whole factor), else empty.
     box_sums: Vec<u32>,
-    /// The taps of both axes and a row of input-width sums (module `resample`).
+    /// The taps of both axes and a row of input-width sums (`vision_gradient::AxisTaps`).
     col_taps: AxisTaps,
     row_taps: AxisTaps,
     acc: Vec<f32>,
@@ -148,8 +147,8 @@ impl WorkingFrame {
                     0
                 }
             ],
-            col_taps: AxisTaps::new(input_size.0, size.0, square.cols, s),
-            row_taps: AxisTaps::new(input_size.1, size.1, square.rows, s),
+            col_taps: AxisTaps::new(input_size.0, size.0, square.cols.span(), s),
+            row_taps: AxisTaps::new(input_size.1, size.1, square.rows.span(), s),
             acc: vec![0.0; input_size.0],
             rows,
             out_lanes: lanes.reports().map(|r| square.report_to_input(r)),
@@ -176,16 +175,18 @@ impl WorkingFrame {
             return;
         }
         self.view.rows = rows;
-        self.row_taps.rebuild(self.input_size.1, self.size.1, rows);
+        self.row_taps
+            .rebuild(self.input_size.1, self.size.1, rows.span());
     }
 
     /// The working frame of `input` (its working rows resampled, the others as they were), in
     /// a buffer taken out of the stage (no allocation: `take` leaves an empty vector); give it
-    /// back with [`Self::put_back`].
-    pub(super) fn resample(&mut self, input: &GreyImage<'_>) -> Vec<u8> {
+    /// back with [`Self::put_back`]. A buffer the frame does not fit (the caller checks the
+    /// frame's size first, so never in practice) is an error, the buffer kept.
+    pub(super) fn resample(&mut self, input: &GreyImage<'_>) -> Result<Vec<u8>, GradientError> {
         let mut pixels = std::mem::take(&mut self.pixels);
         let width = self.size.0;
-        match self.view.whole_factor() {
+        let done = match self.view.whole_factor() {
             Some(f) => downscale_box(f, input, &mut pixels, width, self.rows, &mut self.box_sums),
             None => resample_rows(
                 input,
@@ -195,8 +196,14 @@ impl WorkingFrame {
                 self.rows,
                 &mut self.acc,
             ),
+        };
+        match done {
+            Ok(()) => Ok(pixels),
+            Err(e) => {
+                self.pixels = pixels;
+                Err(e)
+            }
         }
-        pixels
     }
 
     /// The working rows that are resampled, `[first, end)`.

@@ -298,7 +298,7 @@ pub(super) fn run_qemu(
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
-        .context("starting qemu-system-x86_64")?;
+        .context("starting qemu-system-x86_64 (Debian package qemu-system-x86)")?;
     let stdout = child.stdout.take().context("qemu stdout")?;
     let reader = std::thread::spawn(move || {
         let mut lines = Vec::new();

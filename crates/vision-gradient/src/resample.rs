@@ -1,10 +1,10 @@
-//! # Resampling by any factor (module `view`'s axes)
+//! # Resampling by any factor
 //!
-//! The working frame is the input resampled by `s` input pixels per working pixel along each
-//! axis, `s` any positive real (module `view`). Working pixel `j` of an axis stands for the
+//! The lane tracker's working frame is its input resampled by `s` input pixels per working pixel
+//! along each axis, `s` any positive real ([`AxisSpan`]; the tracker's `view` module derives its
+//! coefficient maps in the same convention). Working pixel `j` of an axis stands for the
 //! input interval `[start + s·j, start + s·(j + 1))` (input pixel `i` covering `[i, i + 1)`),
-//! centred on input coordinate `x_j = start + s·j + (s − 1)/2`, the pixel-centre convention the
-//! coefficient map of module `view` is derived in. Its value is a weighted sum of input pixels, separable:
+//! centred on input coordinate `x_j = start + s·j + (s − 1)/2`. Its value is a weighted sum of input pixels, separable:
 //!
 //! ```text
 //! I'(c, r) = Σ_i Σ_k  w_x(c, i) · w_y(r, k) · I(i, k),        Σ_i w_x(c, i) = Σ_k w_y(r, k) = 1,
@@ -20,17 +20,48 @@
 //!
 //! The taps of both axes are computed once for a frame size ([`AxisTaps::new`]), the rows' again
 //! when the road's rows change ([`AxisTaps::rebuild`], in place); a frame then costs one
-//! multiply-add per tap and pixel of the rows resampled, into caller-owned buffers. A whole
+//! multiply-add per tap and pixel of the rows resampled, into caller-owned buffers whose sizes
+//! are checked ([`GradientError::BufferTooSmall`] names the buffer). A whole
 //! factor on square pixels from the top-left is the box average, summed in integers
 //! ([`downscale_box`]).
 
-use vision_gradient::GreyImage;
+use crate::{GradientError, GreyImage};
 
-use super::view::AxisMap;
+/// One axis of a resampling: output pixel `j` stands for input `[start + s·j, start + s·(j + 1))`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisSpan {
+    /// Input pixels per output pixel, > 0.
+    pub scale: f64,
+    /// Input coordinate of output pixel 0's leading edge, px.
+    pub start_px: f64,
+}
+
+impl AxisSpan {
+    /// The input coordinate of output pixel `j`'s centre, px: `start + s·j + (s − 1)/2`.
+    pub fn centre_px(self, j: f64) -> f64 {
+        self.start_px + self.scale * j + (self.scale - 1.0) / 2.0
+    }
+}
+
+/// [`GradientError::BufferTooSmall`] unless `len ≥ required`.
+pub(crate) fn check(
+    buffer: &'static str,
+    len: usize,
+    required: usize,
+) -> Result<(), GradientError> {
+    if len < required {
+        return Err(GradientError::BufferTooSmall {
+            buffer,
+            len,
+            required,
+        });
+    }
+    Ok(())
+}
 
 /// The input pixels and weights behind each working pixel of one axis.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct AxisTaps {
+pub struct AxisTaps {
     /// `first[j]`: the first input pixel of working pixel `j`; its taps are
     /// `weights[offset[j]..offset[j + 1]]`, for input pixels `first[j]`, `first[j] + 1`, ….
     first: Vec<usize>,
@@ -42,7 +73,7 @@ impl AxisTaps {
     /// The taps of `out_len` working pixels over `in_len` input pixels under `map` (module
     /// docs), with room to be rebuilt ([`Self::rebuild`]) for maps of up to `max_scale` input
     /// pixels per working pixel without allocating.
-    pub(crate) fn new(in_len: usize, out_len: usize, map: AxisMap, max_scale: f64) -> Self {
+    pub fn new(in_len: usize, out_len: usize, map: AxisSpan, max_scale: f64) -> Self {
         let per_pixel = max_scale.max(map.scale).ceil() as usize + 2;
         let mut taps = AxisTaps {
             first: Vec::with_capacity(out_len),
@@ -55,7 +86,7 @@ impl AxisTaps {
 
     /// The taps for `map`, in the buffers there are. Input pixels outside `[0, in_len)` are
     /// never read: their weight goes to the nearest pixel inside.
-    pub(crate) fn rebuild(&mut self, in_len: usize, out_len: usize, map: AxisMap) {
+    pub fn rebuild(&mut self, in_len: usize, out_len: usize, map: AxisSpan) {
         self.first.clear();
         self.offset.clear();
         self.weights.clear();
@@ -83,7 +114,7 @@ impl AxisTaps {
                 }
                 self.first.push(first);
             } else {
-                let x = map.to_input_px(j as f64);
+                let x = map.centre_px(j as f64);
                 let t = x - x.floor();
                 let (i0, i1) = (clamp(x.floor()), clamp(x.floor() + 1.0));
                 self.weights.resize(base + i1 - i0 + 1, 0.0);
@@ -99,6 +130,16 @@ impl AxisTaps {
             }
             self.offset.push(self.weights.len());
         }
+    }
+
+    /// The number of output pixels.
+    pub fn len(&self) -> usize {
+        self.first.len()
+    }
+
+    /// Whether there are no output pixels.
+    pub fn is_empty(&self) -> bool {
+        self.first.is_empty()
     }
 
     /// The first input pixel of working pixel `j` and its weights (empty past the end).
@@ -117,16 +158,19 @@ impl AxisTaps {
 /// Resample working rows `rows = [first, end)` of `src` (`in_w × in_h`, row `k` at
 /// `src[k·stride..]`) into `dst` (`cols.len()` bytes a row, row `r` at `r · cols.len()`) by the
 /// taps of both axes, summing the input rows of each working row in `acc` (at least `in_w`
-/// entries). Rows outside `rows`, and rows the buffers are too short for, are left as they are.
-pub(crate) fn resample_rows(
+/// entries). Rows outside `rows` are left as they are; `dst` must hold `end` rows and `acc`
+/// the input's width, else [`GradientError::BufferTooSmall`] and nothing is written.
+pub fn resample_rows(
     src: &GreyImage<'_>,
     dst: &mut [u8],
     cols: &AxisTaps,
     row_taps: &AxisTaps,
     rows: (usize, usize),
     acc: &mut [f32],
-) {
+) -> Result<(), GradientError> {
     let out_w = cols.first.len();
+    check("dst", dst.len(), rows.1.saturating_mul(out_w))?;
+    check("acc", acc.len(), src.width())?;
     for r in rows.0..rows.1 {
         let (first_row, weights) = row_taps.of(r);
         acc.fill(0.0);
@@ -139,7 +183,7 @@ pub(crate) fn resample_rows(
             }
         }
         let Some(out) = dst.get_mut(r * out_w..(r + 1) * out_w) else {
-            return;
+            break;
         };
         for (c, o) in out.iter_mut().enumerate() {
             let (first_col, weights) = cols.of(c);
@@ -151,6 +195,7 @@ pub(crate) fn resample_rows(
             *o = (v + 0.5).clamp(0.0, 255.0) as u8;
         }
     }
+    Ok(())
 }
 
 /// Box-average rows `rows = [first, end)` of the working frame from `src` into `dst`
@@ -158,18 +203,20 @@ pub(crate) fn resample_rows(
 /// of each working row column by column in `sums` (at least `f · working_width` entries;
 /// `u32`), then each run of `f` sums. Rows outside `rows` are left as they are.
 ///
-/// Needs `src` at least `f·working_width` wide and `f·end` high, `dst` and `sums` large
-/// enough; the tracker sizes all of them in `LaneTracker::new` and checks the frame's size
-/// before calling. The common factors are compiled for their constant `f` (the sums of a
+/// `dst` must hold `end` rows and `sums` `f · working_width` entries, else
+/// [`GradientError::BufferTooSmall`] and nothing is written; input rows or columns
+/// past `src`'s edge count as 0 (the caller checks the frame's size). The common factors are compiled for their constant `f` (the sums of a
 /// run then vectorise).
-pub(crate) fn downscale_box(
+pub fn downscale_box(
     factor: usize,
     src: &GreyImage<'_>,
     dst: &mut [u8],
     working_width: usize,
     rows: (usize, usize),
     sums: &mut [u32],
-) {
+) -> Result<(), GradientError> {
+    check("dst", dst.len(), rows.1.saturating_mul(working_width))?;
+    check("sums", sums.len(), factor.saturating_mul(working_width))?;
     match factor {
         2 => box_rows::<2>(src, dst, working_width, rows, sums),
         3 => box_rows::<3>(src, dst, working_width, rows, sums),
@@ -178,6 +225,7 @@ pub(crate) fn downscale_box(
         6 => box_rows::<6>(src, dst, working_width, rows, sums),
         f => box_rows_any(f, src, dst, working_width, rows, sums),
     }
+    Ok(())
 }
 
 /// [`downscale_box`] for a constant factor `F` (the body inlined with `f = F`).
@@ -202,7 +250,9 @@ fn box_rows_any(
     sums: &mut [u32],
 ) {
     let area = (f * f) as u32;
-    let sums = &mut sums[..f * working_width];
+    let Some(sums) = sums.get_mut(..f * working_width) else {
+        return;
+    };
     for r in rows.0..rows.1 {
         sums.fill(0);
         for j in 0..f {
@@ -228,13 +278,12 @@ fn box_rows_any(
 mod tests {
     use super::*;
 
-    fn square(s: f64) -> AxisMap {
-        AxisMap {
+    fn square(s: f64) -> AxisSpan {
+        AxisSpan {
             scale: s,
             start_px: 0.0,
         }
     }
-    use vision_gradient::GreyImage;
 
     #[test]
     fn every_working_pixels_weights_sum_to_one_and_stay_inside_the_input() {
@@ -268,7 +317,7 @@ mod tests {
                 let t = AxisTaps::new(
                     n,
                     m,
-                    AxisMap {
+                    AxisSpan {
                         scale: s,
                         start_px: start,
                     },
@@ -349,7 +398,7 @@ mod tests {
         );
         let mut dst = vec![9u8; 320 * 180];
         let mut acc = vec![0.0f32; w];
-        resample_rows(&src, &mut dst, &cols, &rows, (100, 180), &mut acc);
+        resample_rows(&src, &mut dst, &cols, &rows, (100, 180), &mut acc).expect("buffers sized");
         assert!(dst[..100 * 320].iter().all(|&v| v == 9));
         assert!(dst[100 * 320..].iter().all(|&v| v == 137));
     }
@@ -365,7 +414,7 @@ mod tests {
         );
         let mut dst = vec![0u8; 24];
         let mut acc = vec![0.0f32; w];
-        resample_rows(&src, &mut dst, &cols, &rows, (0, 4), &mut acc);
+        resample_rows(&src, &mut dst, &cols, &rows, (0, 4), &mut acc).expect("buffers sized");
         for r in 0..4 {
             for c in 0..6 {
                 let sum: u32 = [(0, 0), (0, 1), (1, 0), (1, 1)]
@@ -392,13 +441,13 @@ mod tests {
         ];
         let src = GreyImage::new(&input, 6, 4, 6).expect("image");
         let (mut dst, mut acc) = (vec![9u8; 6], vec![0u32; 6]);
-        downscale_box(2, &src, &mut dst, 3, (0, 2), &mut acc);
+        downscale_box(2, &src, &mut dst, 3, (0, 2), &mut acc).expect("buffers sized");
         // (0+1+1+1)/4 = 0.75 → 1; 41/4 = 10.25 → 10; 1019/4 = 254.75 → 255;
         // 29/4 = 7.25 → 7; 1/4 → 0; 100/4 = 25.
         assert_eq!(dst, vec![1, 10, 255, 7, 0, 25]);
         // Only the rows asked for are written.
         let mut dst = vec![9u8; 6];
-        downscale_box(2, &src, &mut dst, 3, (1, 2), &mut acc);
+        downscale_box(2, &src, &mut dst, 3, (1, 2), &mut acc).expect("buffers sized");
         assert_eq!(dst, vec![9, 9, 9, 7, 0, 25]);
     }
 
@@ -414,7 +463,7 @@ mod tests {
         for f in 2..=9 {
             let (ww, wh) = (w / f, h / f);
             let (mut dst, mut sums) = (vec![0u8; ww * wh], vec![0u32; w]);
-            downscale_box(f, &src, &mut dst, ww, (0, wh), &mut sums);
+            downscale_box(f, &src, &mut dst, ww, (0, wh), &mut sums).expect("buffers sized");
             for r in 0..wh {
                 for c in 0..ww {
                     let mut sum = 0u32;
@@ -431,5 +480,43 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_buffer_too_small_is_a_named_error_and_nothing_is_written() {
+        let (w, h) = (64usize, 36usize);
+        let input = vec![200u8; w * h];
+        let src = GreyImage::new(&input, w, h, w).expect("image");
+        let (cols, rows) = (
+            AxisTaps::new(w, 32, square(2.0), 2.0),
+            AxisTaps::new(h, 18, square(2.0), 2.0),
+        );
+        let mut short = vec![7u8; 32 * 17];
+        let mut acc = vec![0.0f32; w];
+        assert_eq!(
+            resample_rows(&src, &mut short, &cols, &rows, (0, 18), &mut acc),
+            Err(GradientError::BufferTooSmall {
+                buffer: "dst",
+                len: 32 * 17,
+                required: 32 * 18
+            })
+        );
+        assert!(short.iter().all(|&v| v == 7));
+        let mut dst = vec![7u8; 32 * 18];
+        let mut sums = vec![0u32; 63];
+        assert_eq!(
+            downscale_box(2, &src, &mut dst, 32, (0, 18), &mut sums),
+            Err(GradientError::BufferTooSmall {
+                buffer: "sums",
+                len: 63,
+                required: 64
+            })
+        );
+        assert!(dst.iter().all(|&v| v == 7));
+        let mut acc_short = vec![0.0f32; w - 1];
+        assert!(matches!(
+            resample_rows(&src, &mut dst, &cols, &rows, (0, 18), &mut acc_short),
+            Err(GradientError::BufferTooSmall { buffer: "acc", .. })
+        ));
     }
 }

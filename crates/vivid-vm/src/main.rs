@@ -1,4 +1,7 @@
-//! `cargo xtask vivid`: prove the capture path against a real kernel V4L2 driver.
+//! `vivid-vm`: prove the capture path against a real kernel V4L2 driver.
+//!
+//! Run it as `cargo xtask vivid [ARGS]` (a gate step; it installs the host packages first and
+//! then runs `cargo run -p vivid-vm -- ARGS`), or directly with `cargo run -p vivid-vm -- ARGS`.
 //!
 //! The host kernel cannot load modules, so this boots Debian's own kernel under qemu (TCG) with
 //! an initramfs holding busybox, the media modules, the `vivid` test driver and a statically
@@ -8,9 +11,8 @@
 //! Steps (everything cached under `target/vivid/`, nothing committed):
 //!
 //! 1. Host packages: `qemu-system-x86`, `busybox-static`, `libclang-dev` (the `v4l` crate's
-//!    bindgen needs libclang). Missing ones are installed with apt-get when running as root
-//!    (fresh machine), or in CI (`CI` set) through passwordless `sudo`; otherwise the command
-//!    stops and says what to install.
+//!    bindgen needs libclang). `cargo xtask vivid` installs missing ones with apt-get when
+//!    running as root (fresh machine), or in CI (`CI` set) through passwordless `sudo`.
 //! 2. Guest program: the real `nav-app` (lane tracker with its `capture` feature), built
 //!    with `-C target-feature=+crt-static` for `x86_64-unknown-linux-gnu` in the cargo profile
 //!    `vivid-guest` (release settings at opt-level 1: the guest tracks 60-frame streams, so build
@@ -43,11 +45,15 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail, ensure};
 use serde_json::Value;
 
-use crate::paths::{target_dir, workspace_root};
+use clap::Parser;
 
-/// Options of `cargo xtask vivid`.
-#[derive(clap::Args, Debug)]
-pub struct VividArgs {
+/// Options of `vivid-vm` (and `cargo xtask vivid`).
+#[derive(Parser, Debug)]
+#[command(
+    name = "vivid-vm",
+    about = "Boot Debian's kernel under qemu with the vivid V4L2 driver and run nav-app's capture cases."
+)]
+struct VividArgs {
     /// Static nav-app binary to test instead of building it.
     #[arg(long)]
     guest_bin: Option<PathBuf>,
@@ -60,18 +66,6 @@ pub struct VividArgs {
     /// Print the whole serial log, not just the verdict.
     #[arg(long)]
     verbose: bool,
-}
-
-impl Default for VividArgs {
-    /// What `cargo xtask vivid` without flags does (for calling [`run`] from the test gate).
-    fn default() -> Self {
-        Self {
-            guest_bin: None,
-            timeout_secs: 240,
-            cases: Vec::new(),
-            verbose: false,
-        }
-    }
 }
 
 /// Modules to insert, in dependency order (vivid last, with its parameters).
@@ -101,17 +95,31 @@ mod tests;
 use cases::*;
 use guest::*;
 use host::*;
-pub use host::{ensure_host_packages, ensure_test_packages};
 use judge::*;
 
-/// Run `cargo xtask vivid`.
-pub fn run(args: VividArgs) -> Result<()> {
+/// The workspace root: two levels above this crate's manifest directory.
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .nth(2)
+        .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+}
+
+/// Cargo's target directory: `CARGO_TARGET_DIR`, or `target/` in the workspace root.
+fn target_dir(root: &Path) -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from)
+}
+
+fn main() -> Result<()> {
+    run(VividArgs::parse())
+}
+
+/// Build the guest, boot the VM, judge the cases.
+fn run(args: VividArgs) -> Result<()> {
     let started = Instant::now();
     let root = workspace_root();
     let work = target_dir(&root).join("vivid");
     std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;
-
-    ensure_host_packages(&["qemu-system-x86", "busybox-static", "libclang-dev"])?;
 
     let guest = match &args.guest_bin {
         Some(p) => p.clone(),
