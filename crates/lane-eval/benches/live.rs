@@ -17,7 +17,15 @@
 //!   channels and reading on its own thread (its reading, and the server's client thread, run
 //!   beside the tracker on the same machine).
 //!
-//! `cargo bench -p lane-eval --bench live -- --warm-up-time 2 --measurement-time 10`
+//! Unpaced, the loop hands the encoder and the client frames at thousands a second (about 1 GB/s
+//! of images), so on a machine with few cores they take the tracker's core from it. A camera
+//! gives 25–30: the `paced_…` cases hand the clip's first [`PACED_FRAMES`] frames at its own rate
+//! (25 frames/s) and criterion's time is then `LaneTracker::track`'s own per frame, with no
+//! server and with one client reading:
+//! - `paced_no_server`, `paced_one_client`.
+//!
+//! `cargo bench -p lane-eval --bench live -- --warm-up-time 2 --measurement-time 10` (the paced
+//! cases take about 1 s an iteration: criterion runs its 20 samples whatever the time asked).
 //!
 //! Without the clip under the data root (`lane_bench::data`), it says so and measures nothing.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -66,19 +74,30 @@ struct Live {
     encode: EncodeThread,
 }
 
-/// One pass over the clip as nav-app's frame loop does it; returns the time spent, and adds the
-/// time spent in `LaneTracker::track` to `track_time`.
+/// The paced cases' frames: one second of the clip at its rate.
+const PACED_FRAMES: usize = 25;
+/// The clip's frame period (25 frames/s).
+const FRAME_PERIOD: Duration = Duration::from_millis(40);
+
+/// One pass over the clip as nav-app's frame loop does it, each frame handed `pace` after the
+/// last when paced; returns the time spent, and adds the time spent in `LaneTracker::track` to
+/// `track_time`.
 fn pass(
     cfg: &TrackerConfig,
     frames: &[GreyFrame],
     mut live: Option<&mut Live>,
     json: &mut Vec<u8>,
     track_time: &mut Duration,
+    pace: Option<Duration>,
 ) -> Duration {
     let (w, h) = (frames[0].width(), frames[0].height());
     let mut tracker = LaneTracker::new(cfg, Estimator::Kif, w, h).unwrap();
     let start = Instant::now();
     for (k, frame) in frames.iter().enumerate() {
+        if let Some(period) = pace {
+            let due = start + period * u32::try_from(k).unwrap();
+            std::thread::sleep(due.saturating_duration_since(Instant::now()));
+        }
         let t0 = Instant::now();
         let report = tracker.track(black_box(frame)).unwrap();
         let dt = t0.elapsed();
@@ -157,7 +176,6 @@ fn live(c: &mut Criterion) {
         return;
     };
     let cfg = TrackerConfig::default_preset().unwrap();
-    let n = u32::try_from(frames.len()).unwrap();
     let mut json = Vec::new();
     let mut group = c.benchmark_group("live");
     group.sample_size(20);
@@ -177,10 +195,23 @@ fn live(c: &mut Criterion) {
             encode,
         }
     };
-    for case in ["no_server", "server_no_client", "server_one_client"] {
-        let mut server = (case != "no_server").then(start_server);
+    for case in [
+        "no_server",
+        "server_no_client",
+        "server_one_client",
+        "paced_no_server",
+        "paced_one_client",
+    ] {
+        let paced = case.starts_with("paced");
+        let clip = if paced {
+            &frames[..PACED_FRAMES.min(frames.len())]
+        } else {
+            &frames[..]
+        };
+        let n = u32::try_from(clip.len()).unwrap();
+        let mut server = (!case.ends_with("no_server")).then(start_server);
         let stop = Arc::new(AtomicBool::new(false));
-        let client = (case == "server_one_client").then(|| {
+        let client = case.ends_with("one_client").then(|| {
             let l = server.as_ref().unwrap();
             let handle = reading_client(&l.server, Arc::clone(&stop));
             let end = Instant::now() + Duration::from_secs(10);
@@ -195,7 +226,18 @@ fn live(c: &mut Criterion) {
             b.iter_custom(|iters| {
                 let mut total = Duration::ZERO;
                 for _ in 0..iters {
-                    total += pass(&cfg, &frames, server.as_mut(), &mut json, &mut track_time);
+                    let before = track_time;
+                    let pace = paced.then_some(FRAME_PERIOD);
+                    let spent = pass(
+                        &cfg,
+                        clip,
+                        server.as_mut(),
+                        &mut json,
+                        &mut track_time,
+                        pace,
+                    );
+                    // Paced, the tracker's own time (the rest is waiting for the next frame).
+                    total += if paced { track_time - before } else { spent };
                     tracked += u64::from(n);
                 }
                 // Criterion divides by `iters`: the time it reports is per frame.
