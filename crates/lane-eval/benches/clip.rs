@@ -26,30 +26,10 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use lane_io::FrameSource;
-use lane_io::y4m::Y4mSource;
-use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
+mod common;
 
-/// The clip's frames, or `None` (said on stderr) when it is missing.
-fn udacity_clip() -> Option<Vec<GreyFrame>> {
-    let path = match lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP) {
-        Ok(path) => path,
-        Err(e) => {
-            eprintln!("SKIPPED: the clip bench needs the real udacity clip: {e}");
-            return None;
-        }
-    };
-    let file = std::fs::File::open(&path).expect("the clip opens");
-    let mut src = Y4mSource::new(std::io::BufReader::new(file), path.display().to_string())
-        .expect("a y4m stream");
-    let mut frames = Vec::new();
-    let mut frame = GreyFrame::default();
-    while src.next_frame(&mut frame).expect("a frame").is_some() {
-        frames.push(frame.clone());
-    }
-    Some(frames)
-}
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use lane_tracker::{Estimator, GreyFrame, LaneTracker, TrackerConfig};
 
 /// Tracks `frames` with a fresh tracker, each frame timed: the per-frame times and the
 /// re-validations counted.
@@ -87,7 +67,7 @@ fn print_per_frame(case: &str, cfg: &TrackerConfig, frames: &[GreyFrame]) {
 }
 
 fn clip(c: &mut Criterion) {
-    let Some(frames) = udacity_clip() else {
+    let Some(frames) = common::udacity_clip("clip") else {
         return;
     };
     let default = TrackerConfig::default_preset().unwrap();

@@ -36,36 +36,16 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+mod common;
+
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use foxglove_live::{ChannelId, LiveConfig, LiveServer};
-use lane_io::FrameSource;
 use lane_io::encode_thread::EncodeThread;
 use lane_io::lane_frame::LaneFrame;
 use lane_io::mcap_sink::{frame_t_ns, lane_channels};
-use lane_io::y4m::Y4mSource;
 use lane_tracker::{Estimator, GreyFrame, LaneTracker, Side, TrackerConfig};
 use tungstenite::Message;
 use tungstenite::client::IntoClientRequest;
-
-/// The clip's frames, or `None` (said on stderr) when it is missing.
-fn udacity_clip() -> Option<Vec<GreyFrame>> {
-    let path = match lane_bench::data::data_file(lane_bench::data::UDACITY_CLIP) {
-        Ok(path) => path,
-        Err(e) => {
-            eprintln!("SKIPPED: the live bench needs the real udacity clip: {e}");
-            return None;
-        }
-    };
-    let file = std::fs::File::open(&path).expect("the clip opens");
-    let mut src = Y4mSource::new(std::io::BufReader::new(file), path.display().to_string())
-        .expect("a y4m stream");
-    let mut frames = Vec::new();
-    let mut frame = GreyFrame::default();
-    while src.next_frame(&mut frame).expect("a frame").is_some() {
-        frames.push(frame.clone());
-    }
-    Some(frames)
-}
 
 /// The server, its three channels (image, annotations, lanes) and the encoder thread.
 struct Live {
@@ -172,7 +152,7 @@ fn reading_client(server: &LiveServer, stop: Arc<AtomicBool>) -> std::thread::Jo
 }
 
 fn live(c: &mut Criterion) {
-    let Some(frames) = udacity_clip() else {
+    let Some(frames) = common::udacity_clip("live") else {
         return;
     };
     let cfg = TrackerConfig::default_preset().unwrap();
