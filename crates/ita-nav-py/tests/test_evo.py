@@ -14,8 +14,9 @@ import subprocess
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parents[3]
-DATA = pathlib.Path(os.environ.get("ITA_NAV_DATA", ROOT.parent / "shared" / "data"))
+from nav_paths import DATA, data_file, exe
+
+
 
 # The replay recipes of the shared logs (ins_sim::real_sets::REAL_SETS): start, alignment, and
 # the landmarks' placement.
@@ -23,13 +24,6 @@ REAL_SETS = {
     "euroc_mh01": dict(start_s=21.0, align_s=20.0, ranges=(5.0, 20.0), landmarks=12, max_range=40.0),
     "rtkexp_drive0708": dict(start_s=None, align_s=30.0, ranges=(30.0, 200.0), landmarks=60, max_range=500.0),
 }
-
-
-def exe():
-    e = os.environ.get("NAV_APP_BIN")
-    if not e:
-        pytest.fail("NAV_APP_BIN is not set (cargo xtask test sets it to the nav-app binary)")
-    return e
 
 
 def evo_ape():
@@ -104,12 +98,7 @@ def test_evo_ape_gives_nav_apps_position_rms_on_a_small_log(tmp_path):
 @pytest.mark.parametrize("name", sorted(REAL_SETS))
 def test_evo_ape_gives_nav_apps_position_rms_on_the_shared_logs_kf_runs(name, tmp_path):
     d = DATA / "ins" / name
-    imu, truth = d / "imu.csv", d / "truth.csv"
-    if not (imu.is_file() and truth.is_file()):
-        msg = f"no {imu} / {truth} (the shared real IMU logs)"
-        if os.environ.get("CI") == "true":
-            pytest.fail(msg)
-        pytest.skip(msg)
+    imu, truth = data_file(d / "imu.csv"), data_file(d / "truth.csv")
     r = REAL_SETS[name]
     s, lm = make_sightings(truth, tmp_path, landmarks=r["landmarks"], ranges=r["ranges"],
                            max_range=r["max_range"], seed=7)

@@ -10,7 +10,6 @@ Loopback only; each test picks a free port.
 import base64
 import json
 import math
-import os
 import pathlib
 import signal
 import socket
@@ -20,30 +19,13 @@ import threading
 import time
 
 import pytest
+
 import websockets
 from websockets.sync.client import connect
 
-ROOT = pathlib.Path(__file__).resolve().parents[3]
-DATA = pathlib.Path(os.environ.get("ITA_NAV_DATA", ROOT.parent / "shared" / "data"))
-SAMPLE = DATA / "udacity" / "solidWhiteRight-320x240-gray.y4m"
+from nav_paths import DATA, SAMPLE, data_file, exe
+
 TOPICS = ("/lanes", "/camera/image", "/camera/lanes")
-
-
-def exe():
-    e = os.environ.get("NAV_APP_BIN")
-    if not e:
-        pytest.fail("NAV_APP_BIN is not set (cargo xtask test sets it to the nav-app binary)")
-    return e
-
-
-def data_file(path):
-    """`path`, or a skip (a failure under CI=true) naming it when the shared data is missing."""
-    if not path.is_file():
-        msg = f"no {path} (the shared data)"
-        if os.environ.get("CI") == "true":
-            pytest.fail(msg)
-        pytest.skip(msg)
-    return path
 
 
 def free_port():
@@ -157,30 +139,51 @@ def stalled_client(port, topics):
     return s, frame
 
 
-def run_with_clients(port, stalled):
-    """nav-app on the clip with --json --foxglove --wait-client, one reading client (and a stalled
-    one); the stdout lines, the summary and what the reading client received."""
-    args = [exe(), "--input", str(data_file(SAMPLE)), "--json", "--foxglove", f"127.0.0.1:{port}", "--wait-client"]
+def serve_and_read(args, port, topics, timeout_s, before_subscribe=None, after_subscribe=None):
+    """Run nav-app `args` (serving on `port` with --wait-client), connect one reading client,
+    call `before_subscribe`, subscribe the reader to `topics`, call `after_subscribe`, wait for
+    the run to end and the server to close the connection; nav-app's exit must be 0. Returns its
+    stdout, its stderr and the reader."""
     proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
         with ws_connect(port) as ws:
-            raw = stalled_client(port, TOPICS) if stalled else None
-            op, sub_topics = subscribe_op(channels_of(ws, TOPICS), TOPICS)
+            if before_subscribe is not None:
+                before_subscribe()
+            op, sub_topics = subscribe_op(channels_of(ws, topics), topics)
             reader = Reader(ws, sub_topics)
             ws.send(op)
             reader.start()
-            if raw is not None:
-                raw[0].sendall(raw[1])
-            out, err = proc.communicate(timeout=300)
-            reader.join(timeout=60)
+            if after_subscribe is not None:
+                after_subscribe()
+            out, err = proc.communicate(timeout=timeout_s)
+            reader.join(timeout=timeout_s / 5)
             assert not reader.is_alive(), "the server did not close the connection"
     finally:
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == 0, err.decode()
+    return out, err, reader
+
+
+def run_with_clients(port, stalled):
+    """nav-app on the clip with --json --foxglove --wait-client, one reading client (and a stalled
+    one); the stdout lines, the summary and what the reading client received."""
+    args = [exe(), "--input", str(data_file(SAMPLE)), "--json", "--foxglove", f"127.0.0.1:{port}", "--wait-client"]
+    raw = []
+
+    def connect_stalled():
+        if stalled:
+            raw.extend(stalled_client(port, TOPICS))
+
+    def subscribe_stalled():
+        if raw:
+            raw[0].sendall(raw[1])
+
+    out, err, reader = serve_and_read(args, port, TOPICS, timeout_s=300,
+                                      before_subscribe=connect_stalled, after_subscribe=subscribe_stalled)
     lines = out.decode().splitlines()
     summary = json.loads(lines[-1])["summary"]
-    if raw is not None:
+    if raw:
         raw[0].close()
     return lines[:-1], summary, reader
 
@@ -307,24 +310,11 @@ def test_ins_solution_rows_reach_the_client_equal_to_the_csv(tmp_path):
                     "--make-landmarks", "60", "--landmark-range-m", "30", "200", "--max-range-m", "500",
                     "--seed", "7", "--out", str(s)], check=True, capture_output=True)
     port = free_port()
-    proc = subprocess.Popen([exe(), "ins", "--imu", str(imu), "--truth", str(truth), "--sightings", str(s),
-                             "--landmarks", str(lm), "--filter", "kf", "--align-s", "30", "--out", str(sol),
-                             "--foxglove", f"127.0.0.1:{port}", "--wait-client"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    args = [exe(), "ins", "--imu", str(imu), "--truth", str(truth), "--sightings", str(s),
+            "--landmarks", str(lm), "--filter", "kf", "--align-s", "30", "--out", str(sol),
+            "--foxglove", f"127.0.0.1:{port}", "--wait-client"]
     topics = ("/ins/solution", "/ins/fix", "/ins/epochs", "/ins/errors")
-    try:
-        with ws_connect(port) as ws:
-            op, sub_topics = subscribe_op(channels_of(ws, topics), topics)
-            reader = Reader(ws, sub_topics)
-            ws.send(op)
-            reader.start()
-            out, err = proc.communicate(timeout=600)
-            reader.join(timeout=120)
-            assert not reader.is_alive(), "the server did not close the connection"
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == 0, err.decode()
+    _, err, reader = serve_and_read(args, port, topics, timeout_s=600)
     assert b"0 dropped" in err, err.decode()
     header, *rows = sol.read_text().splitlines()
     cols = header.split(",")

@@ -8,7 +8,6 @@ the --mcap-out file read back with Python's mcap reader, its JSON schemas valida
 import io
 import json
 import os
-import pathlib
 import pty
 import select
 import subprocess
@@ -17,12 +16,12 @@ import tempfile
 import jsonschema
 import numpy as np
 import pytest
+
 from mcap.reader import make_reader
 from mcap_ros2.writer import Writer as Ros2Writer
 
-ROOT = pathlib.Path(__file__).resolve().parents[3]
-DATA = pathlib.Path(os.environ.get("ITA_NAV_DATA", ROOT.parent / "shared" / "data"))
-SAMPLE = DATA / "udacity" / "solidWhiteRight-320x240-gray.y4m"
+from nav_paths import SAMPLE, exe
+
 
 IMAGE_MSG = """std_msgs/Header header
 uint32 height
@@ -78,13 +77,6 @@ MSG: geometry_msgs/Vector3
 float64 x
 float64 y
 float64 z"""
-
-
-def exe():
-    e = os.environ.get("NAV_APP_BIN")
-    if not e:
-        pytest.fail("NAV_APP_BIN is not set (cargo xtask test sets it to the nav-app binary)")
-    return e
 
 
 def read_y4m(path):
