@@ -109,7 +109,13 @@ fn pass(
                 l.server.publish(l.channels[2], t_ns, json);
             }
             if wants[0] || wants[1] {
-                l.encode.offer(t_ns, frame, &report, [wants[0], wants[1]]);
+                l.encode.offer(
+                    t_ns,
+                    frame,
+                    &report,
+                    None,
+                    [wants[0], wants[1], false, false],
+                );
             }
         }
     }
@@ -165,7 +171,7 @@ fn live(c: &mut Criterion) {
             .map(|(topic, name, schema)| server.add_channel(topic, name, &schema).unwrap());
         let server = Arc::new(server);
         let publisher = Arc::clone(&server);
-        let encode = EncodeThread::start(move |k, t_ns, json: &[u8]| {
+        let encode = EncodeThread::start(None, move |k, t_ns, json: &[u8]| {
             publisher.publish(channels[k], t_ns, json);
         })
         .unwrap();

@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("frame {last}: truth {truth:?}\nestimate {ego:?}");
     let (mut cam_rgb, mut bird_rgb) = (Vec::new(), Vec::new());
     render_overlay(&frame, &tracker, &mut cam_rgb);
-    view.render(&frame, &tracker, &report, ego, &mut bird_rgb);
+    view.render(&frame, &report, ego, &mut bird_rgb);
     let (bw, bh) = (view.width_px(), view.height_px());
     let (w, h) = (320 + bw, bh.max(240));
     let mut img = vec![0u8; w * h * 3];

@@ -5,13 +5,14 @@
 //! The view covers `X ∈ [0, 2·far]` forward (up the picture) and `Y ∈ [−far, far]` across
 //! (right is right), `far` the camera file's `lookahead.far_m`, at 320×320 px. Grey:
 //! the camera frame where the ground is visible, dark blue elsewhere. Red / blue dots: the left
-//! and right tracked parabolas mapped to the ground, row by row over the tracker's ROI. Green:
+//! and right lanes as reported, mapped to the ground row by row over the rows each is seen on
+//! (`LaneReport::rows`, the far segment above its join). Green:
 //! the ego-lane model (centre line dashed, the two marks solid) over the look-ahead range,
 //! from `lateral_offset_m`, `heading_rad`, `curvature_per_m` and `lane_width_m`. Yellow ticks:
 //! the look-ahead range's ends. The camera is at the bottom centre.
 
 use lane_tracker::camera::{CameraModel, EgoLaneReport};
-use lane_tracker::{GreyFrame, LaneTracker, TrackReport};
+use lane_tracker::{GreyFrame, TrackReport};
 
 use crate::LaneIoError;
 
@@ -100,11 +101,10 @@ impl BirdseyeView {
     }
 
     /// Draw the view of `frame` with the tracker's lanes (`report`) and the ego lane into `rgb`
-    /// (resized to `width_px·height_px·3`).
+    /// (resized to `width_px·height_px·3`, RGB, rows from the top).
     pub fn render(
         &self,
         frame: &GreyFrame,
-        tracker: &LaneTracker,
         report: &TrackReport,
         ego: Option<EgoLaneReport>,
         rgb: &mut Vec<u8>,
@@ -148,10 +148,11 @@ impl BirdseyeView {
             }
         }
         let hom = self.camera.homography();
-        let (top, bottom) = tracker.roi_rows();
+        let last_row = frame.height().saturating_sub(1) as f64;
         for (k, lane) in report.lanes.iter().enumerate() {
-            for row in top..bottom {
-                let Some(u) = lane.col_at_row(row as f64) else {
+            let [top, bottom] = lane.rows.map(|r| r.clamp(0.0, last_row));
+            for row in top.ceil() as usize..=bottom.floor() as usize {
+                let Some(u) = lane.col_seen_at_row(row as f64) else {
                     break;
                 };
                 if let Ok([x, y]) = hom.image_to_ground([u, row as f64]) {
@@ -165,5 +166,81 @@ impl BirdseyeView {
                 put(Some((c, SIZE_PX - 4 + d)), RANGE_RGB);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lane_tracker::{LaneReport, LaneState, RoadReport, Side};
+
+    /// A straight mark on the floor at `Y = −0.2 m` is a straight line in the image; the lane
+    /// reported along that line is drawn back on `Y = −0.2 m` in the view, over the rows it was
+    /// reported on (from the look-ahead's far end to its near end), and a lost lane not at all.
+    #[test]
+    fn a_lane_along_a_floor_line_is_drawn_back_on_that_line_over_its_rows() {
+        let camera = crate::config::load_camera_config("robot")
+            .unwrap()
+            .model()
+            .unwrap();
+        let view = BirdseyeView::for_camera(&camera).unwrap();
+        let hom = camera.homography();
+        let la = camera.config().lookahead;
+        let y_m = -0.2;
+        let [u_near, v_near] = hom.ground_to_image([la.near_m, y_m]).unwrap();
+        let [u_far, v_far] = hom.ground_to_image([la.far_m, y_m]).unwrap();
+        let a2 = (u_far - u_near) / (v_far - v_near);
+        let left = LaneReport {
+            side: Side::Left,
+            state: LaneState::Tracking,
+            coeffs: Some([0.0, a2, u_near - a2 * v_near]),
+            rows: [v_far, v_near],
+            points: 10,
+            initialised: false,
+            far: None,
+        };
+        let right = LaneReport {
+            side: Side::Right,
+            state: LaneState::Lost,
+            coeffs: None,
+            ..left
+        };
+        let report = TrackReport {
+            lanes: [left, right],
+            full_gradient: false,
+            road: RoadReport {
+                bottom_row_px: 240.0,
+                search_rows_px: [150.0, 240.0],
+                horizon_row_px: None,
+                refused: None,
+            },
+        };
+        let [w, h] = camera.config().image_size_px;
+        let frame = GreyFrame::from_vec(w, h, vec![128; w * h]).unwrap();
+        let mut rgb = Vec::new();
+        view.render(&frame, &report, None, &mut rgb);
+        assert_eq!(rgb.len(), view.width_px() * view.height_px() * 3);
+        let coloured = |colour: [u8; 3]| -> Vec<(usize, usize)> {
+            rgb.chunks_exact(3)
+                .enumerate()
+                .filter(|(_, px)| *px == colour)
+                .map(|(i, _)| (i % SIZE_PX, i / SIZE_PX))
+                .collect()
+        };
+        let drawn = coloured(LANE_RGB[0]);
+        assert!(drawn.len() > 20, "{} pixels drawn", drawn.len());
+        let (col, row_far) = view.to_view(la.far_m, y_m).unwrap();
+        let (_, row_near) = view.to_view(la.near_m, y_m).unwrap();
+        for &(c, _) in &drawn {
+            assert!(c.abs_diff(col) <= 1, "column {c}, the line's {col}");
+        }
+        let rows = drawn.iter().map(|p| p.1);
+        let (top, bottom) = (rows.clone().min().unwrap(), rows.max().unwrap());
+        assert!(top.abs_diff(row_far) <= 3, "top {top}, far end {row_far}");
+        assert!(
+            bottom.abs_diff(row_near) <= 3,
+            "bottom {bottom}, near end {row_near}"
+        );
+        assert!(coloured(LANE_RGB[1]).is_empty());
     }
 }

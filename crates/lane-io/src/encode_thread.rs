@@ -1,8 +1,9 @@
-//! The lane channels' image and annotations encoded off the tracker's thread (`nav-app
-//! --foxglove` without `--mcap-out`): the tracker's thread copies the grey frame into a buffer of
-//! a small pool and hands it over with the frame's `Copy` [`TrackReport`]; this thread encodes
-//! them with [`LaneEncoder`] (the bytes the MCAP file would get) and gives them to a publish
-//! callback (the live server). No allocation per frame once the pool is full; when every buffer
+//! The lane channels' image, annotations and bird's-eye view encoded off the tracker's thread
+//! (`nav-app --foxglove` without `--mcap-out`): the tracker's thread copies the grey frame into a
+//! buffer of a small pool and hands it over with the frame's `Copy` [`TrackReport`] and ego lane;
+//! this thread renders the bird's-eye view (when it was given one) and encodes them with
+//! [`LaneEncoder`] (the bytes the MCAP file would get) and gives them to a publish callback (the
+//! live server). No allocation per frame once the pool is full; when every buffer
 //! is busy (the encoder cannot keep up) the frame is not sent and counted.
 
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
@@ -10,24 +11,22 @@ use std::thread::JoinHandle;
 
 use grey_frame::GreyFrame;
 use lane_tracker::TrackReport;
+use lane_tracker::camera::EgoLaneReport;
 
 use crate::LaneIoError;
-use crate::mcap_sink::LaneEncoder;
+use crate::birdseye::BirdseyeView;
+use crate::mcap_sink::{ANNOTATIONS, BIRDSEYE, IMAGE, LaneEncoder};
 
 /// Frames that may wait for, or be in, the encoder at once.
 const POOL_FRAMES: usize = 4;
-
-/// Index of the image channel for the publish callback (as in [`crate::mcap_sink::lane_channels`]).
-pub const IMAGE: usize = 0;
-/// Index of the annotations channel for the publish callback.
-pub const ANNOTATIONS: usize = 1;
 
 struct Job {
     t_ns: u64,
     frame: GreyFrame,
     report: TrackReport,
-    /// Image, annotations.
-    wants: [bool; 2],
+    ego: Option<EgoLaneReport>,
+    /// Indexed as the lane channels (`mcap_sink::IMAGE` …); the lanes' own entry is not read.
+    wants: [bool; 4],
 }
 
 /// The encoder thread and its buffer pool.
@@ -49,11 +48,12 @@ impl std::fmt::Debug for EncodeThread {
 
 impl EncodeThread {
     /// Starts the thread; `publish(channel, t_ns, json)` receives each encoded message
-    /// (`channel` [`IMAGE`] or [`ANNOTATIONS`]).
+    /// (`channel` `mcap_sink::IMAGE`, `ANNOTATIONS` or, with a bird's-eye `view`, `BIRDSEYE`).
     ///
     /// # Errors
     /// [`LaneIoError::Io`] when the thread cannot be started.
     pub fn start(
+        view: Option<BirdseyeView>,
         mut publish: impl FnMut(usize, u64, &[u8]) + Send + 'static,
     ) -> Result<Self, LaneIoError> {
         let (jobs, job_rx) = sync_channel::<Job>(POOL_FRAMES);
@@ -62,17 +62,24 @@ impl EncodeThread {
             .name("lane-encode".into())
             .spawn(move || {
                 let mut encoder = LaneEncoder::default();
+                let mut rgb = Vec::new();
                 for job in job_rx {
                     let (w, h) = (job.frame.width(), job.frame.height());
-                    if job.wants[0] && encoder.encode_image(job.t_ns, &job.frame).is_ok() {
+                    if job.wants[IMAGE] && encoder.encode_image(job.t_ns, &job.frame).is_ok() {
                         publish(IMAGE, job.t_ns, encoder.image_json());
                     }
-                    if job.wants[1]
+                    if job.wants[ANNOTATIONS]
                         && encoder
                             .encode_annotations(job.t_ns, w, h, &job.report)
                             .is_ok()
                     {
                         publish(ANNOTATIONS, job.t_ns, encoder.annotations_json());
+                    }
+                    if let Some(view) = view.as_ref().filter(|_| job.wants[BIRDSEYE]) {
+                        view.render(&job.frame, &job.report, job.ego, &mut rgb);
+                        if encoder.encode_birdseye(job.t_ns, view, &rgb).is_ok() {
+                            publish(BIRDSEYE, job.t_ns, encoder.birdseye_json());
+                        }
                     }
                     let _ = free_tx.try_send(job.frame);
                 }
@@ -90,14 +97,16 @@ impl EncodeThread {
         })
     }
 
-    /// Hands `frame` and `report` at `t_ns` to the thread for the channels `wants` (image,
-    /// annotations); false when every buffer is busy (the messages are counted as dropped).
+    /// Hands `frame`, `report` and `ego` at `t_ns` to the thread for the channels `wants`
+    /// (indexed as the lane channels; image, annotations and bird's-eye view are read); false
+    /// when every buffer is busy (the messages are counted as dropped).
     pub fn offer(
         &mut self,
         t_ns: u64,
         frame: &GreyFrame,
         report: &TrackReport,
-        wants: [bool; 2],
+        ego: Option<EgoLaneReport>,
+        wants: [bool; 4],
     ) -> bool {
         let buffer = match self.free.try_recv() {
             Ok(b) => Some(b),
@@ -107,7 +116,10 @@ impl EncodeThread {
             }
             Err(_) => None,
         };
-        let messages = wants.iter().filter(|&&w| w).count() as u64;
+        let messages = [IMAGE, ANNOTATIONS, BIRDSEYE]
+            .iter()
+            .filter(|&&k| wants[k])
+            .count() as u64;
         let Some(mut buffer) = buffer else {
             self.dropped += messages;
             return false;
@@ -121,6 +133,7 @@ impl EncodeThread {
             t_ns,
             frame: buffer,
             report: *report,
+            ego,
             wants,
         };
         // Never full: the pool holds no more frames than the channel does.
@@ -161,19 +174,28 @@ mod tests {
     use super::*;
     use std::sync::{Arc, Mutex};
 
+    /// Image, annotations and bird's-eye view, each as [`LaneEncoder`] and [`BirdseyeView`] give
+    /// them on the caller's thread, in the order offered; a channel not wanted is not sent.
     #[test]
     fn every_frame_offered_is_encoded_as_the_encoder_does_it_on_the_callers_thread() {
+        let camera = crate::config::load_camera_config("robot")
+            .unwrap()
+            .model()
+            .unwrap();
+        let view = BirdseyeView::for_camera(&camera).unwrap();
         let got = Arc::new(Mutex::new(Vec::new()));
         let sink = Arc::clone(&got);
-        let mut thread = EncodeThread::start(move |channel, t_ns, json: &[u8]| {
-            sink.lock().unwrap().push((channel, t_ns, json.to_vec()));
-        })
-        .unwrap();
+        let mut thread =
+            EncodeThread::start(Some(view.clone()), move |channel, t_ns, json: &[u8]| {
+                sink.lock().unwrap().push((channel, t_ns, json.to_vec()));
+            })
+            .unwrap();
+        let (w, h) = (320, 240);
         let lane = |side| lane_tracker::LaneReport {
             side,
             state: lane_tracker::LaneState::Tracking,
-            coeffs: Some([0.01, -0.5, 4.0]),
-            rows: [1.0, 5.0],
+            coeffs: Some([0.001, -0.5, 200.0]),
+            rows: [120.0, 239.0],
             points: 9,
             initialised: false,
             far: None,
@@ -185,24 +207,32 @@ mod tests {
             ],
             full_gradient: false,
             road: lane_tracker::RoadReport {
-                bottom_row_px: 6.0,
-                search_rows_px: [1.0, 6.0],
-                horizon_row_px: Some(0.5),
+                bottom_row_px: 240.0,
+                search_rows_px: [150.0, 240.0],
+                horizon_row_px: Some(60.0),
                 refused: None,
             },
         };
         let mut expected = Vec::new();
         let mut encoder = LaneEncoder::default();
+        let mut rgb = Vec::new();
         for k in 0..20u64 {
-            let data: Vec<u8> = (0..48).map(|i| (i as u64 * 3 + k) as u8).collect();
-            let frame = GreyFrame::from_vec(8, 6, data).unwrap();
-            while !thread.offer(k, &frame, &report, [true, true]) {
+            let data: Vec<u8> = (0..w * h).map(|i| (i as u64 * 3 + k) as u8).collect();
+            let frame = GreyFrame::from_vec(w, h, data).unwrap();
+            // Every channel on even frames; on odd ones the bird's-eye view only.
+            let wants = [k % 2 == 0, k % 2 == 0, true, true];
+            while !thread.offer(k, &frame, &report, None, wants) {
                 std::thread::yield_now();
             }
-            encoder.encode_image(k, &frame).unwrap();
-            expected.push((IMAGE, k, encoder.image_json().to_vec()));
-            encoder.encode_annotations(k, 8, 6, &report).unwrap();
-            expected.push((ANNOTATIONS, k, encoder.annotations_json().to_vec()));
+            if wants[IMAGE] {
+                encoder.encode_image(k, &frame).unwrap();
+                expected.push((IMAGE, k, encoder.image_json().to_vec()));
+                encoder.encode_annotations(k, w, h, &report).unwrap();
+                expected.push((ANNOTATIONS, k, encoder.annotations_json().to_vec()));
+            }
+            view.render(&frame, &report, None, &mut rgb);
+            encoder.encode_birdseye(k, &view, &rgb).unwrap();
+            expected.push((BIRDSEYE, k, encoder.birdseye_json().to_vec()));
         }
         thread.finish();
         assert_eq!(*got.lock().unwrap(), expected);

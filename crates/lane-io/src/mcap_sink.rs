@@ -2,9 +2,11 @@
 //! `foxglove.RawImage` on `/camera/image`, both lanes drawn on it as polylines
 //! (`foxglove.ImageAnnotations` on `/camera/lanes`: left blue, right orange, over the rows of the
 //! points behind each estimate), and the lane estimate itself as JSON on `/lanes` (the object
-//! `nav-app --json` prints for the frame, [`LaneFrame`], with its JSON schema [`LANES_SCHEMA`]). Opening the
+//! `nav-app --json` prints for the frame, [`LaneFrame`](crate::lane_frame::LaneFrame), with its JSON schema [`LANES_SCHEMA`]). Opening the
 //! file in Foxglove's Image panel on `/camera/image` with `/camera/lanes` as annotations shows
 //! the camera with the lanes on it; the Plot panel plots `/lanes.lanes[0].coeffs[2]` and the rest.
+//! With a camera model (`--camera`), a fourth channel, `/camera/birdseye`, carries the bird's-eye
+//! view ([`crate::birdseye`]) as `foxglove.RawImage` (rgb8).
 //!
 //! The messages are encoded once ([`LaneEncoder`]; `/lanes` is the `--json` line itself) and the
 //! same bytes go to the file ([`LaneMcapSink::write_encoded`]) and to a live Foxglove connection
@@ -19,7 +21,7 @@ use ros_bag::out::foxglove::{
 use ros_bag::out::{JsonChannel, JsonMcapWriter, base64_append, base64_into};
 
 use crate::LaneIoError;
-use crate::lane_frame::LaneFrame;
+use crate::birdseye::BirdseyeView;
 
 /// Topic of the grey frames.
 pub const IMAGE_TOPIC: &str = "/camera/image";
@@ -27,6 +29,17 @@ pub const IMAGE_TOPIC: &str = "/camera/image";
 pub const ANNOTATIONS_TOPIC: &str = "/camera/lanes";
 /// Topic of the lane estimates.
 pub const LANES_TOPIC: &str = "/lanes";
+/// Topic of the bird's-eye view (with a camera model).
+pub const BIRDSEYE_TOPIC: &str = "/camera/birdseye";
+
+/// Index of the image channel in [`lane_channels`] (and in a `wants` array).
+pub const IMAGE: usize = 0;
+/// Index of the annotations channel.
+pub const ANNOTATIONS: usize = 1;
+/// Index of the lanes channel.
+pub const LANES: usize = 2;
+/// Index of the bird's-eye channel, after [`lane_channels`]' three ([`birdseye_channel`]).
+pub const BIRDSEYE: usize = 3;
 /// Schema name of the lane estimates.
 pub const LANES_SCHEMA_NAME: &str = "ita_nav.LaneFrame";
 
@@ -83,19 +96,52 @@ pub fn lane_channels() -> [(&'static str, &'static str, String); 3] {
     ]
 }
 
+/// The bird's-eye channel, index [`BIRDSEYE`] when added after [`lane_channels`]: (topic,
+/// schema name, JSON schema).
+pub fn birdseye_channel() -> (&'static str, &'static str, String) {
+    (BIRDSEYE_TOPIC, RAW_IMAGE, raw_image_schema())
+}
+
 /// A frame's time in nanoseconds, as the channels carry it: `round(max(t_s, 0)·1e9)`.
 pub fn frame_t_ns(t_s: f64) -> u64 {
     (t_s.max(0.0) * 1e9).round() as u64
 }
 
-/// Encodes the `/camera/image` and `/camera/lanes` messages as JSON into buffers it keeps, so that
-/// one encoding serves the file and the live connection alike.
+/// Encodes the `/camera/image`, `/camera/lanes` and `/camera/birdseye` messages as JSON into
+/// buffers it keeps, so that one encoding serves the file and the live connection alike.
 #[derive(Debug, Default)]
 pub struct LaneEncoder {
     base64: String,
     ann: ImageAnnotations,
     image: Vec<u8>,
     annotations: Vec<u8>,
+    birdseye: Vec<u8>,
+}
+
+/// `image` with `pixels` (its `data`) as JSON into `out`.
+fn encode_raw_image(
+    topic: &'static str,
+    out: &mut Vec<u8>,
+    base64: &mut String,
+    image: RawImage<'_>,
+    pixels: &[u8],
+) -> Result<(), LaneIoError> {
+    // The message with an empty `data` (its last field) through serde, then the pixels'
+    // base64 appended in place: the same bytes as serialising it whole (base64 needs no
+    // escaping), without the string's copy and escape scan.
+    encode(topic, out, &image)?;
+    if out.ends_with(b"\"\"}") {
+        out.truncate(out.len() - 2);
+        base64_append(pixels, out);
+        out.extend_from_slice(b"\"}");
+        return Ok(());
+    }
+    base64_into(pixels, base64);
+    let image = RawImage {
+        data: base64,
+        ..image
+    };
+    encode(topic, out, &image)
 }
 
 fn encode(
@@ -114,9 +160,6 @@ impl LaneEncoder {
     /// # Errors
     /// [`LaneIoError::Encode`].
     pub fn encode_image(&mut self, t_ns: u64, frame: &GreyFrame) -> Result<(), LaneIoError> {
-        // The message with an empty `data` (its last field) through serde, then the pixels'
-        // base64 appended in place: the same bytes as serialising it whole (base64 needs no
-        // escaping), without the string's copy and escape scan.
         let image = RawImage {
             timestamp: Time::from_ns(t_ns),
             frame_id: "camera",
@@ -126,24 +169,52 @@ impl LaneEncoder {
             step: frame.width() as u32,
             data: "",
         };
-        encode(IMAGE_TOPIC, &mut self.image, &image)?;
-        if self.image.ends_with(b"\"\"}") {
-            self.image.truncate(self.image.len() - 2);
-            base64_append(frame.data(), &mut self.image);
-            self.image.extend_from_slice(b"\"}");
-            return Ok(());
-        }
-        base64_into(frame.data(), &mut self.base64);
+        encode_raw_image(
+            IMAGE_TOPIC,
+            &mut self.image,
+            &mut self.base64,
+            image,
+            frame.data(),
+        )
+    }
+
+    /// Encodes the bird's-eye view `rgb` (as [`BirdseyeView::render`] fills it) as
+    /// `foxglove.RawImage` (rgb8, frame `birdseye`) at `t_ns`: [`Self::birdseye_json`].
+    ///
+    /// # Errors
+    /// [`LaneIoError::Encode`].
+    pub fn encode_birdseye(
+        &mut self,
+        t_ns: u64,
+        view: &BirdseyeView,
+        rgb: &[u8],
+    ) -> Result<(), LaneIoError> {
         let image = RawImage {
-            data: &self.base64,
-            ..image
+            timestamp: Time::from_ns(t_ns),
+            frame_id: "birdseye",
+            width: view.width_px() as u32,
+            height: view.height_px() as u32,
+            encoding: "rgb8",
+            step: 3 * view.width_px() as u32,
+            data: "",
         };
-        encode(IMAGE_TOPIC, &mut self.image, &image)
+        encode_raw_image(
+            BIRDSEYE_TOPIC,
+            &mut self.birdseye,
+            &mut self.base64,
+            image,
+            rgb,
+        )
     }
 
     /// The last image encoded, JSON.
     pub fn image_json(&self) -> &[u8] {
         &self.image
+    }
+
+    /// The last bird's-eye view encoded, JSON.
+    pub fn birdseye_json(&self) -> &[u8] {
+        &self.birdseye
     }
 
     /// The last annotations encoded, JSON.
@@ -169,15 +240,10 @@ impl LaneEncoder {
         for (lane, colour) in report.lanes.iter().zip(COLOURS) {
             let Some(_) = lane.coeffs else { continue };
             let [top, bottom] = lane.rows;
-            // Above the far segment's join, its column (`LaneReport::far`).
-            let col = |y: f64| match lane.far {
-                Some(far) if y < far.rows[1] => Some(far.col_at_row(y)),
-                _ => lane.col_at_row(y),
-            };
             let points = (0..POLYLINE_POINTS)
                 .filter_map(|k| {
                     let y = top + (bottom - top) * k as f64 / (POLYLINE_POINTS - 1) as f64;
-                    col(y).map(|x| Point2 { x, y })
+                    lane.col_seen_at_row(y).map(|x| Point2 { x, y })
                 })
                 .collect();
             self.ann.points.push(PointsAnnotation {
@@ -226,8 +292,7 @@ impl LaneEncoder {
 pub struct LaneMcapSink {
     writer: JsonMcapWriter,
     channels: [JsonChannel; 3],
-    encoder: LaneEncoder,
-    lanes: Vec<u8>,
+    birdseye: Option<JsonChannel>,
 }
 
 fn bag(source: ros_bag::BagError) -> LaneIoError {
@@ -249,62 +314,48 @@ impl LaneMcapSink {
         Ok(Self {
             writer,
             channels,
-            encoder: LaneEncoder::default(),
-            lanes: Vec::new(),
+            birdseye: None,
         })
     }
 
-    /// Writes one frame: the image, the lanes drawn on it, and `lanes_message` (the `--json`
-    /// object) at time `t_s` (negative times are written at 0).
+    /// Adds the bird's-eye channel ([`birdseye_channel`]): from then on
+    /// [`Self::write_encoded`] writes the encoder's bird's-eye view too.
     ///
     /// # Errors
-    /// [`LaneIoError::Bag`] when writing fails, [`LaneIoError::Encode`].
-    pub fn write(
-        &mut self,
-        t_s: f64,
-        frame: &GreyFrame,
-        report: &TrackReport,
-        lanes_message: &LaneFrame<'_>,
-    ) -> Result<(), LaneIoError> {
-        let t_ns = frame_t_ns(t_s);
-        encode(LANES_TOPIC, &mut self.lanes, lanes_message)?;
-        self.encoder.encode_image(t_ns, frame)?;
-        self.encoder
-            .encode_annotations(t_ns, frame.width(), frame.height(), report)?;
-        let [image, annotations, lanes] = self.channels;
-        for (channel, json) in [
-            (image, self.encoder.image_json()),
-            (annotations, self.encoder.annotations_json()),
-            (lanes, &self.lanes[..]),
-        ] {
-            self.writer
-                .write_json_bytes(channel, t_ns, json)
-                .map_err(bag)?;
-        }
+    /// [`LaneIoError::Bag`].
+    pub fn add_birdseye_channel(&mut self) -> Result<(), LaneIoError> {
+        let (topic, name, schema) = birdseye_channel();
+        self.birdseye = Some(self.writer.channel(topic, name, &schema).map_err(bag)?);
         Ok(())
     }
 
-    /// Writes one frame's messages already encoded: `image` and `annotations` from a
-    /// [`LaneEncoder`], `lanes` the [`LaneFrame`] as JSON (the `--json` line without its newline).
+    /// Writes one frame's messages already encoded: the image, the annotations and (with the
+    /// bird's-eye channel added) the bird's-eye view as `encoder` last encoded them, and `lanes`,
+    /// the [`LaneFrame`](crate::lane_frame::LaneFrame) as JSON (the `--json` line without its newline).
     ///
     /// # Errors
     /// [`LaneIoError::Bag`].
     pub fn write_encoded(
         &mut self,
         t_ns: u64,
-        image: &[u8],
-        annotations: &[u8],
+        encoder: &LaneEncoder,
         lanes: &[u8],
     ) -> Result<(), LaneIoError> {
-        self.write_json(0, t_ns, image)?;
-        self.write_json(1, t_ns, annotations)?;
-        self.write_json(2, t_ns, lanes)
-    }
-
-    fn write_json(&mut self, k: usize, t_ns: u64, json: &[u8]) -> Result<(), LaneIoError> {
-        self.writer
-            .write_json_bytes(self.channels[k], t_ns, json)
-            .map_err(bag)
+        let [image, annotations, lanes_channel] = self.channels;
+        let messages = [
+            (Some(image), encoder.image_json()),
+            (Some(annotations), encoder.annotations_json()),
+            (Some(lanes_channel), lanes),
+            (self.birdseye, encoder.birdseye_json()),
+        ];
+        for (channel, json) in messages {
+            if let Some(channel) = channel {
+                self.writer
+                    .write_json_bytes(channel, t_ns, json)
+                    .map_err(bag)?;
+            }
+        }
+        Ok(())
     }
 
     /// Writes the summary and closes the file.

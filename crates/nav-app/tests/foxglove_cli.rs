@@ -1,6 +1,8 @@
 //! `nav-app --foxglove` end to end with a tungstenite client on loopback: with `--mcap-out` the
-//! live messages are the file's, byte for byte and at the same times; `--wait-client` holds the
-//! run until the subscription; `--realtime` needs a recorded input.
+//! live messages are the file's, byte for byte and at the same times (with `--camera`, the
+//! bird's-eye view's too); without it, the bird's-eye view the encoder thread sends is the
+//! `--birdseye` PNG's; `--wait-client` holds the run until the subscription; `--realtime` needs a
+//! recorded input.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::collections::BTreeMap;
@@ -45,15 +47,14 @@ fn connect(port: u16) -> WebSocket<TcpStream> {
 
 type ByTopic = BTreeMap<String, Vec<(u64, Vec<u8>)>>;
 
-#[test]
-fn live_messages_are_the_mcap_files_byte_for_byte() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("foxglove-cli");
-    std::fs::create_dir_all(&dir).unwrap();
-    let mcap_path = dir.join("run.mcap");
+/// What a run of nav-app with `args` and `--json --foxglove PORT --wait-client` sent to a
+/// client subscribed to every channel (by topic), its stdout lines and its frame count; the run's
+/// summary says one client and every message sent, none dropped.
+fn serve_and_read(args: &[&str]) -> (ByTopic, Vec<String>, usize) {
     let port = free_port();
     let child = Command::new(env!("CARGO_BIN_EXE_nav-app"))
-        .args(["--json", "--mcap-out"])
-        .arg(&mcap_path)
+        .arg("--json")
+        .args(args)
         .args(["--foxglove", &format!("127.0.0.1:{port}"), "--wait-client"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -61,7 +62,7 @@ fn live_messages_are_the_mcap_files_byte_for_byte() {
         .unwrap();
     let mut ws = connect(port);
     let mut topics = BTreeMap::new();
-    while topics.len() < 3 {
+    while topics.is_empty() {
         if let Message::Text(t) = ws.read().unwrap() {
             let v: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
             if v["op"] == "advertise" {
@@ -104,16 +105,20 @@ fn live_messages_are_the_mcap_files_byte_for_byte() {
         String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8(out.stdout).unwrap();
-    let lines: Vec<&str> = stdout.lines().collect();
-    let summary: serde_json::Value = serde_json::from_str(lines[lines.len() - 1]).unwrap();
+    let lines: Vec<String> = stdout.lines().map(str::to_owned).collect();
+    let summary: serde_json::Value = serde_json::from_str(&lines[lines.len() - 1]).unwrap();
     let frames = summary["summary"]["tracked_frames"].as_u64().unwrap() as usize;
     assert!(frames > 10);
     assert_eq!(
         summary["summary"]["foxglove"],
-        serde_json::json!({"clients": 1, "sent": 3 * frames, "dropped": 0})
+        serde_json::json!({"clients": 1, "sent": topics.len() * frames, "dropped": 0})
     );
+    (live, lines, frames)
+}
 
-    let bytes = std::fs::read(&mcap_path).unwrap();
+/// The messages of an MCAP file by topic.
+fn read_mcap(path: &Path) -> ByTopic {
+    let bytes = std::fs::read(path).unwrap();
     let mut file = ByTopic::new();
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();
@@ -121,20 +126,104 @@ fn live_messages_are_the_mcap_files_byte_for_byte() {
             .or_default()
             .push((m.log_time, m.data.into_owned()));
     }
-    assert_eq!(
-        live.keys().collect::<Vec<_>>(),
-        ["/camera/image", "/camera/lanes", "/lanes"]
-    );
+    file
+}
+
+/// With `--mcap-out` (and `extra`), every live message is the file's, at the same time, on the
+/// `topics`; `/lanes` is the `--json` line.
+fn live_equals_file(name: &str, extra: &[&str], topics: &[&str]) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mcap_path = dir.join("run.mcap");
+    let mut args = vec!["--mcap-out", mcap_path.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let (live, lines, frames) = serve_and_read(&args);
+    let file = read_mcap(&mcap_path);
+    assert_eq!(live.keys().collect::<Vec<_>>(), topics);
+    assert_eq!(file.keys().collect::<Vec<_>>(), topics);
     for (topic, messages) in &live {
         assert_eq!(messages.len(), frames, "{topic}");
         assert!(messages == &file[topic], "{topic}: live and file differ");
     }
-    // And /lanes is the --json line.
     for ((_, payload), line) in live["/lanes"].iter().zip(&lines) {
-        assert_eq!(std::str::from_utf8(payload).unwrap(), *line);
+        assert_eq!(std::str::from_utf8(payload).unwrap(), line);
     }
 }
 
+#[test]
+fn live_messages_are_the_mcap_files_byte_for_byte() {
+    live_equals_file(
+        "foxglove-cli",
+        &[],
+        &["/camera/image", "/camera/lanes", "/lanes"],
+    );
+}
+
+#[test]
+fn with_a_camera_the_birdseye_view_is_in_the_file_and_live_byte_for_byte() {
+    live_equals_file(
+        "foxglove-cli-camera",
+        &["--camera", "robot"],
+        &[
+            "/camera/birdseye",
+            "/camera/image",
+            "/camera/lanes",
+            "/lanes",
+        ],
+    );
+}
+
+/// Live only, the encoder thread renders the bird's-eye view: each frame's message is an rgb8
+/// `foxglove.RawImage` whose pixels are the `--birdseye` PNG's of the same frame.
+#[test]
+fn live_only_the_birdseye_view_is_the_png_of_the_same_frame() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("foxglove-cli-birdseye");
+    let _ = std::fs::remove_dir_all(&dir);
+    let (live, _, frames) =
+        serve_and_read(&["--camera", "robot", "--birdseye", dir.to_str().unwrap()]);
+    let views = &live["/camera/birdseye"];
+    assert_eq!(views.len(), frames);
+    for (k, (_, payload)) in views.iter().enumerate() {
+        let v: serde_json::Value = serde_json::from_slice(payload).unwrap();
+        assert_eq!(
+            (&v["encoding"], &v["width"], &v["height"], &v["step"]),
+            (
+                &serde_json::json!("rgb8"),
+                &serde_json::json!(320),
+                &serde_json::json!(320),
+                &serde_json::json!(960)
+            )
+        );
+        assert_eq!(v["frame_id"], "birdseye");
+        let png = image::open(dir.join(format!("birdseye_{k:06}.png")))
+            .unwrap()
+            .to_rgb8();
+        let pixels = base64_decode(v["data"].as_str().unwrap());
+        assert!(pixels == png.as_raw().as_slice(), "frame {k} differs");
+    }
+}
+
+/// Standard base64 (with `=` padding) decoded.
+fn base64_decode(text: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => panic!("not base64: {c}"),
+    };
+    let mut out = Vec::with_capacity(text.len() / 4 * 3);
+    for quad in text.as_bytes().chunks(4) {
+        let n = quad.iter().take_while(|&&c| c != b'=').count();
+        let bits = quad[..n]
+            .iter()
+            .fold(0u32, |acc, &c| (acc << 6) | u32::from(value(c)))
+            << (6 * (4 - n));
+        out.extend_from_slice(&bits.to_be_bytes()[1..n]);
+    }
+    out
+}
 #[test]
 fn realtime_with_a_device_and_wait_client_without_foxglove_are_refused() {
     let out = Command::new(env!("CARGO_BIN_EXE_nav-app"))
@@ -163,6 +252,7 @@ fn the_layout_file_shows_only_served_topics() {
     let served: Vec<&str> = lane_io::mcap_sink::lane_channels()
         .iter()
         .map(|c| c.0)
+        .chain([lane_io::mcap_sink::BIRDSEYE_TOPIC])
         .chain(ins_sim::logs::ins_channels().iter().map(|c| c.0))
         .collect();
     let mut shown = Vec::new();

@@ -135,6 +135,17 @@ impl LaneReport {
         self.coeffs
             .map(|c| Parabola::from_coeffs(c).col_at_row(row_px))
     }
+
+    /// Column at `row_px` of the lane as seen: the far segment's above the row it joins the
+    /// near parabola at, the near parabola's elsewhere; `None` without coefficients.
+    pub fn col_seen_at_row(&self, row_px: f64) -> Option<f64> {
+        match self.far {
+            Some(far) if self.coeffs.is_some() && row_px < far.rows[1] => {
+                Some(far.col_at_row(row_px))
+            }
+            _ => self.col_at_row(row_px),
+        }
+    }
 }
 
 /// The tracker's result for one frame.
@@ -360,5 +371,20 @@ mod tests {
         assert_eq!((one.horizon_row_px, one.refused), (None, None));
         let parallel = road(Some([0.0, 0.2, 50.0]), Some([0.0, 0.2, 170.0]));
         assert_eq!((parallel.horizon_row_px, parallel.refused), (None, None));
+    }
+
+    #[test]
+    fn the_column_seen_is_the_far_segments_above_its_join_and_the_near_parabolas_below() {
+        let mut l = lane(Side::Left, Some([0.0, -0.5, 175.0]));
+        l.rows = [60.0, 239.0];
+        l.far = Some(FarSegment {
+            coeffs: [0.0, 0.0, 120.0],
+            rows: [60.0, 110.0],
+        });
+        assert_eq!(l.col_seen_at_row(80.0), Some(120.0));
+        assert_eq!(l.col_seen_at_row(110.0), l.col_at_row(110.0));
+        assert_eq!(l.col_seen_at_row(200.0), Some(75.0));
+        let lost = LaneReport { coeffs: None, ..l };
+        assert_eq!(lost.col_seen_at_row(80.0), None);
     }
 }

@@ -9,10 +9,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use clap::{Parser, ValueEnum};
 use lane_io::birdseye::BirdseyeView;
-use lane_io::capture::{InputSelect, PixelFormat, VideoStd};
-use lane_io::capture_source::{
-    self, CaptureMonitor, DeviceOptions, DeviceSetup, DeviceStats, parse_control_spec,
-};
+use lane_io::capture_source::{self, CaptureMonitor, DeviceSetup, DeviceStats};
 use lane_scenes::{SCENES, SceneSource};
 use std::io::IsTerminal;
 
@@ -26,9 +23,10 @@ use lane_tracker::camera::CameraModel;
 use lane_tracker::{Estimator, LaneReport, LaneState, Side};
 use serde::Serialize;
 
-use crate::live::{self, Live, LiveArgs, Pacer};
+use crate::device_args::{DeviceArgs, device_options};
+use crate::live::{self, LaneOutput, Live, LiveArgs, Pacer};
 use foxglove_live::LiveStats;
-use lane_io::mcap_sink::{LaneEncoder, frame_t_ns, lane_channels};
+use lane_io::mcap_sink::{LaneEncoder, LaneMcapSink, frame_t_ns};
 
 /// The default input: a scene the project renders itself (`lane_scenes`, deterministic), a
 /// curved road with dashed marks, 320×240.
@@ -99,7 +97,8 @@ struct Args {
     #[arg(long, value_name = "robot|highway|FILE.toml")]
     camera: Option<String>,
     /// Write bird's-eye (inverse perspective) views of the ground with the lanes, one PNG per
-    /// frame, into this directory (needs --camera).
+    /// frame, into this directory (needs --camera; with --camera the view is also on
+    /// --mcap-out's and --foxglove's /camera/birdseye).
     #[arg(long, value_name = "DIR", requires = "camera")]
     birdseye: Option<PathBuf>,
     /// Stop after this many frames.
@@ -124,85 +123,6 @@ struct Args {
     live: LiveArgs,
     #[command(flatten)]
     dev: DeviceArgs,
-}
-
-/// Capture options (with `--device`).
-#[derive(clap::Args, Debug)]
-struct DeviceArgs {
-    /// Capture input by name (bttv: Television, Composite0…, S-Video); a unique "NAME N" also matches.
-    #[arg(
-        long,
-        value_name = "NAME",
-        requires = "device",
-        conflicts_with = "input_index"
-    )]
-    input_name: Option<String>,
-    /// Capture input by index (VIDIOC_ENUMINPUT order). Default: the driver's current input.
-    #[arg(long, value_name = "N", requires = "device")]
-    input_index: Option<u32>,
-    /// Video standard: ntsc (NTSC-M), ntsc-m-jp, ntsc443, pal, pal-m, pal-n, pal-nc, pal60, secam.
-    #[arg(long, value_name = "STD", default_value = "ntsc", value_parser = parse_std)]
-    std: VideoStd,
-    /// Requested capture frame size, px (the driver may adjust it; its answer is used).
-    #[arg(long, value_name = "WxH", default_value = "320x240", value_parser = parse_wh)]
-    size: (u32, u32),
-    /// Frame timeouts in a row (each restarts the stream) that end the run with exit code 4.
-    #[arg(long, value_name = "N", default_value_t = 3)]
-    max_timeouts: u32,
-    /// Test hook: capture only this pixel format (fourcc, e.g. YUYV).
-    #[arg(long, value_name = "FOURCC", hide = true)]
-    format: Option<String>,
-    /// Test hook: frame timeout, ms.
-    #[arg(long, value_name = "MS", default_value_t = 1000, hide = true)]
-    timeout_ms: u32,
-    /// Test hook: set a V4L2 control once FRAME frames have been delivered.
-    #[arg(long = "ctrl", value_name = "NAME=VALUE@FRAME", hide = true)]
-    ctrl: Vec<String>,
-    /// Test hook: set a V4L2 control at the first timeout.
-    #[arg(long = "ctrl-on-timeout", value_name = "NAME=VALUE", hide = true)]
-    ctrl_on_timeout: Vec<String>,
-}
-
-fn parse_std(s: &str) -> Result<VideoStd, String> {
-    s.parse()
-        .map_err(|e: lane_io::capture::CaptureError| e.to_string())
-}
-
-fn parse_wh(s: &str) -> Result<(u32, u32), String> {
-    lane_io::capture::parse_size(s).map_err(|e| e.to_string())
-}
-
-fn device_options(d: &DeviceArgs) -> Result<DeviceOptions> {
-    let mut opts = DeviceOptions::default();
-    opts.capture.input = match (&d.input_name, d.input_index) {
-        (Some(name), _) => InputSelect::Name(name.clone()),
-        (None, Some(index)) => InputSelect::Index(index),
-        (None, None) => InputSelect::Current,
-    };
-    opts.capture.std = d.std;
-    (opts.capture.width_px, opts.capture.height_px) = d.size;
-    opts.capture.timeout_ms = d.timeout_ms;
-    if let Some(f) = &d.format {
-        let fourcc = <[u8; 4]>::try_from(f.as_bytes())
-            .ok()
-            .and_then(PixelFormat::from_fourcc)
-            .with_context(|| {
-                format!(
-                    "--format {f:?}: expected one of {}",
-                    PixelFormat::ALL.map(|p| p.to_string()).join(", ")
-                )
-            })?;
-        opts.capture.pixel_formats = vec![fourcc];
-    }
-    opts.max_consecutive_timeouts = d.max_timeouts;
-    for spec in &d.ctrl {
-        opts.controls_at_frame.push(parse_control_spec(spec)?);
-    }
-    for spec in &d.ctrl_on_timeout {
-        opts.controls_on_timeout.push(parse_control_spec(spec)?);
-    }
-    opts.validate()?;
-    Ok(opts)
 }
 
 /// Version of the per-frame `--json` objects and of the summary line ([`LaneFrame`]'s).
@@ -298,22 +218,20 @@ fn run(
     if args.live.realtime && args.device.is_some() {
         bail!("--realtime paces a recorded input; a --device delivers frames at its own pace");
     }
-    if let Some(addr) = &args.live.foxglove {
-        *live = Some(Live::start(addr, &lane_channels())?);
-    }
-    let mut live = live.as_mut();
     let camera: Option<CameraModel> = match &args.camera {
         Some(c) => Some(lane_io::config::load_camera_config(c)?.model()?),
         None => None,
     };
-    let mut birdseye = match (&args.birdseye, &camera) {
-        (Some(dir), Some(cam)) => {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create {}", dir.display()))?;
-            Some((dir.clone(), BirdseyeView::for_camera(cam)?, Vec::new()))
-        }
-        _ => None,
-    };
+    // With a camera model, the bird's-eye view: PNGs with --birdseye, a channel of --mcap-out
+    // and --foxglove.
+    let view = camera.as_ref().map(BirdseyeView::for_camera).transpose()?;
+    if let Some(dir) = &args.birdseye {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    if let Some(addr) = &args.live.foxglove {
+        *live = Some(Live::start_lanes(addr, view.clone())?);
+    }
+    let mut live = live.as_mut();
     let estimator = match args.estimator {
         EstimatorArg::Kif => Estimator::Kif,
         EstimatorArg::Wrls => Estimator::Wrls,
@@ -343,7 +261,13 @@ fn run(
         None => None,
     };
     let mut mcap_out = match &args.mcap_out {
-        Some(p) => Some(lane_io::mcap_sink::LaneMcapSink::create(p)?),
+        Some(p) => {
+            let mut sink = LaneMcapSink::create(p)?;
+            if view.is_some() {
+                sink.add_birdseye_channel()?;
+            }
+            Some(sink)
+        }
         None => None,
     };
     if let Some(l) = live.as_deref()
@@ -362,7 +286,7 @@ fn run(
     let mut pacer = args.live.realtime.then(Pacer::default);
     let mut encoder = LaneEncoder::default();
     let mut lanes_json = Vec::new();
-    let mut rgb = Vec::new();
+    let (mut rgb, mut birdseye_rgb) = (Vec::new(), Vec::new());
     let mut lanes = FrameLoop::new(cfg, estimator);
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
@@ -430,9 +354,14 @@ fn run(
                 eprintln!("nav-app: frame {index}: input signal {what}");
             }
         }
-        let wants = live
-            .as_deref()
-            .map_or([false; 3], |l| [l.wants(0), l.wants(1), l.wants(2)]);
+        // Rendered here for the PNGs and the file; a live-only run renders it on the encoder's
+        // thread.
+        if let Some(v) = &view
+            && (args.birdseye.is_some() || mcap_out.is_some())
+        {
+            v.render(frame, &report, ego.flatten(), &mut birdseye_rgb);
+        }
+        let wants = live.as_deref().map_or([false; 4], Live::lane_wants);
         if args.json || mcap_out.is_some() || wants.contains(&true) {
             let frame_json = LaneFrame {
                 schema: JSON_SCHEMA,
@@ -465,28 +394,29 @@ fn run(
             if let Some(sink) = mcap_out.as_mut() {
                 encoder.encode_image(t_ns, frame)?;
                 encoder.encode_annotations(t_ns, frame.width(), frame.height(), &report)?;
-                sink.write_encoded(
-                    t_ns,
-                    encoder.image_json(),
-                    encoder.annotations_json(),
-                    &lanes_json,
-                )?;
+                if let Some(v) = &view {
+                    encoder.encode_birdseye(t_ns, v, &birdseye_rgb)?;
+                }
+                sink.write_encoded(t_ns, &encoder, &lanes_json)?;
             }
             if let Some(l) = live.as_deref_mut() {
-                let encoded = mcap_out
-                    .is_some()
-                    .then(|| [encoder.image_json(), encoder.annotations_json()]);
-                l.lane_frame(t_ns, frame, &report, &lanes_json, encoded, wants)?;
+                let output = LaneOutput {
+                    t_ns,
+                    frame,
+                    report: &report,
+                    ego: ego.flatten(),
+                    lanes_json: &lanes_json,
+                };
+                l.lane_frame(&output, mcap_out.is_some().then_some(&encoder), wants)?;
             }
         }
         if let Some(sink) = overlay.as_mut() {
             render_overlay(frame, t, &mut rgb);
             sink.write(index, &rgb, frame.width(), frame.height())?;
         }
-        if let Some((dir, view, rgb)) = birdseye.as_mut() {
-            view.render(frame, t, &report, ego.flatten(), rgb);
+        if let (Some(dir), Some(v)) = (&args.birdseye, &view) {
             let path = dir.join(format!("birdseye_{index:06}.png"));
-            view.write_png(&path, rgb)?;
+            v.write_png(&path, &birdseye_rgb)?;
         }
         let states = [report.lanes[0].state, report.lanes[1].state];
         if !quiet && (states != last_states || stats.frames % 100 == 1) {

@@ -11,8 +11,13 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use foxglove_live::{ChannelId, LiveConfig, LiveServer, LiveStats};
 use lane_io::GreyFrame;
+use lane_io::birdseye::BirdseyeView;
 use lane_io::encode_thread::EncodeThread;
+use lane_io::mcap_sink::{
+    ANNOTATIONS, BIRDSEYE, IMAGE, LANES, LaneEncoder, birdseye_channel, lane_channels,
+};
 use lane_tracker::TrackReport;
+use lane_tracker::camera::EgoLaneReport;
 
 /// The address `--foxglove` without a value listens on: loopback only.
 pub(crate) const DEFAULT_ADDR: &str = "127.0.0.1:8765";
@@ -34,11 +39,25 @@ pub(crate) struct LiveArgs {
     pub realtime: bool,
 }
 
-/// A live server and its channels (and, for the lanes, the thread that encodes the images).
+/// A live server and its channels (and, for the lanes, the thread that encodes the images, and
+/// the bird's-eye view it renders with a camera model).
 pub(crate) struct Live {
     server: Arc<LiveServer>,
     channels: Vec<ChannelId>,
     encode: Option<EncodeThread>,
+    birdseye: Option<BirdseyeView>,
+}
+
+/// One tracked frame's messages for the lane channels.
+pub(crate) struct LaneOutput<'a> {
+    /// The frame's time, ns.
+    pub t_ns: u64,
+    pub frame: &'a GreyFrame,
+    pub report: &'a TrackReport,
+    /// The ego lane, with a camera model.
+    pub ego: Option<EgoLaneReport>,
+    /// The `/lanes` message: the `--json` line.
+    pub lanes_json: &'a [u8],
 }
 
 impl Live {
@@ -55,7 +74,18 @@ impl Live {
             server: Arc::new(server),
             channels,
             encode: None,
+            birdseye: None,
         })
+    }
+
+    /// Listens on `addr` with the lane channels (`lane_io::mcap_sink::lane_channels`) and, with
+    /// a bird's-eye `view` (`--camera`), the bird's-eye channel after them.
+    pub fn start_lanes(addr: &str, view: Option<BirdseyeView>) -> Result<Self> {
+        let mut channels = lane_channels().to_vec();
+        channels.extend(view.as_ref().map(|_| birdseye_channel()));
+        let mut live = Self::start(addr, &channels)?;
+        live.birdseye = view;
+        Ok(live)
     }
 
     /// The address served (with the port picked when 0 was given).
@@ -63,9 +93,14 @@ impl Live {
         self.server.local_addr()
     }
 
-    /// Whether a client subscribed channel `k`.
+    /// Whether a client subscribed channel `k` (false for a channel not served).
     pub fn wants(&self, k: usize) -> bool {
-        self.server.wants(self.channels[k])
+        self.channels.get(k).is_some_and(|&c| self.server.wants(c))
+    }
+
+    /// [`Self::wants`] for each lane channel (`lane_io::mcap_sink::IMAGE` … `BIRDSEYE`).
+    pub fn lane_wants(&self) -> [bool; 4] {
+        std::array::from_fn(|k| self.wants(k))
     }
 
     /// Sends `json` on channel `k` at `t_ns` to the clients that subscribed it.
@@ -92,42 +127,48 @@ impl Live {
         false
     }
 
-    /// One tracked frame of the lane channels (image, annotations, lanes) at `t_ns`, for the
-    /// channels in `wants`: `lanes_json` (the `--json` line) at once; the image and annotations
-    /// either `encoded` already (the `--mcap-out` bytes) or by the encoder thread, so that the
-    /// tracker's thread only copies the frame.
+    /// One tracked frame of the lane channels at its time, for the channels in `wants`: the
+    /// `/lanes` message at once; the image, annotations and bird's-eye view either `encoded`
+    /// already (the `--mcap-out` bytes) or by the encoder thread, so that the tracker's thread
+    /// only copies the frame.
     pub fn lane_frame(
         &mut self,
-        t_ns: u64,
-        frame: &GreyFrame,
-        report: &TrackReport,
-        lanes_json: &[u8],
-        encoded: Option<[&[u8]; 2]>,
-        wants: [bool; 3],
+        out: &LaneOutput<'_>,
+        encoded: Option<&LaneEncoder>,
+        wants: [bool; 4],
     ) -> Result<()> {
+        let t_ns = out.t_ns;
         self.time(t_ns);
-        if wants[2] {
-            self.publish(2, t_ns, lanes_json);
+        if wants[LANES] {
+            self.publish(LANES, t_ns, out.lanes_json);
         }
-        if let Some(messages) = encoded {
-            for (k, json) in messages.into_iter().enumerate() {
+        if let Some(encoder) = encoded {
+            let messages = [
+                (IMAGE, encoder.image_json()),
+                (ANNOTATIONS, encoder.annotations_json()),
+                (BIRDSEYE, encoder.birdseye_json()),
+            ];
+            for (k, json) in messages {
                 if wants[k] {
                     self.publish(k, t_ns, json);
                 }
             }
-        } else if wants[0] || wants[1] {
+        } else if wants[IMAGE] || wants[ANNOTATIONS] || wants[BIRDSEYE] {
             let encode = match &mut self.encode {
                 Some(e) => e,
                 None => {
                     let server = Arc::clone(&self.server);
-                    let channels = [self.channels[0], self.channels[1]];
-                    let thread = EncodeThread::start(move |k, t_ns, json: &[u8]| {
-                        server.publish(channels[k], t_ns, json);
-                    })?;
+                    let channels = self.channels.clone();
+                    let thread =
+                        EncodeThread::start(self.birdseye.clone(), move |k, t_ns, json: &[u8]| {
+                            if let Some(&channel) = channels.get(k) {
+                                server.publish(channel, t_ns, json);
+                            }
+                        })?;
                     self.encode.insert(thread)
                 }
             };
-            encode.offer(t_ns, frame, report, [wants[0], wants[1]]);
+            encode.offer(t_ns, out.frame, out.report, out.ego, wants);
         }
         Ok(())
     }

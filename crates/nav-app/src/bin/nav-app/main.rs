@@ -99,6 +99,7 @@
 use std::process::ExitCode;
 
 mod bench;
+mod device_args;
 mod ins;
 mod lane;
 mod live;
