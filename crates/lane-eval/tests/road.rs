@@ -103,7 +103,7 @@ fn straight_first_frame() -> (GreyFrame, SceneRenderer, LaneTracker) {
 fn a_lanes_rows_reach_up_as_far_as_its_mark_is_seen() {
     // The rendered straight scene: its marks run from the bottom towards the horizon, so each
     // lane's rows reach well above the ROI's top (module `lane_tracker::tracker::reach`). With
-    // the marks painted out above a row, the rows stop there (within the walk's gap).
+    // the marks painted out above a row, the rows stop there.
     let (frame, _, mut tracker) = straight_first_frame();
     let (w, h) = (frame.width(), frame.height());
     let report = tracker.track(&frame).unwrap();
@@ -130,6 +130,42 @@ fn a_lanes_rows_reach_up_as_far_as_its_mark_is_seen() {
         assert!(
             top >= cut as f64 && top <= roi_top,
             "rows from {top}, marks from {cut}"
+        );
+    }
+}
+
+#[test]
+fn a_lane_is_followed_up_past_a_gap_in_its_marks() {
+    // The rendered straight scene with its marks painted out on a band of rows above the ROI,
+    // longer than a tenth of the height (worn paint, a shadow, a long dash gap): each lane is
+    // followed on past the band to the marks above it (module `lane_tracker::tracker::reach`:
+    // the walk does not stop at a gap).
+    let (frame, _, mut tracker) = straight_first_frame();
+    let (w, h) = (frame.width(), frame.height());
+    let whole = tracker.track(&frame).unwrap();
+    let roi_top = tracker.roi_rows().0;
+    // From 10 rows below the marks' top to just above the ROI.
+    let marks_top = whole
+        .lanes
+        .map(|l| l.rows[0])
+        .into_iter()
+        .fold(0.0, f64::max);
+    let band = marks_top as usize + 10..roi_top - 4;
+    assert!(band.len() as f64 > 0.1 * h as f64, "{band:?}");
+    let mut pixels = frame.data().to_vec();
+    for y in band.clone() {
+        let floor = pixels[y * w];
+        pixels[y * w..(y + 1) * w].fill(floor);
+    }
+    let gap_frame = GreyFrame::from_vec(w, h, pixels).unwrap();
+    tracker.reset();
+    let report = tracker.track(&gap_frame).unwrap();
+    for (lane, seen) in report.lanes.iter().zip(whole.lanes) {
+        let top = lane.rows[0];
+        assert!(
+            top < band.start as f64 - 5.0,
+            "rows from {top}, the gap {band:?}, the whole marks' rows from {}",
+            seen.rows[0]
         );
     }
 }
