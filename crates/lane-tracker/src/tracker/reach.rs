@@ -24,22 +24,14 @@
 //! (within ±3 px of it): where fewer than half hold a bright mark and at least half a step of
 //! one sign, `s · (I(c + 2) − I(c − 2)) ≥ MIN_STEP` (`s = ±1`, [`MIN_STEP`] grey levels), the
 //! walk looks for the strongest such step instead. The brightest (strongest) such column moves
-//! `d` halfway to it (`|d| ≤ 2k`). The walk goes on to the top of the rows the working frame
-//! holds; the lane's rows then start at the highest row where a mark was seen, if at least
-//! [`MIN_MARK_ROWS`] were.
-//!
-//! It stops neither at `y_h` nor at a gap. It used to do both (at `y_h`, and after a tenth of
-//! the height without a mark), and both cut lanes short: on a curve the near field's tangents
-//! meet well below where the marks end (the labels of the indoor set run to its top rows), and
-//! dashes, worn paint and shadows leave gaps longer than a tenth of the height. On the shared
-//! sets' development parts, TuSimple's full rule (every labelled row), the walk to `y_h` →
-//! past it → and past any gap (the longest gap allowed 0.1 → 0.2 → 0.3 → no limit of the
-//! height): culane 58.3 → 58.3 → 58.3 (every step), f1tenth 56.1 → 56.6 → 58.1 → 59.3 → 60.9,
-//! lanenet 70.6 → 73.7 (then the same), seame 74.2 → 74.6 → 74.9 → 74.9 → 75.0, tusimple 73.1
-//! → 73.3 → 76.7 → 77.6 → 77.6 %; the near band unchanged (78.3 %). No set loses at any step, so
-//! chosen on any four sets each step helps or ties the fifth (leave-one-set-out). Marks found on
-//! clutter above the road are what the full rule then counts as wrong rows; `y_h` still shapes
-//! the marks' widths (taking the frame's top instead lost 0.4–4.1 points on three sets).
+//! `d` halfway to it (`|d| ≤ 2k`). The walk stops at `y_h` (without one — the lanes do not close
+//! in upwards — at the top of the rows the working frame holds); the lane's rows then start at
+//! the highest row where a mark was seen, if at least [`MIN_MARK_ROWS`] were. A gap does not stop
+//! it: it used to stop after a tenth of the height without a mark, and dashes, worn paint and
+//! shadows leave longer gaps (decision and figures: `docs/lanes/history/road-region.md`, "Past
+//! gaps"). Going on past `y_h` as well gains little (on a curve the near tangents meet below
+//! where the marks end, but that is rare on roads) and costs the walk through the sky on every
+//! frame: the clip's tracked frame 21 → 32 µs.
 //!
 //! The marks followed make the lane's **far segment** ([`super::report::FarSegment`]): a
 //! parabola joined to the near one at the top of its points `y_j` with the same column `x_j` and
@@ -84,8 +76,8 @@ const PRIOR_ROWS: f64 = 10.0;
 pub(crate) const MAX_RESIDUAL_RATIO: f64 = 0.5;
 
 /// Follow each lane updated or initialised on this frame upwards (module docs) on `image`,
-/// valid on the working rows `rows`, the marks' widths shrinking towards `horizon_row` (working
-/// rows); extend its rows' top to the highest mark found.
+/// valid on the working rows `rows`, no higher than `horizon_row` (working rows); extend its
+/// rows' top to the highest mark found.
 pub(super) fn reach_up(
     lanes: &mut Lanes,
     image: &GreyImage<'_>,
@@ -94,9 +86,9 @@ pub(super) fn reach_up(
     setup: &Setup,
 ) {
     let h = image.height();
-    // Without a horizon (the lanes do not close in upwards) the widths shrink to the top row.
+    // Without a horizon (the lanes do not close in upwards) up to the top row.
     let y_h = horizon_row.unwrap_or(0.0).max(0.0);
-    let limit = rows.0.max(1);
+    let limit = (y_h.ceil() as usize).max(rows.0).max(1);
     let k = setup.cfg.track.window_half_width_px as i64;
     let max_width = f64::from(setup.cfg.gradient.stripe_max_width_px).max(4.0);
     for side in Side::BOTH {
