@@ -148,8 +148,20 @@ fn pass(
     }
 }
 
-/// A client subscribed to the three channels, reading until `stop`.
-fn reading_client(server: &LiveServer, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<u64> {
+/// A client subscribed to `live`'s three channels (returned once the server sees every
+/// subscription), reading until `stop`; its thread returns the bytes it read.
+fn reading_client(live: &Live, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<u64> {
+    let handle = spawn_reader(&live.server, stop);
+    let end = Instant::now() + Duration::from_secs(10);
+    while !live.channels.iter().all(|&ch| live.server.wants(ch)) {
+        assert!(Instant::now() < end, "the client did not subscribe");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    handle
+}
+
+/// The reading client's connection, subscription and thread.
+fn spawn_reader(server: &LiveServer, stop: Arc<AtomicBool>) -> std::thread::JoinHandle<u64> {
     let addr = server.local_addr();
     let stream = TcpStream::connect(addr).unwrap();
     stream
@@ -223,16 +235,9 @@ fn live(c: &mut Criterion) {
         let n = u32::try_from(clip.len()).unwrap();
         let mut server = (!case.ends_with("no_server")).then(start_server);
         let stop = Arc::new(AtomicBool::new(false));
-        let client = case.ends_with("one_client").then(|| {
-            let l = server.as_ref().unwrap();
-            let handle = reading_client(&l.server, Arc::clone(&stop));
-            let end = Instant::now() + Duration::from_secs(10);
-            while !l.channels.iter().all(|&ch| l.server.wants(ch)) {
-                assert!(Instant::now() < end, "the client did not subscribe");
-                std::thread::sleep(Duration::from_millis(1));
-            }
-            handle
-        });
+        let client = case
+            .ends_with("one_client")
+            .then(|| reading_client(server.as_ref().unwrap(), Arc::clone(&stop)));
         let timed: [(Pick, &str); 2] = [
             (|t| t.track, "track_per_frame"),
             (|t| t.work, "loop_per_frame"),
@@ -278,15 +283,7 @@ fn paired(
     };
     let n = u32::try_from(clip.len()).unwrap();
     let stop = Arc::new(AtomicBool::new(false));
-    let client = with_client.then(|| {
-        let handle = reading_client(&live.server, Arc::clone(&stop));
-        let end = Instant::now() + Duration::from_secs(10);
-        while !live.channels.iter().all(|&ch| live.server.wants(ch)) {
-            assert!(Instant::now() < end, "the client did not subscribe");
-            std::thread::sleep(Duration::from_millis(1));
-        }
-        handle
-    });
+    let client = with_client.then(|| reading_client(&live, Arc::clone(&stop)));
     let mut json = Vec::new();
     // Times without and with the server, and the pairs run.
     let (mut sums, mut pairs) = ([PassTimes::default(); 2], 0u64);
