@@ -172,49 +172,28 @@ impl BirdseyeView {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lane_tracker::{LaneReport, LaneState, RoadReport, Side};
+    use crate::test_support::{report, tracked_lane};
+    use lane_tracker::{LaneReport, LaneState, Side};
 
     /// A straight mark on the floor at `Y = −0.2 m` is a straight line in the image; the lane
     /// reported along that line is drawn back on `Y = −0.2 m` in the view, over the rows it was
     /// reported on (from the look-ahead's far end to its near end), and a lost lane not at all.
     #[test]
     fn a_lane_along_a_floor_line_is_drawn_back_on_that_line_over_its_rows() {
-        let camera = crate::config::load_camera_config("robot")
-            .unwrap()
-            .model()
-            .unwrap();
-        let view = BirdseyeView::for_camera(&camera).unwrap();
+        let (camera, view) = crate::test_support::robot_view();
         let hom = camera.homography();
         let la = camera.config().lookahead;
         let y_m = -0.2;
         let [u_near, v_near] = hom.ground_to_image([la.near_m, y_m]).unwrap();
         let [u_far, v_far] = hom.ground_to_image([la.far_m, y_m]).unwrap();
         let a2 = (u_far - u_near) / (v_far - v_near);
-        let left = LaneReport {
-            side: Side::Left,
-            state: LaneState::Tracking,
-            coeffs: Some([0.0, a2, u_near - a2 * v_near]),
-            rows: [v_far, v_near],
-            points: 10,
-            initialised: false,
-            far: None,
-        };
+        let left = tracked_lane(Side::Left, [0.0, a2, u_near - a2 * v_near], [v_far, v_near]);
         let right = LaneReport {
-            side: Side::Right,
             state: LaneState::Lost,
             coeffs: None,
-            ..left
+            ..tracked_lane(Side::Right, [0.0; 3], [0.0; 2])
         };
-        let report = TrackReport {
-            lanes: [left, right],
-            full_gradient: false,
-            road: RoadReport {
-                bottom_row_px: 240.0,
-                search_rows_px: [150.0, 240.0],
-                horizon_row_px: None,
-                refused: None,
-            },
-        };
+        let report = report([left, right], None);
         let [w, h] = camera.config().image_size_px;
         let frame = GreyFrame::from_vec(w, h, vec![128; w * h]).unwrap();
         let mut rgb = Vec::new();

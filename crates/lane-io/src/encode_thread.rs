@@ -172,17 +172,15 @@ impl Drop for EncodeThread {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::{report, tracked_lane};
+    use lane_tracker::Side;
     use std::sync::{Arc, Mutex};
 
     /// Image, annotations and bird's-eye view, each as [`LaneEncoder`] and [`BirdseyeView`] give
     /// them on the caller's thread, in the order offered; a channel not wanted is not sent.
     #[test]
     fn every_frame_offered_is_encoded_as_the_encoder_does_it_on_the_callers_thread() {
-        let camera = crate::config::load_camera_config("robot")
-            .unwrap()
-            .model()
-            .unwrap();
-        let view = BirdseyeView::for_camera(&camera).unwrap();
+        let (_, view) = crate::test_support::robot_view();
         let got = Arc::new(Mutex::new(Vec::new()));
         let sink = Arc::clone(&got);
         let mut thread =
@@ -191,28 +189,8 @@ mod tests {
             })
             .unwrap();
         let (w, h) = (320, 240);
-        let lane = |side| lane_tracker::LaneReport {
-            side,
-            state: lane_tracker::LaneState::Tracking,
-            coeffs: Some([0.001, -0.5, 200.0]),
-            rows: [120.0, 239.0],
-            points: 9,
-            initialised: false,
-            far: None,
-        };
-        let report = TrackReport {
-            lanes: [
-                lane(lane_tracker::Side::Left),
-                lane(lane_tracker::Side::Right),
-            ],
-            full_gradient: false,
-            road: lane_tracker::RoadReport {
-                bottom_row_px: 240.0,
-                search_rows_px: [150.0, 240.0],
-                horizon_row_px: Some(60.0),
-                refused: None,
-            },
-        };
+        let lane = |side| tracked_lane(side, [0.001, -0.5, 200.0], [120.0, 239.0]);
+        let report = report([lane(Side::Left), lane(Side::Right)], Some(60.0));
         let mut expected = Vec::new();
         let mut encoder = LaneEncoder::default();
         let mut rgb = Vec::new();

@@ -33,6 +33,8 @@ pub mod mcap_sink;
 pub mod mcap_source;
 pub mod overlay;
 pub mod sources;
+#[cfg(test)]
+mod test_support;
 pub mod video;
 pub mod y4m;
 
