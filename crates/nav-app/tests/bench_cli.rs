@@ -24,19 +24,22 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// The size of the drawn stills of the import test.
 const W: u32 = 160;
 const H: u32 = 90;
 
-/// The two marks of the ego lane at row `y`: columns of the left and the right one.
-fn marks(y: u32) -> (u32, u32) {
-    (W / 4 + (H - 1 - y) / 4, 3 * W / 4 - (H - 1 - y) / 4)
+/// The two marks of the ego lane at row `y` of a `w × h` still: columns of the left and the
+/// right one.
+fn marks(y: u32, w: u32, h: u32) -> (u32, u32) {
+    let lean = (h - 1 - y) * w / 640;
+    (w / 4 + lean, 3 * w / 4 - lean)
 }
 
-/// A grey PNG with the two marks drawn bright on a dark road.
-fn write_frame(path: &Path) {
+/// A grey `w × h` PNG with the two marks drawn bright on a dark road.
+fn write_frame(path: &Path, w: u32, h: u32) {
     std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-    image::GrayImage::from_fn(W, H, |x, y| {
-        let (l, r) = marks(y);
+    image::GrayImage::from_fn(w, h, |x, y| {
+        let (l, r) = marks(y, w, h);
         let on = x.abs_diff(l) <= 1 || x.abs_diff(r) <= 1;
         image::Luma([if on { 220 } else { 60 }])
     })
@@ -44,11 +47,12 @@ fn write_frame(path: &Path) {
     .unwrap();
 }
 
-/// One TuSimple label record: both marks on rows 50, 55, …, 85.
-fn record(file: &str) -> String {
-    let rows: Vec<u32> = (50..H).step_by(5).collect();
-    let left: Vec<u32> = rows.iter().map(|&y| marks(y).0).collect();
-    let right: Vec<u32> = rows.iter().map(|&y| marks(y).1).collect();
+/// One TuSimple label record of a `w × h` still: both marks on every fifth row of its lower
+/// half.
+fn record(file: &str, w: u32, h: u32) -> String {
+    let rows: Vec<u32> = (h / 2 + h / 18..h).step_by(5).collect();
+    let left: Vec<u32> = rows.iter().map(|&y| marks(y, w, h).0).collect();
+    let right: Vec<u32> = rows.iter().map(|&y| marks(y, w, h).1).collect();
     serde_json::json!({"lanes": [left, right], "h_samples": rows, "raw_file": file}).to_string()
 }
 
@@ -62,18 +66,18 @@ fn an_imported_tusimple_set_is_scored_from_any_directory() {
     let data = dir.join("data");
     let files = ["clips/a/1/20.png", "clips/b/1/20.png", "clips/c/1/20.png"];
     for f in files {
-        write_frame(&data.join(f));
+        write_frame(&data.join(f), W, H);
     }
     // The fourth still (held out: the last of four) is cut short: its size reads,
     // its pixels do not decode.
-    write_frame(&data.join("clips/d/1/20.png"));
+    write_frame(&data.join("clips/d/1/20.png"), W, H);
     let bad = data.join("clips/d/1/20.png");
     let bytes = std::fs::read(&bad).unwrap();
     std::fs::write(&bad, &bytes[..bytes.len() - 24]).unwrap();
     let text: Vec<String> = files
         .iter()
         .chain(&["clips/d/1/20.png"])
-        .map(|f| record(f))
+        .map(|f| record(f, W, H))
         .collect();
     std::fs::write(data.join("label_data.json"), text.join("\n")).unwrap();
     let work = dir.join("work");
@@ -190,4 +194,104 @@ fn a_missing_data_directory_is_an_error_naming_it() {
         "{}",
         stderr(&o)
     );
+}
+
+/// A `w × h` still with the ego lane's two marks and a third mark right of the right one (the
+/// next lane's outer boundary), and its TuSimple record labelling that third mark as the right
+/// ego lane: the tracker's right lane misses its label, one of its candidates does not.
+fn write_relabelled(data: &Path, file: &str, w: u32, h: u32) -> String {
+    let outer = |y: u32| 3 * w / 4 + w / 5 - (h - 1 - y) * w / 1280;
+    let path = data.join(file);
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    image::GrayImage::from_fn(w, h, |x, y| {
+        let (l, r) = marks(y, w, h);
+        let on = x.abs_diff(l) <= 1 || x.abs_diff(r) <= 1 || x.abs_diff(outer(y)) <= 1;
+        image::Luma([if on { 220 } else { 60 }])
+    })
+    .save(&path)
+    .unwrap();
+    let rows: Vec<u32> = (h / 2 + h / 18..h).step_by(5).collect();
+    let left: Vec<u32> = rows.iter().map(|&y| marks(y, w, h).0).collect();
+    let right: Vec<u32> = rows.iter().map(|&y| outer(y)).collect();
+    serde_json::json!({"lanes": [left, right], "h_samples": rows, "raw_file": file}).to_string()
+}
+
+#[test]
+fn under_each_perturbation_the_bound_of_the_choice_is_reported_and_bounds_the_default() {
+    let (w, h) = (320, 180);
+    let dir = scratch("perturb");
+    let data = dir.join("data");
+    let files = [
+        "clips/a/1/20.png",
+        "clips/b/1/20.png",
+        "clips/c/1/20.png",
+        "clips/d/1/20.png",
+    ];
+    let text: Vec<String> = files
+        .iter()
+        .map(|f| write_relabelled(&data, f, w, h))
+        .collect();
+    std::fs::write(data.join("label_data.json"), text.join("\n")).unwrap();
+    let import = nav_app(
+        &dir,
+        &[
+            "import-lanes",
+            "--format",
+            "tusimple",
+            "--out",
+            "sets/drawn",
+            "data/label_data.json",
+        ],
+    );
+    assert!(import.status.success(), "{}", stderr(&import));
+    let eval = nav_app(
+        &dir,
+        &[
+            "eval-lanes",
+            "--data",
+            "sets",
+            "--out",
+            "report",
+            "--config",
+            "outdoor",
+            "--perturb",
+        ],
+    );
+    assert!(eval.status.success(), "{}", stderr(&eval));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report/summary.json")).unwrap())
+            .unwrap();
+    let acc = |rates: &serde_json::Value, split: &str| {
+        rates[split]["tusimple_accuracy"].as_f64().unwrap()
+    };
+    let unperturbed_bound = &summary["overall"]["best-of-candidates"];
+    let perturbations = summary["perturbations"].as_array().unwrap();
+    assert_eq!(perturbations.len(), 15);
+    for p in perturbations {
+        let name = p["perturbation"].as_str().unwrap();
+        let bound = &p["best_of_candidates"];
+        for split in ["dev", "holdout"] {
+            // The output's right lane is on the ego mark, off its label; the candidate on the
+            // labelled mark is the bound's, under every perturbation of these stills.
+            assert!(acc(&p["overall"], split) < 0.6, "{name} {split}: {p}");
+            assert!(acc(bound, split) > 0.99, "{name} {split}: {p}");
+            assert_eq!(
+                acc(&p["best_of_candidates_sets"]["drawn"], split),
+                acc(bound, split),
+                "{name}: one set, its figures are the pooled ones"
+            );
+        }
+        if name == "width-320" {
+            // The stills' own width: the frames as they are, so the bound as it is.
+            for split in ["dev", "holdout", "all"] {
+                assert_eq!(acc(bound, split), acc(unperturbed_bound, split), "{p}");
+            }
+        }
+    }
+    let md = std::fs::read_to_string(dir.join("report/summary.md")).unwrap();
+    assert!(
+        md.contains("The bound of the default's choice under each perturbation"),
+        "{md}"
+    );
+    assert!(md.contains("| perturbation | hold-out best | Δ | bound on the default's Δ |"));
 }

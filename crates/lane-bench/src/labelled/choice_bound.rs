@@ -60,7 +60,7 @@ pub fn choice_bound_set(
     estimator: Estimator,
     rules: &ScoringRules,
 ) -> Result<ChoiceBound, BenchError> {
-    let y_top = rules.eval_top_fraction * set.height as f64;
+    let y_top = super::near_top_px(rules, set.height);
     let tus_px = rules.tusimple_px_at_1280 * set.width as f64 / 1280.0;
     let n = set.frames.len();
     let mut out = ChoiceBound {
@@ -77,36 +77,50 @@ pub fn choice_bound_set(
             out.best_or_none.push([None, None]);
             return Ok(());
         };
-        let tracker = t.tracker;
         let output: EgoPrediction = super::run::ego_of(&t.report);
-        let searched = candidate_rows_px(tracker);
-        let (mut best, mut best_or_none) = (output, output);
-        for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
-            let pts = scored_points(labels, side, y_top);
-            if pts.len() < 2 {
-                continue;
-            }
-            let accuracy = |c: [f64; 3]| tusimple_lane_accuracy(&pts, c, tus_px, &mut 0.0);
-            let mut top = output[k].map_or(0.0, |p| accuracy(p.coeffs));
-            for c in tracker.init_candidates() {
-                let a = accuracy(c.coeffs);
-                if a > top {
-                    top = a;
-                    best[k] = Some(PredictedLane {
-                        coeffs: c.coeffs,
-                        rows_px: searched,
-                        far: None,
-                    });
-                }
-            }
-            best_or_none[k] = best[k].filter(|_| top >= NEAR_MISS_FRACTION);
-        }
+        let (best, best_or_none) = best_of_candidates(t.tracker, &output, labels, y_top, tus_px);
         out.output.push(output);
         out.best.push(best);
         out.best_or_none.push(best_or_none);
         Ok(())
     })?;
     Ok(out)
+}
+
+/// Per side, the best of `output` and `tracker`'s candidates against `labels`' points below
+/// `y_top` (TuSimple point accuracy at `tus_px`), and that best without the lanes under
+/// [`NEAR_MISS_FRACTION`]: the [`ChoiceBound`]'s `best` and `best_or_none` of one frame
+/// (module docs). A side with fewer than two scored label points keeps the output.
+pub(crate) fn best_of_candidates(
+    tracker: &lane_tracker::LaneTracker,
+    output: &EgoPrediction,
+    labels: &super::LabelFrame,
+    y_top: f64,
+    tus_px: f64,
+) -> (EgoPrediction, EgoPrediction) {
+    let searched = candidate_rows_px(tracker);
+    let (mut best, mut best_or_none) = (*output, *output);
+    for (k, side) in [LabelSide::Left, LabelSide::Right].into_iter().enumerate() {
+        let pts = scored_points(labels, side, y_top);
+        if pts.len() < 2 {
+            continue;
+        }
+        let accuracy = |c: [f64; 3]| tusimple_lane_accuracy(&pts, c, tus_px, &mut 0.0);
+        let mut top = output[k].map_or(0.0, |p| accuracy(p.coeffs));
+        for c in tracker.init_candidates() {
+            let a = accuracy(c.coeffs);
+            if a > top {
+                top = a;
+                best[k] = Some(PredictedLane {
+                    coeffs: c.coeffs,
+                    rows_px: searched,
+                    far: None,
+                });
+            }
+        }
+        best_or_none[k] = best[k].filter(|_| top >= NEAR_MISS_FRACTION);
+    }
+    (best, best_or_none)
 }
 
 /// The row extent given to `tracker`'s candidates (module docs): `[top, bottom − 1]` of the

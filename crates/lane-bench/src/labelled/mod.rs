@@ -685,6 +685,7 @@ mod tests;
 
 pub use ceiling::{ceiling_prediction, whole_label_ceiling};
 pub use census::{LaneCensus, LaneStage, StageCensus, census_lanes};
+pub(crate) use choice_bound::best_of_candidates;
 pub use choice_bound::{ChoiceBound, choice_bound_set};
 pub use full_rule::{FullRates, FullTotals, score_frame_full};
 pub(crate) use run::{FileStills, Stills, ego_of, run_label_set, run_stills};

@@ -84,7 +84,7 @@ pub struct FullSplitRates {
 }
 
 /// One configuration's figures on one set (or overall).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct SplitRates {
     /// Every frame.
     pub all: LaneRates,

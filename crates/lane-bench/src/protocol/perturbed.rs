@@ -2,7 +2,10 @@
 //! frames changed as other cameras would give them ([`crate::perturb::TABLE`]), scored on the
 //! near band — the rows that were the near band before the perturbation, mapped
 //! ([`crate::perturb`]) — per set and overall, development and held-out parts, beside the
-//! unperturbed run.
+//! unperturbed run. From the same runs, the bound of the default's choice under each
+//! perturbation ([`crate::labelled::choice_bound_set`]'s *best*: per side the best of its output
+//! and its candidates, picked by the labels): where even that bound loses more than a target
+//! allows, no choice among the candidates can meet it, and the loss is the detection's.
 //!
 //! Each set's frames are decoded once and kept; each perturbation's frames are made from them
 //! one at a time as the frame loop asks for them (a frame source over memory, never a file),
@@ -21,8 +24,8 @@ use serde::{Deserialize, Serialize};
 use super::{DEFAULT_NAME, SplitRates, SplitTotals, Summary, dev_count};
 use crate::BenchError;
 use crate::labelled::{
-    FileStills, LabelFrame, LabelSet, LaneRates, LaneTotals, ScoringRules, Stills, ego_of,
-    near_top_px, run_stills, score_sides_from,
+    FileStills, LabelFrame, LabelSet, LaneRates, LaneTotals, ScoringRules, Stills,
+    best_of_candidates, ego_of, near_top_px, run_stills, score_sides_from,
 };
 use crate::perturb::{Perturbation, TABLE, TABLE_SEED, frame_seed};
 
@@ -37,6 +40,14 @@ pub struct PerturbedSummary {
     pub sets: BTreeMap<String, SplitRates>,
     /// Pooled over every set.
     pub overall: SplitRates,
+    /// The bound of the default's choice under the perturbation
+    /// ([`super::CHOICE_BOUND_NAME`]: per side the best of its output and its candidates,
+    /// picked by the labels), per set; absent from files written before it.
+    #[serde(default)]
+    pub best_of_candidates_sets: BTreeMap<String, SplitRates>,
+    /// … pooled over every set.
+    #[serde(default)]
+    pub best_of_candidates: SplitRates,
 }
 
 /// The frames of one set under one perturbation, made in memory from the decoded originals.
@@ -108,6 +119,8 @@ pub(super) fn perturbation_table(
     }
     let mut per_set: Vec<BTreeMap<String, SplitRates>> = vec![BTreeMap::new(); TABLE.len()];
     let mut overall = vec![SplitTotals::default(); TABLE.len()];
+    let mut best_per_set: Vec<BTreeMap<String, SplitRates>> = vec![BTreeMap::new(); TABLE.len()];
+    let mut best_overall = vec![SplitTotals::default(); TABLE.len()];
     let mut times = vec![Duration::ZERO; TABLE.len()];
     for (dir, set) in sets {
         let originals: Vec<Option<GreyFrame>> = set
@@ -141,6 +154,8 @@ pub(super) fn perturbation_table(
                 perturbation: *p,
             };
             let mut totals = SplitTotals::default();
+            let mut best_totals = SplitTotals::default();
+            let tus_px = rules.tusimple_px_at_1280 * width as f64 / 1280.0;
             let n = mapped.frames.len();
             run_stills(
                 &mut stills,
@@ -150,26 +165,37 @@ pub(super) fn perturbation_table(
                 n,
                 |i, labels, t| {
                     let prediction = t.map_or([None, None], |t| ego_of(&t.report));
-                    let sides = score_sides_from(labels, width, height, &prediction, rules, y_top);
-                    totals.add(&LaneTotals::of_frame(&sides), i < n_dev);
+                    let best = t.map_or([None, None], |t| {
+                        best_of_candidates(t.tracker, &prediction, labels, y_top, tus_px).0
+                    });
+                    let score = |p| {
+                        let sides = score_sides_from(labels, width, height, p, rules, y_top);
+                        LaneTotals::of_frame(&sides)
+                    };
+                    totals.add(&score(&prediction), i < n_dev);
+                    best_totals.add(&score(&best), i < n_dev);
                     Ok(())
                 },
             )
             .map_err(|e| e.during(format!("set {} under {}", set.set, p.name())))?;
             overall[k].merge(&totals);
             per_set[k].insert(set.set.clone(), totals.rates());
+            best_overall[k].merge(&best_totals);
+            best_per_set[k].insert(set.set.clone(), best_totals.rates());
             times[k] += start.elapsed();
         }
     }
     let summaries = TABLE
         .iter()
-        .zip(per_set)
-        .zip(&overall)
-        .map(|((p, sets), all)| PerturbedSummary {
+        .zip(per_set.into_iter().zip(&overall))
+        .zip(best_per_set.into_iter().zip(&best_overall))
+        .map(|((p, (sets, all)), (best_sets, best_all))| PerturbedSummary {
             perturbation: p.name(),
             description: p.describe(),
             sets,
             overall: all.rates(),
+            best_of_candidates_sets: best_sets,
+            best_of_candidates: best_all.rates(),
         })
         .collect();
     let times = TABLE.iter().map(Perturbation::name).zip(times).collect();
@@ -239,6 +265,7 @@ pub(super) fn render(s: &Summary, dev_only: bool) -> String {
         }
         md += "\n";
     }
+    md += &render_choice_bound(s, parts, base);
     for (part, pick) in parts {
         md += &format!(
             "\nPer set, {part} part: TuSimple accuracy / FP, % (Δ accuracy, points).\n\n\
@@ -278,6 +305,48 @@ pub(super) fn render(s: &Summary, dev_only: bool) -> String {
             }
             md += "\n";
         }
+    }
+    md
+}
+
+/// The bound of the default's choice under each perturbation: what the best of its candidates
+/// reaches there, its change, and how far the default could at best stay from its unperturbed
+/// figure with a perfect choice among those candidates.
+fn render_choice_bound(s: &Summary, parts: &[(&str, Pick)], base: &SplitRates) -> String {
+    let Some(base_best) = s.overall.get(super::CHOICE_BOUND_NAME) else {
+        return String::new();
+    };
+    let mut md = format!(
+        "\nThe bound of the default's choice under each perturbation ({}: per side the best of \
+         its output and its candidates, picked by the labels; near band, TuSimple accuracy in \
+         %). Δ: against the bound on the frames as they are; *bound on the default's Δ*: the \
+         bound under the perturbation − the default on the frames as they are, the least any \
+         choice among these candidates loses (a loss beyond the target there is the detection's, \
+         not the choice's).\n\n| perturbation |",
+        super::CHOICE_BOUND_NAME
+    );
+    for (part, _) in parts {
+        md += &format!(" {part} best | Δ | bound on the default's Δ |");
+    }
+    md += "\n|---|";
+    md += &"---|---|---|".repeat(parts.len());
+    md += "\n| none |";
+    for (_, pick) in parts {
+        md += &format!(" {} | | |", pct(pick(base_best).tusimple_accuracy));
+    }
+    md += "\n";
+    for p in &s.perturbations {
+        md += &format!("| {} |", p.perturbation);
+        for (_, pick) in parts {
+            let (r, b, d) = (pick(&p.best_of_candidates), pick(base_best), pick(base));
+            md += &format!(
+                " {} | {} | {} |",
+                pct(r.tusimple_accuracy),
+                delta(r.tusimple_accuracy, b.tusimple_accuracy),
+                delta(r.tusimple_accuracy, d.tusimple_accuracy)
+            );
+        }
+        md += "\n";
     }
     md
 }
