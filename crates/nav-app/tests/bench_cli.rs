@@ -261,6 +261,7 @@ fn under_each_perturbation_the_bound_of_the_choice_is_reported_and_bounds_the_de
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("report/summary.json")).unwrap())
             .unwrap();
+    assert_eq!(summary["schema"], 4, "the bound's fields are schema 4's");
     let acc = |rates: &serde_json::Value, split: &str| {
         rates[split]["tusimple_accuracy"].as_f64().unwrap()
     };

@@ -51,8 +51,10 @@ pub use perturbed::PerturbedSummary;
 pub use report::FRAMES_CSV_HEADER;
 
 /// Format version of `summary.json` (3: the full rule, `full_rule` and `overall_full_rule`, and
-/// the perturbation table, `perturbations`, were added; the near band's fields are as in 2).
-pub const SUMMARY_SCHEMA: u32 = 3;
+/// the perturbation table, `perturbations`, were added; the near band's fields are as in 2. 4:
+/// each perturbation's `best_of_candidates` and `best_of_candidates_sets`, the bound of the
+/// default's choice under it, were added).
+pub const SUMMARY_SCHEMA: u32 = 4;
 /// Fraction of every set's frames (the first ones, in set order) in the development part.
 pub const DEV_FRACTION: f64 = 0.7;
 /// Name of the default configuration in the reports.
