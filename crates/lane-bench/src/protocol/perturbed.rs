@@ -189,14 +189,16 @@ pub(super) fn perturbation_table(
         .iter()
         .zip(per_set.into_iter().zip(&overall))
         .zip(best_per_set.into_iter().zip(&best_overall))
-        .map(|((p, (sets, all)), (best_sets, best_all))| PerturbedSummary {
-            perturbation: p.name(),
-            description: p.describe(),
-            sets,
-            overall: all.rates(),
-            best_of_candidates_sets: best_sets,
-            best_of_candidates: best_all.rates(),
-        })
+        .map(
+            |((p, (sets, all)), (best_sets, best_all))| PerturbedSummary {
+                perturbation: p.name(),
+                description: p.describe(),
+                sets,
+                overall: all.rates(),
+                best_of_candidates_sets: best_sets,
+                best_of_candidates: best_all.rates(),
+            },
+        )
         .collect();
     let times = TABLE.iter().map(Perturbation::name).zip(times).collect();
     Ok((summaries, times))
