@@ -295,4 +295,10 @@ fn under_each_perturbation_the_bound_of_the_choice_is_reported_and_bounds_the_de
         "{md}"
     );
     assert!(md.contains("| perturbation | hold-out best | Δ | bound on the default's Δ |"));
+    // Per set: the default / the bound under the stills' own width, the bound 100 %.
+    assert!(
+        md.contains("Per set, hold-out part: the default / the bound of its choice"),
+        "{md}"
+    );
+    assert!(md.contains("| width-320 | 50.0 / 100.0 (+50.0) |"), "{md}");
 }

@@ -350,5 +350,41 @@ fn render_choice_bound(s: &Summary, parts: &[(&str, Pick)], base: &SplitRates) -
         }
         md += "\n";
     }
+    for (part, pick) in parts {
+        md += &format!(
+            "\nPer set, {part} part: the default / the bound of its choice under each \
+             perturbation, % (the bound − the default on the frames as they are, points).\n\n\
+             | perturbation |"
+        );
+        for set in &s.sets {
+            md += &format!(" {} |", set.set);
+        }
+        md += "\n|---|";
+        md += &"---|".repeat(s.sets.len());
+        md += "\n";
+        for p in &s.perturbations {
+            md += &format!("| {} |", p.perturbation);
+            for set in &s.sets {
+                let cells = (
+                    p.sets.get(&set.set),
+                    p.best_of_candidates_sets.get(&set.set),
+                    set.results.get(DEFAULT_NAME),
+                );
+                match cells {
+                    (Some(r), Some(b), Some(d)) => {
+                        let (r, b, d) = (pick(r), pick(b), pick(d));
+                        md += &format!(
+                            " {} / {} ({}) |",
+                            pct(r.tusimple_accuracy),
+                            pct(b.tusimple_accuracy),
+                            delta(b.tusimple_accuracy, d.tusimple_accuracy)
+                        );
+                    }
+                    _ => md += " |",
+                }
+            }
+            md += "\n";
+        }
+    }
     md
 }
