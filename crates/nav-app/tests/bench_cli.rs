@@ -56,6 +56,22 @@ fn record(file: &str, w: u32, h: u32) -> String {
     serde_json::json!({"lanes": [left, right], "h_samples": rows, "raw_file": file}).to_string()
 }
 
+/// `nav-app eval-lanes` run in `cwd` on its `sets/` with the `outdoor` preset beside the
+/// default, into `report/`, with `extra` options.
+fn eval_sets(cwd: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "eval-lanes",
+        "--data",
+        "sets",
+        "--out",
+        "report",
+        "--config",
+        "outdoor",
+    ];
+    args.extend_from_slice(extra);
+    nav_app(cwd, &args)
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -100,18 +116,7 @@ fn an_imported_tusimple_set_is_scored_from_any_directory() {
     assert!(said.contains("4 frames (160×90)"), "{said}");
     assert!(work.join("sets/drawn/labels.json").is_file());
 
-    let eval = nav_app(
-        &work,
-        &[
-            "eval-lanes",
-            "--data",
-            "sets",
-            "--out",
-            "report",
-            "--config",
-            "outdoor",
-        ],
-    );
+    let eval = eval_sets(&work, &[]);
     assert!(eval.status.success(), "{}", stderr(&eval));
     // The bad still is reported, naming it, and the run goes on.
     let err = stderr(&eval);
@@ -244,19 +249,7 @@ fn under_each_perturbation_the_bound_of_the_choice_is_reported_and_bounds_the_de
         ],
     );
     assert!(import.status.success(), "{}", stderr(&import));
-    let eval = nav_app(
-        &dir,
-        &[
-            "eval-lanes",
-            "--data",
-            "sets",
-            "--out",
-            "report",
-            "--config",
-            "outdoor",
-            "--perturb",
-        ],
-    );
+    let eval = eval_sets(&dir, &["--perturb"]);
     assert!(eval.status.success(), "{}", stderr(&eval));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("report/summary.json")).unwrap())

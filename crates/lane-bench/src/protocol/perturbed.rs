@@ -21,7 +21,7 @@ use lane_io::{GreyFrame, LaneIoError};
 use lane_tracker::{Estimator, TrackerConfig};
 use serde::{Deserialize, Serialize};
 
-use super::{DEFAULT_NAME, SplitRates, SplitTotals, Summary, dev_count};
+use super::{DEFAULT_NAME, SetSummary, SplitRates, SplitTotals, Summary, dev_count};
 use crate::BenchError;
 use crate::labelled::{
     FileStills, LabelFrame, LabelSet, LaneRates, LaneTotals, ScoringRules, Stills,
@@ -269,43 +269,30 @@ pub(super) fn render(s: &Summary, dev_only: bool) -> String {
     }
     md += &render_choice_bound(s, parts, base);
     for (part, pick) in parts {
-        md += &format!(
-            "\nPer set, {part} part: TuSimple accuracy / FP, % (Δ accuracy, points).\n\n\
-             | perturbation |"
-        );
-        for set in &s.sets {
-            md += &format!(" {} |", set.set);
-        }
-        md += "\n|---|";
-        md += &"---|".repeat(s.sets.len());
-        md += "\n| none |";
-        for set in &s.sets {
-            match set.results.get(DEFAULT_NAME) {
-                Some(r) => {
-                    let r = pick(r);
-                    md += &format!(" {} / {} |", pct(r.tusimple_accuracy), pct(r.tusimple_fp));
-                }
-                None => md += " |",
-            }
-        }
-        md += "\n";
+        md +=
+            &format!("\nPer set, {part} part: TuSimple accuracy / FP, % (Δ accuracy, points).\n\n");
+        md += &per_set_header(s);
+        md += &per_set_row(s, "none", |set| {
+            let r = pick(set.results.get(DEFAULT_NAME)?);
+            Some(format!(
+                "{} / {}",
+                pct(r.tusimple_accuracy),
+                pct(r.tusimple_fp)
+            ))
+        });
         for p in &s.perturbations {
-            md += &format!("| {} |", p.perturbation);
-            for set in &s.sets {
-                match (p.sets.get(&set.set), set.results.get(DEFAULT_NAME)) {
-                    (Some(r), Some(b)) => {
-                        let (r, b) = (pick(r), pick(b));
-                        md += &format!(
-                            " {} / {} ({}) |",
-                            pct(r.tusimple_accuracy),
-                            pct(r.tusimple_fp),
-                            delta(r.tusimple_accuracy, b.tusimple_accuracy)
-                        );
-                    }
-                    _ => md += " |",
-                }
-            }
-            md += "\n";
+            md += &per_set_row(s, &p.perturbation, |set| {
+                let (r, b) = (
+                    pick(p.sets.get(&set.set)?),
+                    pick(set.results.get(DEFAULT_NAME)?),
+                );
+                Some(format!(
+                    "{} / {} ({})",
+                    pct(r.tusimple_accuracy),
+                    pct(r.tusimple_fp),
+                    delta(r.tusimple_accuracy, b.tusimple_accuracy)
+                ))
+            });
         }
     }
     md
@@ -353,38 +340,42 @@ fn render_choice_bound(s: &Summary, parts: &[(&str, Pick)], base: &SplitRates) -
     for (part, pick) in parts {
         md += &format!(
             "\nPer set, {part} part: the default / the bound of its choice under each \
-             perturbation, % (the bound − the default on the frames as they are, points).\n\n\
-             | perturbation |"
+             perturbation, % (the bound − the default on the frames as they are, points).\n\n"
         );
-        for set in &s.sets {
-            md += &format!(" {} |", set.set);
-        }
-        md += "\n|---|";
-        md += &"---|".repeat(s.sets.len());
-        md += "\n";
+        md += &per_set_header(s);
         for p in &s.perturbations {
-            md += &format!("| {} |", p.perturbation);
-            for set in &s.sets {
-                let cells = (
-                    p.sets.get(&set.set),
-                    p.best_of_candidates_sets.get(&set.set),
-                    set.results.get(DEFAULT_NAME),
-                );
-                match cells {
-                    (Some(r), Some(b), Some(d)) => {
-                        let (r, b, d) = (pick(r), pick(b), pick(d));
-                        md += &format!(
-                            " {} / {} ({}) |",
-                            pct(r.tusimple_accuracy),
-                            pct(b.tusimple_accuracy),
-                            delta(b.tusimple_accuracy, d.tusimple_accuracy)
-                        );
-                    }
-                    _ => md += " |",
-                }
-            }
-            md += "\n";
+            md += &per_set_row(s, &p.perturbation, |set| {
+                let r = pick(p.sets.get(&set.set)?);
+                let b = pick(p.best_of_candidates_sets.get(&set.set)?);
+                let d = pick(set.results.get(DEFAULT_NAME)?);
+                Some(format!(
+                    "{} / {} ({})",
+                    pct(r.tusimple_accuracy),
+                    pct(b.tusimple_accuracy),
+                    delta(b.tusimple_accuracy, d.tusimple_accuracy)
+                ))
+            });
         }
     }
     md
+}
+
+/// The head of a per-set table: a column per set of `s`.
+fn per_set_header(s: &Summary) -> String {
+    let mut md = String::from("| perturbation |");
+    for set in &s.sets {
+        md += &format!(" {} |", set.set);
+    }
+    md += "\n|---|";
+    md += &"---|".repeat(s.sets.len());
+    md + "\n"
+}
+
+/// One row of a per-set table: `name`, then `cell` of each set of `s` (blank where `None`).
+fn per_set_row(s: &Summary, name: &str, cell: impl Fn(&SetSummary) -> Option<String>) -> String {
+    let mut md = format!("| {name} |");
+    for set in &s.sets {
+        md += &format!(" {} |", cell(set).unwrap_or_default());
+    }
+    md + "\n"
 }
