@@ -79,6 +79,15 @@ pub fn mechanisms() -> Vec<Mechanism> {
             others: &[],
         },
         Mechanism {
+            name: "dark frames brightened",
+            keys: "exposure.below_median_grey",
+            off: value!("0 (never)", |c| c.exposure.below_median_grey = 0.0),
+            others: &[
+                value!("40 grey levels", |c| c.exposure.below_median_grey = 40.0),
+                value!("60 grey levels", |c| c.exposure.below_median_grey = 60.0),
+            ],
+        },
+        Mechanism {
             name: "noisy frames smoothed",
             keys: "denoise.above_noise_grey",
             off: value!("0 (never)", |c| c.denoise.above_noise_grey = 0.0),

@@ -111,6 +111,7 @@ fn pass(
             t_s,
             lanes: &report.lanes,
             road: report.road,
+            exposure: tracker.frame_exposure(),
             noise: tracker.frame_noise(),
             track_us: dt.as_secs_f64() * 1e6,
             ego_lane: None,

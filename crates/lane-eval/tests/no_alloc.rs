@@ -179,3 +179,32 @@ fn noisy_frames_smoothed_before_tracking_do_not_allocate() {
         assert_eq!(allocs, 0, "{w}×{h}: {allocs} allocations");
     }
 }
+
+#[test]
+fn brightened_dark_frames_do_not_allocate() {
+    // The default on a camera at a fifth of the scene's exposure: every frame brightened before
+    // the stages read it (module `lane_tracker::tracker::exposure`), the road's bottom looked
+    // for with the gain, re-initialisations included.
+    let cfg = TrackerConfig::default_preset().unwrap();
+    let spec = SCENES
+        .iter()
+        .find(|s| s.name == "wall_recovery")
+        .copied()
+        .unwrap();
+    let mut renderer = SceneRenderer::new(spec, 320, 240);
+    let mut tracker = LaneTracker::new(&cfg, Estimator::Kif, 320, 240).unwrap();
+    let mut frame = GreyFrame::default();
+    let mut allocs = 0;
+    for i in 0..spec.frames {
+        renderer.render(i, &mut frame);
+        for v in frame.data_mut() {
+            *v /= 5;
+        }
+        let (report, n) = allocations_in(|| tracker.track(&frame));
+        report.unwrap();
+        assert!(tracker.frame_exposure().gain > 1.0, "frame {i}");
+        allocs += n;
+    }
+    assert!(spec.frames > 20);
+    assert_eq!(allocs, 0, "{allocs} allocations in {} frames", spec.frames);
+}

@@ -3,7 +3,7 @@
 //! JSON schema [`crate::mcap_sink::LANES_SCHEMA`] (`docs/json.md` documents its fields).
 
 use lane_tracker::camera::EgoLaneReport;
-use lane_tracker::{FrameNoise, LaneReport, RoadReport};
+use lane_tracker::{FrameExposure, FrameNoise, LaneReport, RoadReport};
 use serde::Serialize;
 
 use crate::capture_source::DeviceFrameInfo;
@@ -26,6 +26,9 @@ pub struct LaneFrame<'a> {
     /// The road region the frame was searched in: the road's bottom row, the rows searched and
     /// the horizon the ego lanes show (`lane_tracker::RoadReport`).
     pub road: RoadReport,
+    /// The frames' exposure as last measured and the gain they are brightened by before tracking
+    /// (`lane_tracker::FrameExposure`, `[exposure]`).
+    pub exposure: FrameExposure,
     /// The frames' noise as last measured and whether they are smoothed before tracking
     /// (`lane_tracker::FrameNoise`, `[denoise]`).
     pub noise: FrameNoise,
@@ -94,6 +97,10 @@ mod tests {
                 search_rows_px: [148.0, 240.0],
                 horizon_row_px: Some(96.5),
                 refused: None,
+            },
+            exposure: FrameExposure {
+                median_grey: 42.0,
+                gain: 50.0 / 42.0,
             },
             noise: FrameNoise {
                 sigma_grey: 1.7,

@@ -341,14 +341,15 @@ mod tracker;
 mod wrls_lane;
 
 pub use config::{
-    DEFAULT_TOML, DEFAULT_WORKING_WIDTH_PX, DenoiseConfig, FilterConfig, FrameConfig,
-    GradientConfig, INDOOR_TOML, InitConfig, OUTDOOR_TOML, RoadBottom, RoiConfig, TrackConfig,
-    TrackerConfig,
+    DEFAULT_TOML, DEFAULT_WORKING_WIDTH_PX, DenoiseConfig, ExposureConfig, FilterConfig,
+    FrameConfig, GradientConfig, INDOOR_TOML, InitConfig, OUTDOOR_TOML, RoadBottom, RoiConfig,
+    TrackConfig, TrackerConfig,
 };
 pub use error::{FilterFailure, TrackerError};
 /// The workspace's one grey frame (crate `grey-frame`).
 pub use grey_frame::{FrameError, GreyFrame};
 pub use tracker::{
-    Estimator, FarSegment, FrameNoise, InitCandidate, LaneReport, LaneState, LaneTracker, LaneView,
-    RoadRefusal, RoadReport, Side, TrackReport, TrackerCounters,
+    Estimator, FarSegment, FrameExposure, FrameNoise, InitCandidate, LaneReport, LaneState,
+    LaneTracker, LaneView, MAX_EXPOSURE_GAIN, RoadRefusal, RoadReport, Side, TrackReport,
+    TrackerCounters,
 };

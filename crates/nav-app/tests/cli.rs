@@ -102,9 +102,14 @@ fn json_is_one_object_per_frame_with_the_documented_schema() {
         assert_eq!(
             keys,
             [
-                "frame", "lanes", "noise", "road", "schema", "t_s", "track_us"
+                "exposure", "frame", "lanes", "noise", "road", "schema", "t_s", "track_us"
             ]
         );
+        // Rendered frames exposed as the settings assume: measured, above the limit, not
+        // brightened.
+        let median = v["exposure"]["median_grey"].as_f64().unwrap();
+        assert!(median >= 50.0, "median grey {median}");
+        assert_eq!(v["exposure"]["gain"], 1.0);
         // Rendered frames with σ = 2 noise: measured, below the default's limit, not smoothed.
         let sigma = v["noise"]["sigma_grey"].as_f64().unwrap();
         assert!(sigma > 0.5 && sigma < 4.0, "σ̂ {sigma}");

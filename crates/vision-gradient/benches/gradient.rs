@@ -1,6 +1,7 @@
 //! Criterion benches of the directional gradient: full frame (fixed and adaptive threshold,
 //! AVX2 and portable backends) at 320×240 and 640×480, and the tracking mode (two windows);
-//! and of the periodic-stripe filter on a frame's edges.
+//! of the periodic-stripe filter on a frame's edges; and of the exposure's kernels (the median
+//! grey of the rows searched, a frame brightened).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -9,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 use vision_gradient::{
     Backend, ColSpan, EdgeBuffer, GradientDetector, GradientParams, GreyImage,
-    PeriodicStripeParams, Region, Threshold, drop_periodic_stripes,
+    PeriodicStripeParams, Region, Threshold, brighten, drop_periodic_stripes, median_grey,
 };
 
 /// Road-like test frame: textured grey with two bright diagonal marks.
@@ -169,5 +170,23 @@ fn bench_periodic(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, bench_periodic);
+fn bench_exposure(c: &mut Criterion) {
+    let mut group = c.benchmark_group("exposure");
+    let (w, h) = (320usize, 240usize);
+    let data: Vec<u8> = frame(w, h).iter().map(|&v| v / 3).collect();
+    let img = GreyImage::new(&data, w, h, w).unwrap();
+    // The default ROI of a 320×240 frame: rows 148..240.
+    let roi = (148, h);
+    let mut hist = [0u32; 256];
+    group.bench_function(BenchmarkId::new("median_grey", "320x240_roi"), |b| {
+        b.iter(|| median_grey(black_box(&img), roi, &mut hist))
+    });
+    let mut out = vec![0u8; w * h];
+    group.bench_function(BenchmarkId::new("brighten", "320x240_rows_0_240"), |b| {
+        b.iter(|| brighten(black_box(&img), (0, h), 1.7, &mut out).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_periodic, bench_exposure);
 criterion_main!(benches);

@@ -162,6 +162,7 @@
 
 mod edges;
 mod error;
+mod exposure;
 mod image;
 mod kernel;
 mod noise;
@@ -173,6 +174,7 @@ mod ridge;
 
 pub use edges::{EdgeBuffer, EdgeClass, EdgePixel, EdgeStats};
 pub use error::GradientError;
+pub use exposure::{brighten, brighten_in_place, median_grey};
 pub use image::{GreyImage, MAX_SIDE_PX};
 pub use noise::{NOISE_MEDIAN_PER_SIGMA, noise_sigma_grey, smooth_binomial};
 pub use normal::gradient_normal_deg;

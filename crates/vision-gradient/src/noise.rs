@@ -97,7 +97,7 @@ pub fn smooth_binomial(
 }
 
 /// The smallest value with at least half of the `n` counted values at or below it.
-fn median(hist: &[u32], n: usize) -> u32 {
+pub(crate) fn median(hist: &[u32], n: usize) -> u32 {
     let k = n.div_ceil(2).max(1);
     let mut acc = 0usize;
     for (v, &count) in hist.iter().enumerate() {

@@ -478,6 +478,18 @@ pub struct DenoiseConfig {
     pub above_noise_grey: f64,
 }
 
+/// The frame's exposure (an addition beyond the paper; module `tracker::exposure`): the median
+/// grey of the rows searched, measured on the noise stage's schedule, and a frame darker than the
+/// exposures the settings were tuned on brightened up to them. Absent: never.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ExposureConfig {
+    /// Median grey of the rows searched, grey levels, below which the frame's grey levels are
+    /// multiplied by `below_median_grey / median` (at most 2) before the stages read them; 0 =
+    /// never (the default when absent).
+    pub below_median_grey: f64,
+}
+
 /// The whole tracker configuration (one TOML file).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -485,6 +497,9 @@ pub struct TrackerConfig {
     /// The working resolution (`[frame]`; absent: 320 px wide).
     #[serde(default)]
     pub frame: FrameConfig,
+    /// The frame's exposure (`[exposure]`; absent: never brightened).
+    #[serde(default)]
+    pub exposure: ExposureConfig,
     /// The frame's noise (`[denoise]`; absent: never smoothed).
     #[serde(default)]
     pub denoise: DenoiseConfig,

@@ -64,6 +64,12 @@ fn each_out_of_range_field_is_named() {
     type Edit = fn(&mut TrackerConfig);
     let cases: &[(&str, Edit)] = &[
         ("frame.working_width_px", |c| c.frame.working_width_px = 15),
+        ("exposure.below_median_grey", |c| {
+            c.exposure.below_median_grey = -1.0
+        }),
+        ("exposure.below_median_grey", |c| {
+            c.exposure.below_median_grey = 256.0
+        }),
         ("denoise.above_noise_grey", |c| {
             c.denoise.above_noise_grey = -1.0
         }),
@@ -430,7 +436,18 @@ fn denoising_is_off_when_absent_and_its_limit_is_located_in_a_file_when_out_of_r
     for preset in [OUTDOOR_TOML, INDOOR_TOML] {
         let c = TrackerConfig::from_toml_str("p.toml", preset).unwrap();
         assert_eq!(c.denoise.above_noise_grey, 0.0);
+        assert_eq!(
+            c.exposure.below_median_grey, 0.0,
+            "brightening off when absent"
+        );
     }
+    assert_eq!(
+        TrackerConfig::default_preset()
+            .unwrap()
+            .exposure
+            .below_median_grey,
+        50.0
+    );
     assert_eq!(
         TrackerConfig::default_preset()
             .unwrap()

@@ -13,6 +13,13 @@ impl TrackerConfig {
             w,
             "must be 0 (the input's own size) or in 16..=16384 px",
         )?;
+        let m = self.exposure.below_median_grey;
+        check(
+            m.is_finite() && (0.0..=255.0).contains(&m),
+            "exposure.below_median_grey",
+            m,
+            "must be in 0..=255 grey levels (0: never)",
+        )?;
         let n = self.denoise.above_noise_grey;
         check(
             n.is_finite() && (0.0..=255.0).contains(&n),

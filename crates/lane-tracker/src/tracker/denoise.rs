@@ -24,21 +24,44 @@
 //! beside it in its gaps (the rendered `noise` scene) and gained nothing overall on the real
 //! stills (`docs/lanes/history/denoising.md`).
 //!
+//! **A brightened frame** (module `exposure`) has its noise multiplied by the gain: σ̂ is measured
+//! on the frame as it came and `gain · σ̂` compared with the limit.
+//!
 //! **When.** Measured on every frame that starts with no lane estimate (a new scene: the frame
 //! the road's bottom is placed on) and every [`REMEASURE_EVERY_FRAMES`] frames while lanes are
-//! tracked, carried in between. A frame below the limit is tracked as it is, at the cost of the
-//! measurement; one above it is written once into this stage's buffer (the rows any stage reads),
+//! tracked, carried in between ([`Remeasure`], the exposure's schedule too). A frame below the
+//! limit and not brightened is tracked as it is, at the cost of the measurements; otherwise it is
+//! written once into this stage's buffer (the rows any stage reads), smoothed then brightened,
 //! which the stages then read instead.
 //!
 //! Decisions and figures: `docs/lanes/history/denoising.md`.
 
 use serde::Serialize;
-use vision_gradient::{GreyImage, noise_sigma_grey, smooth_binomial};
+use vision_gradient::{GreyImage, brighten, brighten_in_place, noise_sigma_grey, smooth_binomial};
 
 use super::setup::Rows;
 
 /// Frames between two measurements while a lane is tracked.
 pub(crate) const REMEASURE_EVERY_FRAMES: u32 = 30;
+
+/// When the frame's levels are measured (module docs): a new scene, or [`REMEASURE_EVERY_FRAMES`]
+/// frames after the last measurement.
+#[derive(Debug, Default)]
+pub(super) struct Remeasure {
+    frames_since_measured: u32,
+}
+
+impl Remeasure {
+    /// Count this frame; whether it is measured (`new_scene`: no lane had an estimate).
+    pub(super) fn due(&mut self, new_scene: bool) -> bool {
+        self.frames_since_measured += 1;
+        let due = new_scene || self.frames_since_measured >= REMEASURE_EVERY_FRAMES;
+        if due {
+            self.frames_since_measured = 0;
+        }
+        due
+    }
+}
 
 /// The last measurement of the frames' noise and what it does to them (`nav-app --json`'s
 /// `noise`).
@@ -46,8 +69,8 @@ pub(crate) const REMEASURE_EVERY_FRAMES: u32 = 30;
 pub struct FrameNoise {
     /// Noise σ̂ of the rows searched, grey levels (0: not measured).
     pub sigma_grey: f64,
-    /// Whether the frames are smoothed before the stages read them (σ̂ above
-    /// `denoise.above_noise_grey`).
+    /// Whether the frames are smoothed before the stages read them (σ̂, times the exposure's
+    /// gain, above `denoise.above_noise_grey`).
     pub denoised: bool,
 }
 
@@ -59,37 +82,38 @@ impl FrameNoise {
     };
 }
 
-/// The stage: its limit, the histogram of a measurement and the buffers the smoothed frame is
-/// written to.
+/// The stage: its limit, the histogram of a measurement and the buffers the frame as the stages
+/// read it (smoothed, brightened) is written to.
 #[derive(Debug)]
 pub(super) struct Denoiser {
     /// `denoise.above_noise_grey` (0: never measured nor smoothed).
     above_noise_grey: f64,
     last: FrameNoise,
-    frames_since_measured: u32,
+    schedule: Remeasure,
+    /// The exposure's gain the last measurement was made for.
+    gain: f64,
     noise_hist: [u32; 256],
     /// The vertical binomial sums of the rows written, `width` a row.
     sums: Vec<u16>,
-    /// The smoothed frame, `width` a row.
+    /// The frame as the stages read it (smoothed, brightened), `width` a row.
     pixels: Vec<u8>,
 }
 
 impl Denoiser {
     /// The stage for `width × height` working frames, smoothing above `above_noise_grey`
-    /// (0: never).
-    pub(super) fn new(above_noise_grey: f64, width: usize, height: usize) -> Self {
-        let n = if above_noise_grey > 0.0 {
-            width * height
-        } else {
-            0
-        };
+    /// (0: never); `brightens`: whether the exposure stage may brighten them (the frame's buffer
+    /// is then kept even when the noise is never measured).
+    pub(super) fn new(above_noise_grey: f64, brightens: bool, width: usize, height: usize) -> Self {
+        let smooths = above_noise_grey > 0.0;
+        let size = |kept: bool| if kept { width * height } else { 0 };
         Denoiser {
             above_noise_grey,
             last: FrameNoise::NONE,
-            frames_since_measured: 0,
+            schedule: Remeasure::default(),
+            gain: 1.0,
             noise_hist: [0; 256],
-            sums: vec![0; n],
-            pixels: vec![0; n],
+            sums: vec![0; size(smooths)],
+            pixels: vec![0; size(smooths || brightens)],
         }
     }
 
@@ -101,18 +125,21 @@ impl Denoiser {
     /// Forget the last measurement (a reset).
     pub(super) fn reset(&mut self) {
         self.last = FrameNoise::NONE;
-        self.frames_since_measured = 0;
+        self.schedule = Remeasure::default();
+        self.gain = 1.0;
     }
 
-    /// Measure `image` over `roi` when due: on a frame that starts with no lane estimate
-    /// (`new_scene`), or [`REMEASURE_EVERY_FRAMES`] frames after the last measurement.
-    pub(super) fn measure_if_due(&mut self, image: &GreyImage<'_>, roi: Rows, new_scene: bool) {
-        if self.above_noise_grey <= 0.0 {
-            return;
-        }
-        self.frames_since_measured += 1;
-        if new_scene || self.frames_since_measured >= REMEASURE_EVERY_FRAMES {
-            self.frames_since_measured = 0;
+    /// Measure `image` over `roi` when due ([`Remeasure`]), for frames brightened by `gain` (the
+    /// exposure stage's, measured on the same frame; 1: not brightened).
+    pub(super) fn measure_if_due(
+        &mut self,
+        image: &GreyImage<'_>,
+        roi: Rows,
+        new_scene: bool,
+        gain: f64,
+    ) {
+        self.gain = gain;
+        if self.above_noise_grey > 0.0 && self.schedule.due(new_scene) {
             self.measure(image, roi);
         }
     }
@@ -122,31 +149,42 @@ impl Denoiser {
         self.last = match noise_sigma_grey(image, roi, &mut self.noise_hist) {
             Some(sigma_grey) => FrameNoise {
                 sigma_grey,
-                denoised: sigma_grey > self.above_noise_grey,
+                denoised: sigma_grey * self.gain > self.above_noise_grey,
             },
             None => FrameNoise::NONE,
         };
     }
 
-    /// The frame the stages read when the last measurement smooths: `image`'s rows `rows`
-    /// smoothed into a buffer lent out of the stage (the other rows are stale;
-    /// give it back with [`Self::put_back`]); `None`: `image` as it is.
-    pub(super) fn smoothed(&mut self, image: &GreyImage<'_>, rows: Rows) -> Option<Vec<u8>> {
+    /// The frame the stages read when the last measurements smooth or brighten it: `image`'s
+    /// rows `rows` smoothed, then multiplied by the exposure's gain, into a buffer lent out of
+    /// the stage (the other rows are stale; give it back with [`Self::put_back`]); `None`:
+    /// `image` as it is.
+    pub(super) fn frame_as_read(&mut self, image: &GreyImage<'_>, rows: Rows) -> Option<Vec<u8>> {
         let (w, h) = (image.width(), image.height());
-        if !self.last.denoised || self.pixels.len() != w * h {
+        let brightened = self.gain > 1.0;
+        if !(self.last.denoised || brightened) || self.pixels.len() != w * h {
             return None;
         }
         let mut out = std::mem::take(&mut self.pixels);
         let rows = (rows.0.min(h), rows.1.min(h));
         // The buffers hold `w × h` (checked above), all any rows need.
-        if smooth_binomial(image, rows, &mut self.sums, &mut out).is_err() {
+        let written = if self.last.denoised {
+            smooth_binomial(image, rows, &mut self.sums, &mut out).map(|()| {
+                if brightened {
+                    brighten_in_place(&mut out[rows.0 * w..rows.1.max(rows.0) * w], self.gain);
+                }
+            })
+        } else {
+            brighten(image, rows, self.gain, &mut out)
+        };
+        if written.is_err() {
             self.pixels = out;
             return None;
         }
         Some(out)
     }
 
-    /// The buffer [`Self::smoothed`] lent out, back.
+    /// The buffer [`Self::frame_as_read`] lent out, back.
     pub(super) fn put_back(&mut self, pixels: Vec<u8>) {
         self.pixels = pixels;
     }

@@ -4,6 +4,7 @@
 //! | stage | type (module) | reads → writes |
 //! |---|---|---|
 //! | working frame | `WorkingFrame` (`working`) | input → working frame; lanes → reports in input px |
+//! | frame's levels | `Exposure` (`exposure`), `Denoiser` (`denoise`) | working frame → the frame as the stages read it (brightened, smoothed) |
 //! | I. gradient | `EdgeStage` (`edges`) | frame, rows or windows → edge pixels |
 //! | II. initialisation | `Initialiser` (`init`, `candidates`, `chosen_fit`) | edges → candidates, chosen pair, fresh lanes |
 //! | III. windows | `predict_windows` (`windows`) | lane → prediction, windows |
@@ -28,6 +29,7 @@ mod chosen_fit;
 mod denoise;
 mod double_line;
 mod edges;
+mod exposure;
 mod gates;
 mod init;
 mod joint;
@@ -57,6 +59,8 @@ pub use report::{
 use denoise::Denoiser;
 pub use denoise::FrameNoise;
 use edges::EdgeStage;
+use exposure::Exposure;
+pub use exposure::{FrameExposure, MAX_EXPOSURE_GAIN};
 use init::Initialiser;
 use kerb::KerbReader;
 use lane::{Health, LaneFilter, Lanes};
@@ -77,6 +81,8 @@ pub struct LaneTracker {
     frame: WorkingFrame,
     /// Where the road ends at the bottom (`roi.road_bottom`, module `road`).
     road: RoadFinder,
+    /// The frame's exposure (`[exposure]`, module `exposure`).
+    exposure: Exposure,
     /// The frame's noise (`[denoise]`, module `denoise`).
     denoiser: Denoiser,
     /// Stage I.
@@ -147,7 +153,13 @@ impl LaneTracker {
         Ok(LaneTracker {
             frame,
             road: RoadFinder::new(width, height, whole_frame),
-            denoiser: Denoiser::new(cfg.denoise.above_noise_grey, width, height),
+            exposure: Exposure::new(cfg.exposure.below_median_grey),
+            denoiser: Denoiser::new(
+                cfg.denoise.above_noise_grey,
+                cfg.exposure.below_median_grey > 0.0,
+                width,
+                height,
+            ),
             edges,
             init,
             points: PointSelector::new(capacity),
@@ -218,6 +230,12 @@ impl LaneTracker {
         self.denoiser.last()
     }
 
+    /// The last measurement of the frames' exposure and the gain it brightens them by
+    /// (`[exposure]`; [`FrameExposure::NONE`] before the first measurement or with it off).
+    pub fn frame_exposure(&self) -> FrameExposure {
+        self.exposure.last()
+    }
+
     /// The configuration in use.
     pub fn config(&self) -> &TrackerConfig {
         &self.setup.cfg
@@ -241,6 +259,7 @@ impl LaneTracker {
         self.init.found.clear();
         self.health = Health::default();
         self.road.reset();
+        self.exposure.reset();
         self.denoiser.reset();
         // What the accessors hand out with a resampled input: the cleared lanes, mapped.
         if self.frame.resamples() {
@@ -403,23 +422,28 @@ impl LaneTracker {
         })
     }
 
-    /// The working frame as the stages read it (module `denoise`): its noise measured when due
-    /// (`new_scene`: no lane had an estimate), and the frame smoothed where the last measurement
-    /// says so.
+    /// The working frame as the stages read it (modules `exposure`, `denoise`): its exposure and
+    /// noise measured when due (`new_scene`: no lane had an estimate), and the frame brightened
+    /// and smoothed where the last measurements say so.
     fn track_denoised(
         &mut self,
         image: GreyImage<'_>,
         new_scene: bool,
     ) -> Result<bool, TrackerError> {
-        self.denoiser
-            .measure_if_due(&image, self.setup.roi, new_scene);
-        let Some(pixels) = self.denoiser.smoothed(&image, self.frame.resampled_rows()) else {
+        let roi = self.setup.roi;
+        self.exposure.measure_if_due(&image, roi, new_scene);
+        let gain = self.exposure.last().gain;
+        self.denoiser.measure_if_due(&image, roi, new_scene, gain);
+        let Some(pixels) = self
+            .denoiser
+            .frame_as_read(&image, self.frame.resampled_rows())
+        else {
             return self.track_working(image);
         };
         let (w, h) = (self.setup.width, self.setup.height);
         let tracked = GreyImage::new(&pixels, w, h, w)
             .map_err(TrackerError::from)
-            .and_then(|smoothed| self.track_working(smoothed));
+            .and_then(|as_read| self.track_working(as_read));
         self.denoiser.put_back(pixels);
         tracked
     }
@@ -431,15 +455,20 @@ impl LaneTracker {
         let square = self.frame.square_view();
         self.frame.set_rows(square.rows);
         let h = self.setup.height;
+        // The road is looked for on the frame as the stages will read it: its exposure's gain
+        // (module `exposure`) measured over the square view's ROI.
+        let roi = self.setup.roi;
         let bottom = if square.is_identity() {
-            self.road.find(input, (0, input.height()))
+            let gain = self.exposure.gain_of(input, roi);
+            self.road.find(input, (0, input.height()), gain)
         } else {
             let pixels = self.frame.resample(input)?;
             let w = self.setup.width;
             let rows = self.frame.resampled_rows();
-            let found = GreyImage::new(&pixels, w, h, w)
-                .ok()
-                .and_then(|image| self.road.find(&image, rows));
+            let found = GreyImage::new(&pixels, w, h, w).ok().and_then(|image| {
+                let gain = self.exposure.gain_of(&image, roi);
+                self.road.find(&image, rows, gain)
+            });
             self.frame.put_back(pixels);
             found
         };

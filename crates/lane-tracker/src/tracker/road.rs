@@ -19,7 +19,8 @@
 //! lane-like edge:   |I(x+1, y) − I(x−1, y)| ≥ T   and  > |I(x, y+1) − I(x, y−1)|,
 //! ```
 //!
-//! (`T` = [`EDGE_STEP`] grey levels). Row `y` is a boundary when the columns holding a
+//! (`T` = [`EDGE_STEP`] grey levels; `T / gain` on a frame the exposure stage brightens by
+//! `gain`, module `exposure`: the same as brightening it). Row `y` is a boundary when the columns holding a
 //! horizontal edge within ±2 rows of it (a curved bonnet edge spans a few rows) cover at least
 //! [`MIN_BOUNDARY_COVER`] of the width, and the rows under it (from `y + 3`, at least
 //! [`MIN_BONNET_ROWS`] of the height) hold at most [`MAX_LANE_EDGES_BELOW`] lane-like edges per
@@ -97,10 +98,13 @@ impl RoadFinder {
 
     /// The road's bottom, `[0, h]` working rows of the square view (one past the last row of
     /// road), found on `image` (the square view's working frame, valid on `rows`) and carried
-    /// over the sequence (module docs): `None` when the road reaches the frame's bottom.
-    pub(super) fn find(&mut self, image: &GreyImage<'_>, rows: Rows) -> Option<f64> {
+    /// over the sequence (module docs), for a frame the exposure stage brightens by `gain` (1:
+    /// read as it is): `None` when the road reaches the frame's bottom.
+    pub(super) fn find(&mut self, image: &GreyImage<'_>, rows: Rows, gain: f64) -> Option<f64> {
         let h = image.height();
-        let found = self.boundary(image, rows).map(|b| b as f64);
+        // Rounded, at least one grey level (`gain` is 1..=2).
+        let step = ((f64::from(EDGE_STEP) / gain.max(1.0)).round() as i16).max(1);
+        let found = self.boundary(image, rows, step).map(|b| b as f64);
         self.bottom_row = match (self.bottom_row, found) {
             (Some(last), Some(now)) if (last - now).abs() <= SAME_BOTTOM_FRACTION * h as f64 => {
                 Some(0.5 * (last + now))
@@ -110,8 +114,8 @@ impl RoadFinder {
         self.bottom_row
     }
 
-    /// The boundary row's road bottom on this frame alone (module docs).
-    fn boundary(&mut self, image: &GreyImage<'_>, rows: Rows) -> Option<usize> {
+    /// The boundary row's road bottom on this frame alone, `step` its edges' step (module docs).
+    fn boundary(&mut self, image: &GreyImage<'_>, rows: Rows, step: i16) -> Option<usize> {
         let (w, h) = (image.width(), image.height());
         let first = (h / 2).max(rows.0 + 1);
         let last = h.min(rows.1).saturating_sub(1);
@@ -132,9 +136,9 @@ impl RoadFinder {
             for x in 1..w - 1 {
                 let gv = (i16::from(down[x]) - i16::from(up[x])).abs();
                 let gh = (i16::from(mid[x + 1]) - i16::from(mid[x - 1])).abs();
-                let horizontal = gv >= EDGE_STEP && gv >= 2 * gh;
+                let horizontal = gv >= step && gv >= 2 * gh;
                 bits[x / 64] |= u64::from(horizontal) << (x % 64);
-                lane_edges += u32::from(gh >= EDGE_STEP && gh > gv);
+                lane_edges += u32::from(gh >= step && gh > gv);
             }
             self.lane_edges[y] = lane_edges;
         }
@@ -245,7 +249,7 @@ mod tests {
 
     fn find(img: &[u8]) -> Option<f64> {
         let image = GreyImage::new(img, W, H, W).expect("image");
-        finder().find(&image, (0, H))
+        finder().find(&image, (0, H), 1.0)
     }
 
     #[test]
@@ -289,12 +293,23 @@ mod tests {
     }
 
     #[test]
+    fn an_under_exposed_road_read_with_its_gain_is_not_taken_for_a_bonnet() {
+        // The road at a tenth of its exposure: the marks' step (11 grey levels) is under the
+        // edge step, and the rows read as a flat run. Brightened twofold (the step halved) the
+        // marks are lane-like edges again and the road reaches the frame's bottom.
+        let dark: Vec<u8> = road(0).iter().map(|&v| v / 10).collect();
+        let image = GreyImage::new(&dark, W, H, W).expect("image");
+        assert!(finder().find(&image, (0, H), 1.0).is_some());
+        assert_eq!(finder().find(&image, (0, H), 2.0), None);
+    }
+
+    #[test]
     fn a_bottom_seen_again_is_averaged_and_a_new_one_replaces_it() {
         let mut finder = finder();
         let mut at = |top| {
             let img = with_bonnet(road(4), top, 0.0);
             let image = GreyImage::new(&img, W, H, W).expect("image");
-            finder.find(&image, (0, H))
+            finder.find(&image, (0, H), 1.0)
         };
         let first = at(140).expect("found");
         let again = at(142).expect("found");

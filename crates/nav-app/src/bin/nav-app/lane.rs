@@ -369,6 +369,7 @@ fn run(
                 t_s: meta.t_s,
                 lanes: &report.lanes,
                 road: report.road,
+                exposure: t.frame_exposure(),
                 noise: t.frame_noise(),
                 track_us: dt.as_secs_f64() * 1e6,
                 ego_lane: ego,

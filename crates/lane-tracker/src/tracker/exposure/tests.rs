@@ -1,0 +1,99 @@
+use super::super::denoise::{Denoiser, REMEASURE_EVERY_FRAMES};
+use super::*;
+
+const W: usize = 48;
+const H: usize = 32;
+
+/// A flat frame of one grey with a bright mark (columns 20..24) of `mark` grey: its median is
+/// `grey`.
+fn frame(grey: u8, mark: u8) -> Vec<u8> {
+    (0..W * H)
+        .map(|i| {
+            if (20..24).contains(&(i % W)) {
+                mark
+            } else {
+                grey
+            }
+        })
+        .collect()
+}
+
+fn image(px: &[u8]) -> GreyImage<'_> {
+    GreyImage::new(px, W, H, W).expect("test image")
+}
+
+#[test]
+fn a_frame_darker_than_the_limit_is_brightened_up_to_it_and_one_at_it_is_not() {
+    let mut stage = Exposure::new(50.0);
+    let dark = frame(25, 60);
+    stage.measure_if_due(&image(&dark), (0, H), true);
+    assert_eq!(
+        stage.last(),
+        FrameExposure {
+            median_grey: 25.0,
+            gain: 2.0
+        }
+    );
+    // A third of the limit: capped at MAX_EXPOSURE_GAIN.
+    stage.measure_if_due(&image(&frame(10, 40)), (0, H), true);
+    assert_eq!(stage.last().gain, MAX_EXPOSURE_GAIN);
+    stage.measure_if_due(&image(&frame(40, 90)), (0, H), true);
+    assert!((stage.last().gain - 1.25).abs() < 1e-12);
+    stage.measure_if_due(&image(&frame(50, 90)), (0, H), true);
+    assert_eq!(stage.last().gain, 1.0);
+    // Off: never measured.
+    let mut off = Exposure::new(0.0);
+    off.measure_if_due(&image(&dark), (0, H), true);
+    assert_eq!(off.last(), FrameExposure::NONE);
+}
+
+#[test]
+fn the_gain_is_carried_between_measurements_and_forgotten_on_reset() {
+    let mut stage = Exposure::new(50.0);
+    stage.measure_if_due(&image(&frame(25, 60)), (0, H), true);
+    let bright = frame(120, 200);
+    for _ in 1..REMEASURE_EVERY_FRAMES {
+        stage.measure_if_due(&image(&bright), (0, H), false);
+        assert_eq!(stage.last().gain, 2.0, "carried until the period's frame");
+    }
+    stage.measure_if_due(&image(&bright), (0, H), false);
+    assert_eq!(stage.last().gain, 1.0, "measured on the period's frame");
+    stage.reset();
+    assert_eq!(stage.last(), FrameExposure::NONE);
+}
+
+#[test]
+fn the_frame_as_read_is_brightened_by_the_gain_and_its_noise_judged_brightened() {
+    let dark = frame(25, 60);
+    // Noise off, brightening on: the buffer is kept and the frame brightened.
+    let mut levels = Denoiser::new(0.0, true, W, H);
+    levels.measure_if_due(&image(&dark), (0, H), true, 2.0);
+    let read = levels
+        .frame_as_read(&image(&dark), (0, H))
+        .expect("a brightened frame is written");
+    assert_eq!(read, frame(50, 120));
+    levels.put_back(read);
+    // Gain 1: read as it is.
+    levels.measure_if_due(&image(&dark), (0, H), true, 1.0);
+    assert!(levels.frame_as_read(&image(&dark), (0, H)).is_none());
+    // A checkerboard of ±1 (σ̂ ≈ 3.95) passes the limit of 4 as it is, not brightened twice.
+    let board: Vec<u8> = (0..W * H)
+        .map(|i| {
+            if (i % W + i / W).is_multiple_of(2) {
+                31
+            } else {
+                29
+            }
+        })
+        .collect();
+    let mut noise = Denoiser::new(4.0, true, W, H);
+    noise.measure_if_due(&image(&board), (0, H), true, 1.0);
+    assert!(!noise.last().denoised);
+    noise.measure_if_due(&image(&board), (0, H), true, 2.0);
+    assert!(noise.last().denoised, "σ̂ · gain = 7.9 > 4");
+    let read = noise
+        .frame_as_read(&image(&board), (0, H))
+        .expect("smoothed and brightened");
+    // Smoothed to 30 ± 1, then doubled.
+    assert!(read[W + 1..2 * W - 1].iter().all(|&v| v.abs_diff(60) <= 2));
+}
