@@ -45,6 +45,15 @@ fn noisy(frame: &GreyFrame) -> GreyFrame {
     out
 }
 
+/// `frame` at a third of its exposure (every grey level divided by 3, rounded down).
+fn dark(frame: &GreyFrame) -> GreyFrame {
+    let mut out = frame.clone();
+    for v in out.data_mut() {
+        *v /= 3;
+    }
+    out
+}
+
 /// A tracker for `frame`'s size that has tracked it five times (its lanes settled on it).
 fn warmed_up(cfg: &TrackerConfig, estimator: Estimator, frame: &GreyFrame) -> LaneTracker {
     let mut tracker = LaneTracker::new(cfg, estimator, frame.width(), frame.height()).unwrap();
@@ -120,6 +129,21 @@ fn tracking_frame(c: &mut Criterion) {
             if !tracking.track(&noisy_frame).unwrap().full_gradient {
                 group.bench_function(BenchmarkId::new("kif_default_noisy", name), |b| {
                     b.iter(|| black_box(tracking.track(black_box(&noisy_frame)).unwrap()));
+                });
+            }
+        }
+        // The same frame at a third of its exposure: brightened on every frame before the stages
+        // read it (`[exposure]`).
+        if *name == "udacity_320x240" {
+            let dark_frame = dark(frame);
+            let mut tracking = warmed_up(&tracked_only, Estimator::Kif, &dark_frame);
+            assert!(
+                tracking.frame_exposure().gain > 1.0,
+                "a third must be brightened"
+            );
+            if !tracking.track(&dark_frame).unwrap().full_gradient {
+                group.bench_function(BenchmarkId::new("kif_default_dark", name), |b| {
+                    b.iter(|| black_box(tracking.track(black_box(&dark_frame)).unwrap()));
                 });
             }
         }

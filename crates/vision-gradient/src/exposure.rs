@@ -1,7 +1,8 @@
 //! # A frame's exposure: its median grey and a gain
 //!
-//! **The measure.** The median grey of the rows asked for (a histogram of every pixel; the
-//! smallest level with at least half the pixels at or below it). On a road or a floor most of
+//! **The measure.** The median grey of the rows asked for (a histogram of every other pixel of
+//! every other row, as the noise estimate reads them; the smallest level with at least half the
+//! pixels counted at or below it). On a road or a floor most of
 //! the rows searched are the surface itself, so the median is the surface's grey — the camera's
 //! exposure of it — and a mark, a shadow or a car move it little.
 //!
@@ -20,8 +21,9 @@ use crate::noise::median;
 use crate::resample::check;
 use crate::{GradientError, GreyImage};
 
-/// The median grey of `image`'s rows `[first, end)` (clamped to the frame), counting every pixel
-/// in `hist` (cleared first); `None` when the rows hold no pixel.
+/// The median grey of `image`'s rows `[first, end)` (clamped to the frame), counting every other
+/// pixel of every other row (from `first`) in `hist` (cleared first); `None` when the rows hold
+/// no pixel.
 pub fn median_grey(
     image: &GreyImage<'_>,
     (first, end): (usize, usize),
@@ -29,12 +31,12 @@ pub fn median_grey(
 ) -> Option<u8> {
     hist.fill(0);
     let mut n = 0usize;
-    for y in first..end.min(image.height()) {
+    for y in (first..end.min(image.height())).step_by(2) {
         let Some(row) = image.row(y) else { continue };
-        for &v in row {
+        for &v in row.iter().step_by(2) {
             hist[usize::from(v)] += 1;
+            n += 1;
         }
-        n += row.len();
     }
     // The median of 8-bit levels is one.
     (n > 0).then(|| median(hist, n) as u8)

@@ -479,8 +479,8 @@ pub struct DenoiseConfig {
 }
 
 /// The frame's exposure (an addition beyond the paper; module `tracker::exposure`): the median
-/// grey of the rows searched, measured on the noise stage's schedule, and a frame darker than the
-/// exposures the settings were tuned on brightened up to them. Absent: never.
+/// grey of the rows searched, measured on every frame, and a frame darker than the exposures the
+/// settings were tuned on brightened up to them. Absent: never.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ExposureConfig {

@@ -29,7 +29,7 @@
 //!
 //! **When.** Measured on every frame that starts with no lane estimate (a new scene: the frame
 //! the road's bottom is placed on) and every [`REMEASURE_EVERY_FRAMES`] frames while lanes are
-//! tracked, carried in between ([`Remeasure`], the exposure's schedule too). A frame below the
+//! tracked, carried in between ([`Remeasure`]). A frame below the
 //! limit and not brightened is tracked as it is, at the cost of the measurements; otherwise it is
 //! written once into this stage's buffer (the rows any stage reads), smoothed then brightened,
 //! which the stages then read instead.

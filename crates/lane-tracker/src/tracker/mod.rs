@@ -422,16 +422,16 @@ impl LaneTracker {
         })
     }
 
-    /// The working frame as the stages read it (modules `exposure`, `denoise`): its exposure and
-    /// noise measured when due (`new_scene`: no lane had an estimate), and the frame brightened
-    /// and smoothed where the last measurements say so.
+    /// The working frame as the stages read it (modules `exposure`, `denoise`): its exposure
+    /// measured, its noise when due (`new_scene`: no lane had an estimate), and the frame
+    /// brightened and smoothed where the measurements say so.
     fn track_denoised(
         &mut self,
         image: GreyImage<'_>,
         new_scene: bool,
     ) -> Result<bool, TrackerError> {
         let roi = self.setup.roi;
-        self.exposure.measure_if_due(&image, roi, new_scene);
+        self.exposure.measure_frame(&image, roi);
         let gain = self.exposure.last().gain;
         self.denoiser.measure_if_due(&image, roi, new_scene, gain);
         let Some(pixels) = self

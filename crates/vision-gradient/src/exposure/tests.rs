@@ -3,16 +3,17 @@ use super::*;
 const W: usize = 40;
 const H: usize = 30;
 
-/// A road-like frame: every level 0..=199 once per row in a shuffled order, then grey 90 to the
-/// row's end (the median of a row: 90).
+/// A road-like frame: a dark band (columns 0..8, grey 20), a bright one (8..16, 220), road grey
+/// 90 on the other 24 columns: the median of any rows is 90; a row's texture on top (0..=4).
 fn frame() -> Vec<u8> {
     (0..W * H)
         .map(|i| {
-            let x = i % W;
-            if x < 20 {
-                ((x * 37 + i / W * 11) % 200) as u8
-            } else {
-                90
+            let (x, y) = (i % W, i / W);
+            let texture = ((x * 7 + y * 11) % 5) as u8;
+            match x {
+                0..8 => 20 + texture,
+                8..16 => 220 + texture,
+                _ => 90,
             }
         })
         .collect()
@@ -27,12 +28,18 @@ fn the_median_grey_is_the_level_half_the_rows_pixels_reach() {
     let mut hist = [0u32; 256];
     let px = frame();
     assert_eq!(median_grey(&image(&px), (0, H), &mut hist), Some(90));
-    // Rows of one grey each: rows 0..10 at 20, 10..30 at 200 (only rows 5..15 asked: 5 and 5).
+    // Rows of one grey each: rows 0..10 at 20, 10..30 at 200. Rows 4..14 asked: 4, 6, 8 at 20
+    // and 10, 12 at 200 counted; rows 6..16: 6, 8 and 10, 12, 14.
     let banded: Vec<u8> = (0..W * H)
         .map(|i| if i / W < 10 { 20 } else { 200 })
         .collect();
-    assert_eq!(median_grey(&image(&banded), (5, 15), &mut hist), Some(20));
-    assert_eq!(median_grey(&image(&banded), (5, 16), &mut hist), Some(200));
+    assert_eq!(median_grey(&image(&banded), (4, 14), &mut hist), Some(20));
+    assert_eq!(median_grey(&image(&banded), (6, 16), &mut hist), Some(200));
+    assert_eq!(
+        hist[200],
+        3 * W as u32 / 2,
+        "every other pixel of rows 10, 12, 14"
+    );
     assert_eq!(median_grey(&image(&banded), (30, 40), &mut hist), None);
 }
 

@@ -1,4 +1,4 @@
-use super::super::denoise::{Denoiser, REMEASURE_EVERY_FRAMES};
+use super::super::denoise::Denoiser;
 use super::*;
 
 const W: usize = 48;
@@ -26,7 +26,7 @@ fn image(px: &[u8]) -> GreyImage<'_> {
 fn a_frame_darker_than_the_limit_is_brightened_up_to_it_and_one_at_it_is_not() {
     let mut stage = Exposure::new(50.0);
     let dark = frame(25, 60);
-    stage.measure_if_due(&image(&dark), (0, H), true);
+    stage.measure_frame(&image(&dark), (0, H));
     assert_eq!(
         stage.last(),
         FrameExposure {
@@ -35,29 +35,32 @@ fn a_frame_darker_than_the_limit_is_brightened_up_to_it_and_one_at_it_is_not() {
         }
     );
     // A third of the limit: capped at MAX_EXPOSURE_GAIN.
-    stage.measure_if_due(&image(&frame(10, 40)), (0, H), true);
+    stage.measure_frame(&image(&frame(10, 40)), (0, H));
     assert_eq!(stage.last().gain, MAX_EXPOSURE_GAIN);
-    stage.measure_if_due(&image(&frame(40, 90)), (0, H), true);
+    stage.measure_frame(&image(&frame(40, 90)), (0, H));
     assert!((stage.last().gain - 1.25).abs() < 1e-12);
-    stage.measure_if_due(&image(&frame(50, 90)), (0, H), true);
+    stage.measure_frame(&image(&frame(50, 90)), (0, H));
     assert_eq!(stage.last().gain, 1.0);
     // Off: never measured.
     let mut off = Exposure::new(0.0);
-    off.measure_if_due(&image(&dark), (0, H), true);
+    off.measure_frame(&image(&dark), (0, H));
     assert_eq!(off.last(), FrameExposure::NONE);
 }
 
 #[test]
-fn the_gain_is_carried_between_measurements_and_forgotten_on_reset() {
+fn every_frame_is_measured_and_a_reset_forgets_the_last() {
+    // A bright frame after a dark one is read as it is (a gain carried would saturate it).
     let mut stage = Exposure::new(50.0);
-    stage.measure_if_due(&image(&frame(25, 60)), (0, H), true);
-    let bright = frame(120, 200);
-    for _ in 1..REMEASURE_EVERY_FRAMES {
-        stage.measure_if_due(&image(&bright), (0, H), false);
-        assert_eq!(stage.last().gain, 2.0, "carried until the period's frame");
-    }
-    stage.measure_if_due(&image(&bright), (0, H), false);
-    assert_eq!(stage.last().gain, 1.0, "measured on the period's frame");
+    stage.measure_frame(&image(&frame(25, 60)), (0, H));
+    assert_eq!(stage.last().gain, 2.0);
+    stage.measure_frame(&image(&frame(120, 200)), (0, H));
+    assert_eq!(
+        stage.last(),
+        FrameExposure {
+            median_grey: 120.0,
+            gain: 1.0
+        }
+    );
     stage.reset();
     assert_eq!(stage.last(), FrameExposure::NONE);
 }
