@@ -25,11 +25,12 @@
 //! stills (`docs/lanes/history/denoising.md`).
 //!
 //! **A brightened frame** (module `exposure`) has its noise multiplied by the gain: σ̂ is measured
-//! on the frame as it came and `gain · σ̂` compared with the limit.
+//! on the frame as it came and `gain · σ̂` compared with the limit, on every frame with that
+//! frame's gain (σ̂ is carried, the gain is not).
 //!
 //! **When.** Measured on every frame that starts with no lane estimate (a new scene: the frame
 //! the road's bottom is placed on) and every [`REMEASURE_EVERY_FRAMES`] frames while lanes are
-//! tracked, carried in between ([`Remeasure`]). A frame below the
+//! tracked, carried in between. A frame below the
 //! limit and not brightened is tracked as it is, at the cost of the measurements; otherwise it is
 //! written once into this stage's buffer (the rows any stage reads), smoothed then brightened,
 //! which the stages then read instead.
@@ -43,25 +44,6 @@ use super::setup::Rows;
 
 /// Frames between two measurements while a lane is tracked.
 pub(crate) const REMEASURE_EVERY_FRAMES: u32 = 30;
-
-/// When the frame's levels are measured (module docs): a new scene, or [`REMEASURE_EVERY_FRAMES`]
-/// frames after the last measurement.
-#[derive(Debug, Default)]
-pub(super) struct Remeasure {
-    frames_since_measured: u32,
-}
-
-impl Remeasure {
-    /// Count this frame; whether it is measured (`new_scene`: no lane had an estimate).
-    pub(super) fn due(&mut self, new_scene: bool) -> bool {
-        self.frames_since_measured += 1;
-        let due = new_scene || self.frames_since_measured >= REMEASURE_EVERY_FRAMES;
-        if due {
-            self.frames_since_measured = 0;
-        }
-        due
-    }
-}
 
 /// The last measurement of the frames' noise and what it does to them (`nav-app --json`'s
 /// `noise`).
@@ -89,8 +71,8 @@ pub(super) struct Denoiser {
     /// `denoise.above_noise_grey` (0: never measured nor smoothed).
     above_noise_grey: f64,
     last: FrameNoise,
-    schedule: Remeasure,
-    /// The exposure's gain the last measurement was made for.
+    frames_since_measured: u32,
+    /// The exposure's gain on this frame.
     gain: f64,
     noise_hist: [u32; 256],
     /// The vertical binomial sums of the rows written, `width` a row.
@@ -109,7 +91,7 @@ impl Denoiser {
         Denoiser {
             above_noise_grey,
             last: FrameNoise::NONE,
-            schedule: Remeasure::default(),
+            frames_since_measured: 0,
             gain: 1.0,
             noise_hist: [0; 256],
             sums: vec![0; size(smooths)],
@@ -125,12 +107,14 @@ impl Denoiser {
     /// Forget the last measurement (a reset).
     pub(super) fn reset(&mut self) {
         self.last = FrameNoise::NONE;
-        self.schedule = Remeasure::default();
+        self.frames_since_measured = 0;
         self.gain = 1.0;
     }
 
-    /// Measure `image` over `roi` when due ([`Remeasure`]), for frames brightened by `gain` (the
-    /// exposure stage's, measured on the same frame; 1: not brightened).
+    /// Measure `image` over `roi` when due: on a frame that starts with no lane estimate
+    /// (`new_scene`), or [`REMEASURE_EVERY_FRAMES`] frames after the last measurement; and
+    /// whether this frame, brightened by `gain` (the exposure stage's on this frame; 1: not
+    /// brightened), is smoothed.
     pub(super) fn measure_if_due(
         &mut self,
         image: &GreyImage<'_>,
@@ -139,20 +123,16 @@ impl Denoiser {
         gain: f64,
     ) {
         self.gain = gain;
-        if self.above_noise_grey > 0.0 && self.schedule.due(new_scene) {
-            self.measure(image, roi);
+        if self.above_noise_grey <= 0.0 {
+            return;
         }
-    }
-
-    /// σ̂ of `roi` (module docs), and whether to smooth.
-    fn measure(&mut self, image: &GreyImage<'_>, roi: Rows) {
-        self.last = match noise_sigma_grey(image, roi, &mut self.noise_hist) {
-            Some(sigma_grey) => FrameNoise {
-                sigma_grey,
-                denoised: sigma_grey * self.gain > self.above_noise_grey,
-            },
-            None => FrameNoise::NONE,
-        };
+        self.frames_since_measured += 1;
+        if new_scene || self.frames_since_measured >= REMEASURE_EVERY_FRAMES {
+            self.frames_since_measured = 0;
+            self.last.sigma_grey =
+                noise_sigma_grey(image, roi, &mut self.noise_hist).unwrap_or(0.0);
+        }
+        self.last.denoised = self.last.sigma_grey * gain > self.above_noise_grey;
     }
 
     /// The frame the stages read when the last measurements smooth or brighten it: `image`'s

@@ -100,3 +100,21 @@ fn the_frame_as_read_is_brightened_by_the_gain_and_its_noise_judged_brightened()
     // Smoothed to 30 ± 1, then doubled.
     assert!(read[W + 1..2 * W - 1].iter().all(|&v| v.abs_diff(60) <= 2));
 }
+
+#[test]
+fn the_noise_carried_between_measurements_is_judged_with_each_frames_gain() {
+    // σ̂ ≈ 3.95 measured on a scene's first frame; the next frames are not measured again, but a
+    // frame brightened twofold is smoothed (7.9 > 4) and one read as it is is not.
+    let board: Vec<u8> = (0..W * H)
+        .map(|i| if (i % W + i / W).is_multiple_of(2) { 31 } else { 29 })
+        .collect();
+    let flat = frame(30, 30);
+    let mut noise = Denoiser::new(4.0, true, W, H);
+    noise.measure_if_due(&image(&board), (0, H), true, 1.0);
+    assert!(!noise.last().denoised);
+    noise.measure_if_due(&image(&flat), (0, H), false, 2.0);
+    assert!((noise.last().sigma_grey - 3.95).abs() < 0.01, "carried");
+    assert!(noise.last().denoised);
+    noise.measure_if_due(&image(&flat), (0, H), false, 1.0);
+    assert!(!noise.last().denoised);
+}
