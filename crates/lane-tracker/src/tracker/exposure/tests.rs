@@ -106,7 +106,13 @@ fn the_noise_carried_between_measurements_is_judged_with_each_frames_gain() {
     // σ̂ ≈ 3.95 measured on a scene's first frame; the next frames are not measured again, but a
     // frame brightened twofold is smoothed (7.9 > 4) and one read as it is is not.
     let board: Vec<u8> = (0..W * H)
-        .map(|i| if (i % W + i / W).is_multiple_of(2) { 31 } else { 29 })
+        .map(|i| {
+            if (i % W + i / W).is_multiple_of(2) {
+                31
+            } else {
+                29
+            }
+        })
         .collect();
     let flat = frame(30, 30);
     let mut noise = Denoiser::new(4.0, true, W, H);
